@@ -1,0 +1,137 @@
+// obscura bench-rays SCENE --rays N [--seed S] [--json] — traversal speed on the GPU path with
+// reproducible rays (see render/bench_rays.h), so other ray tracers can shoot the same ones.
+#include <algorithm>
+#include <vector>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "app/scene_setup.h"
+#include "core/error.h"
+#include "render/bench_rays.h"
+#include "render/ray_tracer.h"
+#include "render/scene_buffers.h"
+
+namespace obscura::app {
+namespace {
+
+struct BenchOptions {
+  std::string scenePath;
+  std::size_t rays = 1u << 20;
+  std::uint64_t seed = 1;
+  int repeats = 3;
+  std::size_t verify = 0;
+  bool json = false;
+  std::string saveRays;
+  DeviceOptions device;
+};
+
+struct SetResult {
+  double bestMs = 0.0, medianMs = 0.0;
+  double hitFraction = 0.0;
+  double meanSteps = 0.0;
+  std::size_t mismatches = 0;
+};
+
+SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std::vector<gpu::GpuRay>& rays,
+                 render::TraceMode mode, const BenchOptions& o) {
+  SetResult r;
+  // Warm-up (pipeline JIT, caches) and hit statistics, then timed repeats.
+  auto first = tracer.trace(rays, mode, true);
+  std::size_t hits = 0;
+  double steps = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (first.hits[i].primitive != gpu::kInvalidIndex) ++hits;
+    steps += first.steps[i];
+  }
+  r.hitFraction = rays.empty() ? 0.0 : static_cast<double>(hits) / static_cast<double>(rays.size());
+  r.meanSteps = rays.empty() ? 0.0 : steps / static_cast<double>(rays.size());
+  std::vector<double> times;
+  for (int k = 0; k < o.repeats; ++k) times.push_back(tracer.trace(rays, mode).gpuMs);
+  std::sort(times.begin(), times.end());
+  r.bestMs = times.front();
+  r.medianMs = times[times.size() / 2];
+  // Optional check of the first `verify` rays against the CPU reference traversal.
+  for (std::size_t i = 0; i < std::min(o.verify, rays.size()); ++i) {
+    bvh::Ray ray{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
+    bool gpuHit = first.hits[i].primitive != gpu::kInvalidIndex;
+    if (mode == render::TraceMode::Closest) {
+      bvh::Hit cpu = bvh::closestHit(loaded.bvh, ray);
+      if (cpu.primitive != first.hits[i].primitive) ++r.mismatches;
+    } else if (bvh::anyHit(loaded.bvh, ray) != gpuHit) {
+      ++r.mismatches;
+    }
+  }
+  return r;
+}
+
+void runBench(const BenchOptions& o) {
+  if (o.rays == 0) throw InputError("--rays must be at least 1");
+  LoadedScene loaded = loadScene(o.scenePath);
+  gpu::Context context(o.device.contextOptions());
+  if (!o.json) fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
+
+  render::SceneBuffers buffers(context, loaded.scene, loaded.bvh);
+  render::RayTracer tracer(context, buffers);
+  auto closestRays = render::closestBenchRays(loaded.scene.bounds, o.rays, o.seed);
+  auto shadowRays = render::shadowBenchRays(loaded.scene.bounds, o.rays, o.seed + 1);
+  if (!o.saveRays.empty()) {
+    render::saveRays(o.saveRays + ".closest.bin", closestRays);
+    render::saveRays(o.saveRays + ".shadow.bin", shadowRays);
+  }
+  SetResult closest = runSet(tracer, loaded, closestRays, render::TraceMode::Closest, o);
+  SetResult shadow = runSet(tracer, loaded, shadowRays, render::TraceMode::Any, o);
+  std::uint32_t truncated = buffers.truncatedTraversals();
+  if (truncated > 0) throw DeviceError(fmt::format("{} traversals ran out of steps", truncated));
+  if (closest.bestMs <= 0.0) throw DeviceError("the device has no timestamps; cannot time the traversal");
+
+  const double n = static_cast<double>(o.rays);
+  const double closestMrays = n / (closest.bestMs * 1e3), shadowMrays = n / (shadow.bestMs * 1e3);
+  if (o.json) {
+    nlohmann::json j = {{"scene", loaded.scene.sourcePath}, {"device", context.info().name},
+                        {"rays", o.rays}, {"seed", o.seed},
+                        {"triangles", loaded.scene.triangles.size()},
+                        {"build_s", loaded.bvh.stats.buildSeconds},
+                        {"bvh_nodes", loaded.bvh.stats.nodeCount}, {"bvh_depth", loaded.bvh.stats.maxDepth},
+                        {"sah_cost", loaded.bvh.stats.sahCost},
+                        {"closest_mrays_per_s", closestMrays},
+                        {"closest_median_mrays_per_s", n / (closest.medianMs * 1e3)},
+                        {"closest_hit_fraction", closest.hitFraction},
+                        {"closest_mean_steps", closest.meanSteps},
+                        {"shadow_mrays_per_s", shadowMrays},
+                        {"shadow_median_mrays_per_s", n / (shadow.medianMs * 1e3)},
+                        {"shadow_occluded_fraction", shadow.hitFraction},
+                        {"shadow_mean_steps", shadow.meanSteps},
+                        {"verified", o.verify},
+                        {"mismatches", closest.mismatches + shadow.mismatches}};
+    fmt::print("{}\n", j.dump());
+  } else {
+    fmt::print("closest hit (a): {:8.2f} Mrays/s (best of {}, median {:.2f}), hit fraction {:.3f}, {:.1f} steps/ray\n",
+               closestMrays, o.repeats, n / (closest.medianMs * 1e3), closest.hitFraction, closest.meanSteps);
+    fmt::print("shadow    (b): {:8.2f} Mrays/s (best of {}, median {:.2f}), occluded fraction {:.3f}, {:.1f} steps/ray\n",
+               shadowMrays, o.repeats, n / (shadow.medianMs * 1e3), shadow.hitFraction, shadow.meanSteps);
+    if (o.verify)
+      fmt::print("verified the first {} rays of each set against the CPU: {} mismatches\n", o.verify,
+                 closest.mismatches + shadow.mismatches);
+  }
+  if (closest.mismatches + shadow.mismatches > 0) throw DeviceError("GPU traversal disagrees with the CPU reference");
+}
+
+} // namespace
+
+void addBenchRaysCommand(CLI::App& app) {
+  auto o = std::make_shared<BenchOptions>();
+  CLI::App* cmd = app.add_subcommand("bench-rays", "Measure BVH traversal (closest-hit and shadow rays) on the GPU path");
+  cmd->add_option("scene", o->scenePath, "glTF 2.0 scene")->required();
+  cmd->add_option("--rays", o->rays, "rays per set")->check(CLI::Range(std::size_t(1), std::size_t(1) << 26));
+  cmd->add_option("--seed", o->seed, "seed of the ray generator");
+  cmd->add_option("--repeats", o->repeats, "timed repeats per set (the best is reported)")->check(CLI::Range(1, 100));
+  cmd->add_option("--verify", o->verify, "check the first N rays of each set against the CPU traversal");
+  cmd->add_option("--save-rays", o->saveRays, "write the rays to PREFIX.closest.bin / PREFIX.shadow.bin");
+  cmd->add_flag("--json", o->json, "print one JSON line");
+  addDeviceOptions(*cmd, o->device);
+  cmd->callback([o] { runBench(*o); });
+}
+
+} // namespace obscura::app

@@ -1,0 +1,21 @@
+// commands.h — the `obscura` subcommands; each lives in its own file.
+#pragma once
+#include <CLI/CLI.hpp>
+
+#include "gpu/context.h"
+
+namespace obscura::app {
+
+// Options every GPU command takes (--device, --validate).
+struct DeviceOptions {
+  std::string device;
+  bool validate = false;
+  gpu::ContextOptions contextOptions() const { return {.validate = validate, .device = device}; }
+};
+void addDeviceOptions(CLI::App& command, DeviceOptions& options);
+
+void addRenderCommand(CLI::App& app);
+void addInfoCommand(CLI::App& app);
+void addBenchRaysCommand(CLI::App& app);
+
+} // namespace obscura::app

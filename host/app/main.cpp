@@ -1,0 +1,42 @@
+// obscura — ray-traced obscurances and interactive relighting on Vulkan compute.
+// Errors in input are caught here once: a message naming the file and the problem, exit 2;
+// device failures exit 3. Nothing else ever ends the program.
+#include <cstdio>
+
+#include <fmt/core.h>
+
+#include "app/commands.h"
+#include "core/error.h"
+
+namespace obscura::app {
+void addDeviceOptions(CLI::App& command, DeviceOptions& options) {
+  command.add_option("--device", options.device, "Vulkan device: index or part of its name (see 'obscura info')");
+  command.add_flag("--validate", options.validate, "enable the Khronos validation layer");
+}
+} // namespace obscura::app
+
+int main(int argc, char** argv) {
+  CLI::App app{"obscura: ray-traced obscurances and interactive relighting (Vulkan compute)"};
+  app.require_subcommand(1);
+  obscura::app::addRenderCommand(app);
+  obscura::app::addInfoCommand(app);
+  obscura::app::addBenchRaysCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const obscura::InputError& e) {
+    fmt::print(stderr, "obscura: error: {}\n", e.what());
+    return 2;
+  } catch (const obscura::DeviceError& e) {
+    fmt::print(stderr, "obscura: device error: {}\n", e.what());
+    return 3;
+  } catch (const vk::SystemError& e) {
+    fmt::print(stderr, "obscura: Vulkan error: {}\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "obscura: internal error: {}\n", e.what());
+    return 4;
+  }
+  return 0;
+}

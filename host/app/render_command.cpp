@@ -1,0 +1,191 @@
+// obscura render SCENE -o out.{exr,png} [--width --height --spp --aov NAME... --metrics m.json]
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "app/scene_setup.h"
+#include "core/error.h"
+#include "gpu/buffer.h"
+#include "io/image_io.h"
+#include "render/aov_render.h"
+
+namespace obscura::app {
+namespace {
+
+struct RenderOptions {
+  std::string scenePath;
+  std::string output;
+  std::uint32_t width = 0, height = 0; // 0 = from the camera's aspect, 512 on the long side
+  std::uint32_t spp = 4;
+  std::uint32_t seed = 1;
+  int camera = -1;
+  std::vector<std::string> aovs;
+  std::string metrics;
+  float exposure = 0.0f;
+  DeviceOptions device;
+};
+
+scene::Camera chooseCamera(const scene::Scene& scene, int index) {
+  if (index >= 0) {
+    if (index >= static_cast<int>(scene.cameras.size()))
+      throw InputError(fmt::format("--camera {}: the scene {} has {} cameras", index, scene.sourcePath,
+                                   scene.cameras.size()));
+    return scene.cameras[index];
+  }
+  return scene.cameras.empty() ? scene::defaultCamera(scene.bounds) : scene.cameras.front();
+}
+
+void chooseSize(RenderOptions& o, const scene::Camera& camera) {
+  float aspect = camera.aspectRatio > 0.0f ? camera.aspectRatio : 1.0f;
+  if (o.width == 0 && o.height == 0) {
+    o.width = aspect >= 1.0f ? 512u : static_cast<std::uint32_t>(std::lround(512.0f * aspect));
+    o.height = aspect >= 1.0f ? static_cast<std::uint32_t>(std::lround(512.0f / aspect)) : 512u;
+  } else if (o.height == 0) {
+    o.height = std::max(1u, static_cast<std::uint32_t>(std::lround(static_cast<float>(o.width) / aspect)));
+  } else if (o.width == 0) {
+    o.width = std::max(1u, static_cast<std::uint32_t>(std::lround(static_cast<float>(o.height) * aspect)));
+  }
+}
+
+// Keeps only the requested AOVs' channels (all when none requested).
+io::Image selectAovs(const io::Image& all, const std::vector<std::string>& aovs) {
+  if (aovs.empty()) return all;
+  io::Image out;
+  out.width = all.width;
+  out.height = all.height;
+  std::vector<int> source;
+  for (const auto& aov : aovs)
+    for (const auto& channel : render::aovChannels(aov)) {
+      out.channels.push_back(channel);
+      source.push_back(all.channelIndex(channel));
+    }
+  out.pixels.resize(std::size_t(out.width) * out.height * out.channels.size());
+  std::size_t k = 0;
+  for (int y = 0; y < all.height; ++y)
+    for (int x = 0; x < all.width; ++x)
+      for (int c : source) out.pixels[k++] = all.at(x, y, c);
+  return out;
+}
+
+void printProgress(std::uint32_t done, std::uint32_t total, double seconds, std::uint64_t raysPerSample) {
+  double rate = seconds > 0 ? static_cast<double>(raysPerSample) * done / seconds / 1e6 : 0.0;
+  double eta = done > 0 ? seconds / done * (total - done) : 0.0;
+  std::fprintf(stderr, "\rrender: %3.0f%%  %6.2f Mrays/s  ETA %5.1f s ", 100.0 * done / total, rate, eta);
+  if (done == total) std::fprintf(stderr, "\n");
+  std::fflush(stderr);
+}
+
+void writeMetrics(const std::string& path, const nlohmann::json& json) {
+  std::string temp = path + ".tmp";
+  {
+    std::ofstream out(temp);
+    if (!out) throw InputError(fmt::format("{}: cannot write metrics", path));
+    out << json.dump(2) << "\n";
+    if (!out) throw InputError(fmt::format("{}: cannot write metrics", path));
+  }
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    std::remove(temp.c_str());
+    throw InputError(fmt::format("{}: cannot write metrics", path));
+  }
+}
+
+void runRender(RenderOptions& o) {
+  std::string ext = io::extensionOf(o.output);
+  if (ext != "exr" && ext != "png")
+    throw InputError(fmt::format("{}: the output must be .exr or .png", o.output));
+  for (const auto& aov : o.aovs)
+    if (std::find(render::aovNames().begin(), render::aovNames().end(), aov) == render::aovNames().end())
+      throw InputError(fmt::format("--aov {}: unknown AOV (known: {})", aov, fmt::join(render::aovNames(), ", ")));
+
+  LoadedScene loaded = loadScene(o.scenePath);
+  scene::Camera camera = chooseCamera(loaded.scene, o.camera);
+  chooseSize(o, camera);
+  fmt::print(stderr, "{}\n", sceneSummary(loaded));
+
+  gpu::Context context(o.device.contextOptions());
+  std::uint64_t need = render::renderBytesNeeded(o.width, o.height);
+  if (need > context.info().deviceLocalBytes || need / 6 > context.info().maxStorageBufferRange)
+    throw InputError(fmt::format("{}x{}: the frame buffers would need {:.1f} MiB, more than the device "
+                                 "'{}' offers", o.width, o.height, static_cast<double>(need) / 1048576.0,
+                                 context.info().name));
+  fmt::print(stderr, "device: {} ({})\n", context.info().name, context.info().driver);
+
+  render::RenderSettings settings{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
+                                  .camera = camera};
+  render::RenderStats stats;
+  const bool tty = ::isatty(STDERR_FILENO);
+  const std::uint64_t raysPerSample = std::uint64_t(o.width) * o.height;
+  io::Image image = render::renderAovs(context, loaded.scene, loaded.bvh, settings, stats,
+                                       tty ? render::ProgressFn([&](auto d, auto t, auto s) {
+                                         printProgress(d, t, s, raysPerSample);
+                                       })
+                                           : render::ProgressFn());
+  if (stats.truncatedTraversals > 0)
+    throw DeviceError(fmt::format("{} traversals ran out of steps (kMaxTraversalSteps); the image would be wrong",
+                                  stats.truncatedTraversals));
+
+  io::Image selected = selectAovs(image, o.aovs);
+  if (ext == "exr") {
+    io::writeExr(o.output, selected);
+  } else {
+    std::string first = o.aovs.empty() ? "preview" : o.aovs.front();
+    io::writePng(o.output, image, image.channelIndex(render::aovChannels(first).front()), o.exposure);
+  }
+
+  nlohmann::json passes = nlohmann::json::object();
+  double totalMs = 0.0;
+  std::uint64_t totalRays = 0;
+  for (const auto& [name, pass] : stats.passes) {
+    passes[name] = {{"gpu_ms", pass.gpuMs}, {"rays", pass.rays},
+                    {"mrays_per_s", pass.gpuMs > 0 ? static_cast<double>(pass.rays) / (pass.gpuMs * 1e3) : 0.0}};
+    totalMs += pass.gpuMs;
+    totalRays += pass.rays;
+  }
+  double mrays = totalMs > 0 ? static_cast<double>(totalRays) / (totalMs * 1e3) : 0.0;
+  fmt::print(stderr, "render: {}x{}, {} spp, {} rays in {:.1f} ms GPU ({:.2f} Mrays/s), {:.2f} s wall -> {}\n",
+             o.width, o.height, o.spp, totalRays, totalMs, mrays, stats.wallSeconds, o.output);
+  if (!o.metrics.empty()) {
+    nlohmann::json json = {
+        {"device", {{"name", context.info().name}, {"driver", context.info().driver},
+                    {"type", context.info().type}, {"api", context.info().apiVersion}}},
+        {"scene", sceneJson(loaded)},
+        {"image", {{"width", o.width}, {"height", o.height}, {"spp", o.spp}, {"seed", o.seed}, {"output", o.output}}},
+        {"passes", passes},
+        {"gpu_ms", totalMs},
+        {"rays", totalRays},
+        {"mrays_per_s", mrays},
+        {"wall_s", stats.wallSeconds},
+        {"device_bytes", stats.deviceBytes},
+        {"truncated_traversals", stats.truncatedTraversals}};
+    writeMetrics(o.metrics, json);
+  }
+}
+
+} // namespace
+
+void addRenderCommand(CLI::App& app) {
+  auto options = std::make_shared<RenderOptions>();
+  CLI::App* cmd = app.add_subcommand("render", "Render a glTF scene headless to EXR (all AOVs) or PNG");
+  cmd->add_option("scene", options->scenePath, "glTF 2.0 scene (.gltf or .glb)")->required();
+  cmd->add_option("-o,--output", options->output, "output image, .exr (AOV layers) or .png (tonemapped)")->required();
+  cmd->add_option("--width", options->width, "image width in pixels (default: 512 on the long side)")
+      ->check(CLI::Range(1u, 16384u));
+  cmd->add_option("--height", options->height, "image height in pixels")->check(CLI::Range(1u, 16384u));
+  cmd->add_option("--spp", options->spp, "primary samples per pixel")->check(CLI::Range(1u, 1u << 20));
+  cmd->add_option("--seed", options->seed, "random seed (same seed, same image)");
+  cmd->add_option("--camera", options->camera, "index of the glTF camera to use (default: the first)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--aov", options->aovs, "AOV(s) to write; the first goes to PNG (default: all / preview)");
+  cmd->add_option("--exposure", options->exposure, "PNG exposure in stops");
+  cmd->add_option("--metrics", options->metrics, "write device, scene, BVH and per-pass figures as JSON");
+  addDeviceOptions(*cmd, options->device);
+  cmd->callback([options] { runRender(*options); });
+}
+
+} // namespace obscura::app

@@ -1,0 +1,77 @@
+// bvh.h — bounding volume hierarchy over a triangle soup: build, GPU layout, CPU traversal.
+//
+// The builder is binned SAH (Wald, "On fast Construction of SAH-based Bounding Volume
+// Hierarchies", 2007), parallel over subtrees. The GPU layout is a BVH2 whose nodes hold both
+// children's boxes (Aila & Laine 2009), see shaders/shared/host_device.h. The CPU traversal is the
+// reference the GPU is tested against.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "shared/host_device.h"
+
+namespace obscura::bvh {
+
+struct BuildOptions {
+  int bins = 16;                 // SAH bins per axis
+  float traversalCost = 1.0f;    // SAH cost of visiting one node, relative to...
+  float intersectionCost = 1.0f; // ...the cost of testing one triangle
+  std::uint32_t maxLeafSize = 8; // <= gpu::kLeafMaxTriangles
+  unsigned threads = 0;          // 0 = hardware concurrency
+};
+
+struct BuildStats {
+  double buildSeconds = 0.0;
+  std::uint32_t nodeCount = 0;   // interior nodes in the GPU layout
+  std::uint32_t leafCount = 0;
+  std::uint32_t maxDepth = 0;    // <= gpu::kBvhMaxDepth, always
+  double sahCost = 0.0;          // total SAH cost with the options' costs (root area = 1)
+  std::uint32_t medianFallbacks = 0; // nodes split by median to honour the depth bound
+};
+
+// Input: one entry per triangle, its three world-space vertices.
+struct TriangleSoup {
+  std::vector<glm::vec3> v0, v1, v2;
+  std::size_t size() const { return v0.size(); }
+};
+
+struct Bvh {
+  // GPU layout, ready to upload: nodes[0] is the root. A scene of ONE leaf still has a root node
+  // (with an empty second child whose box is inverted, so it is never hit).
+  std::vector<gpu::BvhNode> nodes;
+  std::vector<gpu::BvhTriangle> triangles; // in leaf order; .v0.w = original index as float bits
+  std::vector<std::uint32_t> order;        // order[i] = original index of triangles[i]
+  BuildStats stats;
+};
+
+// Builds a BVH. Degenerate triangles are allowed (they simply never report a hit). An empty soup
+// gives a root with two empty children.
+Bvh build(const TriangleSoup& soup, const BuildOptions& options = {});
+
+// ---- CPU traversal (the reference).
+struct Ray {
+  glm::vec3 origin;
+  glm::vec3 direction; // need not be unit; t is measured in units of |direction|
+  float tmin = 0.0f;
+  float tmax = std::numeric_limits<float>::infinity();
+};
+
+struct Hit {
+  float t = std::numeric_limits<float>::infinity();
+  float u = 0.0f, v = 0.0f;            // barycentrics of v1 and v2
+  std::uint32_t primitive = gpu::kInvalidIndex; // original triangle index
+  bool hit() const { return primitive != gpu::kInvalidIndex; }
+};
+
+// Closest hit in (tmin, tmax]; ties in t go to the lower original primitive index.
+Hit closestHit(const Bvh& bvh, const Ray& ray);
+// True when anything is hit in (tmin, tmax).
+bool anyHit(const Bvh& bvh, const Ray& ray);
+// Brute force over every triangle, same rules: the oracle for closestHit and for the GPU.
+Hit closestHitBruteForce(const TriangleSoup& soup, const Ray& ray);
+
+} // namespace obscura::bvh

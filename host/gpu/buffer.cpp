@@ -1,0 +1,100 @@
+#include "gpu/buffer.h"
+
+#include <atomic>
+#include <cstring>
+
+#include <fmt/core.h>
+
+#include "core/error.h"
+
+namespace obscura::gpu {
+namespace {
+std::atomic<std::uint64_t> gAllocatedBytes{0};
+
+constexpr vk::BufferUsageFlags kTransfer =
+    vk::BufferUsageFlagBits::eTransferSrc | vk::BufferUsageFlagBits::eTransferDst;
+} // namespace
+
+std::uint64_t allocatedDeviceBytes() { return gAllocatedBytes.load(); }
+
+Buffer::Buffer(const Context& context, vk::DeviceSize size, vk::BufferUsageFlags usage,
+               const std::string& name, Residence residence)
+    : size_(size), name_(name) {
+  if (size == 0) size = 16; // Vulkan forbids empty buffers; an empty scene still binds one.
+  try {
+    buffer_ = context.device().createBuffer({.size = size, .usage = usage | kTransfer});
+    auto requirements = buffer_.getMemoryRequirements();
+    constexpr auto kHost = vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent;
+    std::uint32_t type =
+        residence == Residence::Device
+            ? context.findMemoryType(requirements.memoryTypeBits, vk::MemoryPropertyFlagBits::eDeviceLocal, kHost)
+            : context.findMemoryType(requirements.memoryTypeBits, kHost);
+    memory_ = context.device().allocateMemory(
+        {.allocationSize = requirements.size, .memoryTypeIndex = type});
+    buffer_.bindMemory(*memory_, 0);
+    auto flags = context.memoryTypeFlags(type);
+    if ((flags & vk::MemoryPropertyFlagBits::eHostVisible) &&
+        (flags & vk::MemoryPropertyFlagBits::eHostCoherent))
+      mapped_ = memory_.mapMemory(0, VK_WHOLE_SIZE);
+    gAllocatedBytes += requirements.size;
+  } catch (const vk::OutOfDeviceMemoryError&) {
+    throw DeviceError(fmt::format("out of device memory: buffer '{}' needs {:.1f} MiB", name,
+                                  static_cast<double>(size) / (1024.0 * 1024.0)));
+  } catch (const vk::OutOfHostMemoryError&) {
+    throw DeviceError(fmt::format("out of host memory: buffer '{}' needs {:.1f} MiB", name,
+                                  static_cast<double>(size) / (1024.0 * 1024.0)));
+  }
+  context.setName(buffer_, name);
+}
+
+void Buffer::upload(const Context& context, const void* data, vk::DeviceSize size,
+                    vk::DeviceSize offset) {
+  if (size == 0) return;
+  if (offset + size > size_)
+    throw std::logic_error(fmt::format("upload of {} bytes at {} overflows buffer '{}' ({} bytes)",
+                                       size, offset, name_, size_));
+  if (mapped_) {
+    std::memcpy(static_cast<char*>(mapped_) + offset, data, size);
+    return;
+  }
+  Buffer staging(context, size, {}, name_ + ".staging", Residence::Host);
+  staging.upload(context, data, size);
+  context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
+    cmd.copyBuffer(staging.handle(), *buffer_, vk::BufferCopy{.srcOffset = 0, .dstOffset = offset, .size = size});
+  });
+}
+
+void Buffer::download(const Context& context, void* data, vk::DeviceSize size,
+                      vk::DeviceSize offset) const {
+  if (size == 0) return;
+  if (offset + size > size_)
+    throw std::logic_error(fmt::format("download of {} bytes at {} overflows buffer '{}'", size,
+                                       offset, name_));
+  if (mapped_) {
+    std::memcpy(data, static_cast<const char*>(mapped_) + offset, size);
+    return;
+  }
+  Buffer staging(context, size, {}, name_ + ".staging", Residence::Host);
+  context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
+    cmd.copyBuffer(*buffer_, staging.handle(), vk::BufferCopy{.srcOffset = offset, .dstOffset = 0, .size = size});
+  });
+  staging.download(context, data, size);
+}
+
+void Buffer::fill(const Context& context, std::uint32_t value) {
+  context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
+    cmd.fillBuffer(*buffer_, 0, VK_WHOLE_SIZE, value);
+  });
+}
+
+TexelBuffer::TexelBuffer(const Context& context, const void* data, vk::DeviceSize size,
+                         const std::string& name)
+    : buffer_(context, size, vk::BufferUsageFlagBits::eUniformTexelBuffer, name) {
+  buffer_.upload(context, data, size);
+  view_ = context.device().createBufferView({.buffer = buffer_.handle(),
+                                             .format = vk::Format::eR32G32B32A32Sfloat,
+                                             .offset = 0,
+                                             .range = VK_WHOLE_SIZE});
+}
+
+} // namespace obscura::gpu

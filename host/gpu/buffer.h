@@ -1,0 +1,79 @@
+// buffer.h — a Vulkan buffer and its memory as one RAII value.
+//
+// Buffers live in device-local memory. When that memory is also host-visible (lavapipe, GPUs
+// with resizable BAR) uploads and readbacks are plain memcpy; otherwise they go through a
+// temporary staging buffer.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan_raii.hpp>
+
+#include "gpu/context.h"
+
+namespace obscura::gpu {
+
+// Where a buffer lives: device-local (the default), or host-visible for staging.
+enum class Residence { Device, Host };
+
+class Buffer {
+public:
+  Buffer() = default;
+  // `name` labels the buffer in validation messages ("<pass>.<role>").
+  Buffer(const Context& context, vk::DeviceSize size, vk::BufferUsageFlags usage,
+         const std::string& name, Residence residence = Residence::Device);
+
+  void upload(const Context& context, const void* data, vk::DeviceSize size, vk::DeviceSize offset = 0);
+  template <typename T>
+  void upload(const Context& context, std::span<const T> data) {
+    upload(context, data.data(), data.size_bytes());
+  }
+  template <typename T>
+  void upload(const Context& context, const std::vector<T>& data) {
+    upload(context, data.data(), data.size() * sizeof(T));
+  }
+  void download(const Context& context, void* data, vk::DeviceSize size, vk::DeviceSize offset = 0) const;
+  template <typename T>
+  std::vector<T> download(const Context& context) const {
+    std::vector<T> out(size_ / sizeof(T));
+    download(context, out.data(), out.size() * sizeof(T));
+    return out;
+  }
+  void fill(const Context& context, std::uint32_t value);
+
+  vk::Buffer handle() const { return *buffer_; }
+  vk::DeviceSize size() const { return size_; }
+  const std::string& name() const { return name_; }
+  explicit operator bool() const { return size_ != 0; }
+
+private:
+  // Declaration order is creation order; members are destroyed bottom-up (buffer before memory).
+  vk::raii::DeviceMemory memory_ = nullptr;
+  vk::raii::Buffer buffer_ = nullptr;
+  vk::DeviceSize size_ = 0;
+  void* mapped_ = nullptr; // persistent mapping when the memory is host-visible
+  std::string name_;
+};
+
+// A buffer with a texel view, for the BVH (lavapipe gathers texels as vectors, see
+// docs/ARCHITECTURE.md). RGBA32F texels.
+class TexelBuffer {
+public:
+  TexelBuffer() = default;
+  TexelBuffer(const Context& context, const void* data, vk::DeviceSize size, const std::string& name);
+  const Buffer& buffer() const { return buffer_; }
+  vk::BufferView view() const { return *view_; }
+
+private:
+  Buffer buffer_;
+  vk::raii::BufferView view_ = nullptr;
+};
+
+// Bytes of device memory allocated through Buffer so far in this process (cumulative), for the
+// metrics.
+std::uint64_t allocatedDeviceBytes();
+
+} // namespace obscura::gpu

@@ -1,0 +1,128 @@
+#include "gpu/kernel.h"
+
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+namespace obscura::gpu {
+namespace {
+vk::DescriptorType descriptorType(BindingKind kind) {
+  return kind == BindingKind::StorageBuffer ? vk::DescriptorType::eStorageBuffer
+                                            : vk::DescriptorType::eUniformTexelBuffer;
+}
+} // namespace
+
+Kernel::Kernel(const Context& context, const KernelDesc& desc)
+    : context_(&context), name_(desc.name), bindings_(desc.bindings), pushBytes_(desc.pushConstantBytes) {
+  const auto& device = context.device();
+  std::vector<vk::DescriptorSetLayoutBinding> layoutBindings;
+  for (std::uint32_t i = 0; i < bindings_.size(); ++i)
+    layoutBindings.push_back({.binding = i,
+                              .descriptorType = descriptorType(bindings_[i]),
+                              .descriptorCount = 1,
+                              .stageFlags = vk::ShaderStageFlagBits::eCompute});
+  setLayout_ = device.createDescriptorSetLayout(
+      {.bindingCount = static_cast<std::uint32_t>(layoutBindings.size()), .pBindings = layoutBindings.data()});
+
+  vk::PushConstantRange range{.stageFlags = vk::ShaderStageFlagBits::eCompute, .offset = 0, .size = pushBytes_};
+  vk::DescriptorSetLayout rawLayout = *setLayout_;
+  pipelineLayout_ = device.createPipelineLayout({.setLayoutCount = 1,
+                                                 .pSetLayouts = &rawLayout,
+                                                 .pushConstantRangeCount = pushBytes_ ? 1u : 0u,
+                                                 .pPushConstantRanges = pushBytes_ ? &range : nullptr});
+
+  vk::raii::ShaderModule module = device.createShaderModule(
+      {.codeSize = desc.spirv.size_bytes(), .pCode = desc.spirv.data()});
+  std::vector<vk::SpecializationMapEntry> entries;
+  std::vector<std::uint32_t> values;
+  for (std::size_t i = 0; i < desc.specConstants.size(); ++i) {
+    entries.push_back({.constantID = desc.specConstants[i].id,
+                       .offset = static_cast<std::uint32_t>(i * 4),
+                       .size = 4});
+    values.push_back(desc.specConstants[i].value);
+  }
+  vk::SpecializationInfo specialization{.mapEntryCount = static_cast<std::uint32_t>(entries.size()),
+                                        .pMapEntries = entries.data(),
+                                        .dataSize = values.size() * 4,
+                                        .pData = values.data()};
+  vk::ComputePipelineCreateInfo pipelineInfo{
+      .stage = {.stage = vk::ShaderStageFlagBits::eCompute,
+                .module = *module,
+                .pName = "main",
+                .pSpecializationInfo = entries.empty() ? nullptr : &specialization},
+      .layout = *pipelineLayout_};
+  pipeline_ = vk::raii::Pipeline(device, nullptr, pipelineInfo);
+  context.setName(pipeline_, name_);
+
+  std::uint32_t storage = 0, texel = 0;
+  for (auto kind : bindings_) (kind == BindingKind::StorageBuffer ? storage : texel)++;
+  std::vector<vk::DescriptorPoolSize> sizes;
+  if (storage) sizes.push_back({.type = vk::DescriptorType::eStorageBuffer, .descriptorCount = storage});
+  if (texel) sizes.push_back({.type = vk::DescriptorType::eUniformTexelBuffer, .descriptorCount = texel});
+  pool_ = device.createDescriptorPool({.flags = vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
+                                       .maxSets = 1,
+                                       .poolSizeCount = static_cast<std::uint32_t>(sizes.size()),
+                                       .pPoolSizes = sizes.data()});
+  vk::raii::DescriptorSets sets(device, {.descriptorPool = *pool_, .descriptorSetCount = 1, .pSetLayouts = &rawLayout});
+  set_ = std::move(sets.front());
+}
+
+void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
+  if (binding >= bindings_.size() || bindings_[binding] != BindingKind::StorageBuffer)
+    throw std::logic_error(fmt::format("{}: binding {} is not a storage buffer", name_, binding));
+  vk::DescriptorBufferInfo info{.buffer = buffer.handle(), .offset = 0, .range = VK_WHOLE_SIZE};
+  context_->device().updateDescriptorSets(
+      vk::WriteDescriptorSet{.dstSet = *set_,
+                             .dstBinding = binding,
+                             .descriptorCount = 1,
+                             .descriptorType = vk::DescriptorType::eStorageBuffer,
+                             .pBufferInfo = &info},
+      nullptr);
+}
+
+void Kernel::bind(std::uint32_t binding, const TexelBuffer& buffer) {
+  if (binding >= bindings_.size() || bindings_[binding] != BindingKind::UniformTexelBuffer)
+    throw std::logic_error(fmt::format("{}: binding {} is not a texel buffer", name_, binding));
+  vk::BufferView view = buffer.view();
+  context_->device().updateDescriptorSets(
+      vk::WriteDescriptorSet{.dstSet = *set_,
+                             .dstBinding = binding,
+                             .descriptorCount = 1,
+                             .descriptorType = vk::DescriptorType::eUniformTexelBuffer,
+                             .pTexelBufferView = &view},
+      nullptr);
+}
+
+void Kernel::bindCommon(const vk::raii::CommandBuffer& cmd, const void* push) const {
+  cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_);
+  cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipelineLayout_, 0, {*set_}, {});
+  if (pushBytes_) {
+    if (!push) throw std::logic_error(fmt::format("{}: push constants missing", name_));
+    cmd.pushConstants<std::uint8_t>(*pipelineLayout_, vk::ShaderStageFlagBits::eCompute, 0,
+                                    vk::ArrayProxy<const std::uint8_t>(pushBytes_, static_cast<const std::uint8_t*>(push)));
+  }
+}
+
+void Kernel::dispatch(const vk::raii::CommandBuffer& cmd, std::uint32_t groupsX, std::uint32_t groupsY,
+                      std::uint32_t groupsZ, const void* push) const {
+  bindCommon(cmd, push);
+  cmd.dispatch(groupsX, groupsY, groupsZ);
+}
+
+void Kernel::dispatchIndirect(const vk::raii::CommandBuffer& cmd, const Buffer& args,
+                              vk::DeviceSize offset, const void* push) const {
+  bindCommon(cmd, push);
+  cmd.dispatchIndirect(args.handle(), offset);
+}
+
+void computeBarrier(const vk::raii::CommandBuffer& cmd) {
+  vk::MemoryBarrier barrier{.srcAccessMask = vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eTransferWrite,
+                            .dstAccessMask = vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite |
+                                             vk::AccessFlagBits::eTransferRead | vk::AccessFlagBits::eIndirectCommandRead};
+  cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer,
+                      vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer |
+                          vk::PipelineStageFlagBits::eDrawIndirect,
+                      {}, barrier, nullptr, nullptr);
+}
+
+} // namespace obscura::gpu

@@ -1,0 +1,112 @@
+#include "io/image_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <system_error>
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/core.h>
+
+#include "core/error.h"
+
+namespace obscura::io {
+namespace fs = std::filesystem;
+
+int Image::channelIndex(const std::string& name) const {
+  auto it = std::find(channels.begin(), channels.end(), name);
+  return it == channels.end() ? -1 : static_cast<int>(it - channels.begin());
+}
+
+std::string extensionOf(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext;
+}
+
+namespace {
+
+// Writes through a temporary file next to the target (same file system, so rename is atomic).
+template <typename WriteFn>
+void writeAtomically(const std::string& path, WriteFn&& write) {
+  fs::path target(path);
+  fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  if (!fs::is_directory(dir))
+    throw InputError(fmt::format("{}: cannot write: folder '{}' does not exist", path, dir.string()));
+  fs::path temp = dir / fmt::format(".{}.tmp{}{}", target.stem().string(), ::getpid(), target.extension().string());
+  try {
+    write(temp.string());
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(temp, ignored);
+    throw;
+  }
+  std::error_code ec;
+  fs::rename(temp, target, ec);
+  if (ec) {
+    fs::remove(temp, ec);
+    throw InputError(fmt::format("{}: cannot write: {}", path, ec.message()));
+  }
+}
+
+void writeWithOiio(const std::string& path, const std::string& shownPath, const OIIO::ImageSpec& spec,
+                   OIIO::TypeDesc type, const void* data) {
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) throw InputError(fmt::format("{}: cannot write this image format: {}", shownPath, OIIO::geterror()));
+  if (!out->open(path, spec) || !out->write_image(type, data) || !out->close())
+    throw InputError(fmt::format("{}: cannot write: {}", shownPath, out->geterror()));
+}
+
+float linearToSrgb(float v) {
+  v = std::clamp(v, 0.0f, 1.0f);
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+} // namespace
+
+void writeExr(const std::string& path, const Image& image) {
+  OIIO::ImageSpec spec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT);
+  spec.channelnames = image.channels;
+  spec.attribute("compression", "zip");
+  writeAtomically(path, [&](const std::string& temp) {
+    writeWithOiio(temp, path, spec, OIIO::TypeDesc::FLOAT, image.pixels.data());
+  });
+}
+
+void writePng(const std::string& path, const Image& image, int firstChannel, float exposure) {
+  const float scale = std::exp2(exposure);
+  std::vector<unsigned char> rgb(std::size_t(image.width) * image.height * 3);
+  const int n = image.channelCount();
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        int source = std::min(firstChannel + c, n - 1);
+        float v = image.at(x, y, source) * scale;
+        if (!std::isfinite(v)) v = 0.0f;
+        rgb[(std::size_t(y) * image.width + x) * 3 + c] =
+            static_cast<unsigned char>(std::lround(linearToSrgb(v) * 255.0f));
+      }
+  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+  writeAtomically(path, [&](const std::string& temp) {
+    writeWithOiio(temp, path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+  });
+}
+
+Image readImage(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw InputError(fmt::format("{}: cannot read image: {}", path, OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  image.channels = spec.channelnames;
+  image.pixels.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+    throw InputError(fmt::format("{}: cannot read image: {}", path, in->geterror()));
+  in->close();
+  return image;
+}
+
+} // namespace obscura::io

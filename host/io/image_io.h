@@ -1,0 +1,33 @@
+// image_io.h — images in and out through OpenImageIO.
+//
+// EXR holds linear radiance and every AOV as channel layers ("albedo.R", "depth.Z", …). PNG is
+// for viewing only: exposure, then the sRGB curve, 8 bits [SPEC §5]. Files are written to a
+// temporary name in the same folder and renamed, so a failed run leaves no partial file.
+#pragma once
+#include <string>
+#include <vector>
+
+namespace obscura::io {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::string> channels; // names, e.g. {"R","G","B"} or {"albedo.R", …}
+  std::vector<float> pixels;         // interleaved, rows top to bottom
+
+  int channelCount() const { return static_cast<int>(channels.size()); }
+  float& at(int x, int y, int c) { return pixels[(std::size_t(y) * width + x) * channels.size() + c]; }
+  float at(int x, int y, int c) const { return pixels[(std::size_t(y) * width + x) * channels.size() + c]; }
+  int channelIndex(const std::string& name) const; // -1 when absent
+};
+
+// Writes an EXR (float, all channels). Throws InputError naming the path on failure.
+void writeExr(const std::string& path, const Image& image);
+// Writes an 8-bit sRGB PNG of channels [first, first+3) after multiplying by 2^exposure.
+void writePng(const std::string& path, const Image& image, int firstChannel = 0, float exposure = 0.0f);
+// Reads any image OpenImageIO reads (linear floats as stored; PNG values / 255, no decoding).
+Image readImage(const std::string& path);
+
+// The extension, lower case, without the dot ("exr", "png").
+std::string extensionOf(const std::string& path);
+
+} // namespace obscura::io

@@ -1,0 +1,105 @@
+#include "render/aov_render.h"
+
+#include <bit>
+#include <chrono>
+#include <cmath>
+
+#include "gpu/timestamps.h"
+#include "render/primary_pass.h"
+#include "render/scene_buffers.h"
+
+namespace obscura::render {
+
+const std::vector<std::string>& aovNames() {
+  static const std::vector<std::string> names = {"preview", "albedo", "emission", "normal", "depth",
+                                                 "position", "coverage", "primitive", "material"};
+  return names;
+}
+
+std::vector<std::string> aovChannels(const std::string& aov) {
+  if (aov == "normal" || aov == "position") return {aov + ".X", aov + ".Y", aov + ".Z"};
+  if (aov == "depth") return {"depth.Z"};
+  if (aov == "coverage") return {"coverage.A"};
+  if (aov == "primitive" || aov == "material") return {aov + ".id"};
+  return {aov + ".R", aov + ".G", aov + ".B"};
+}
+
+std::uint64_t renderBytesNeeded(std::uint32_t width, std::uint32_t height) {
+  return PrimaryPass::bytesNeeded(width, height);
+}
+
+namespace {
+
+// Converts the accumulated AOV slots into image channels.
+io::Image resolveAovs(const std::vector<glm::vec4>& aov, std::uint32_t width, std::uint32_t height,
+                      std::uint32_t spp) {
+  io::Image image;
+  image.width = static_cast<int>(width);
+  image.height = static_cast<int>(height);
+  for (const auto& name : aovNames())
+    for (const auto& channel : aovChannels(name)) image.channels.push_back(channel);
+  image.pixels.resize(std::size_t(width) * height * image.channels.size());
+  const float inv = 1.0f / static_cast<float>(spp);
+  std::size_t k = 0;
+  for (std::size_t p = 0; p < std::size_t(width) * height; ++p) {
+    const glm::vec4* slot = &aov[p * gpu::kAovSlots];
+    glm::vec4 albedo = slot[gpu::kAovAlbedo] * inv;
+    glm::vec4 normalDepth = slot[gpu::kAovNormal] * inv;
+    glm::vec3 position = glm::vec3(slot[gpu::kAovPosition]) * inv;
+    glm::vec3 emission = glm::vec3(slot[gpu::kAovEmission]) * inv;
+    float normalLength = glm::length(glm::vec3(normalDepth));
+    glm::vec3 normal = normalLength > 0.0f ? glm::vec3(normalDepth) / normalLength : glm::vec3(0.0f);
+    glm::vec3 preview = glm::vec3(slot[gpu::kAovPreview]) * inv;
+    auto put3 = [&](glm::vec3 v) { image.pixels[k++] = v.x; image.pixels[k++] = v.y; image.pixels[k++] = v.z; };
+    put3(preview);
+    put3(glm::vec3(albedo));
+    put3(emission);
+    put3(normal);
+    image.pixels[k++] = normalDepth.w;
+    put3(position);
+    image.pixels[k++] = albedo.w;
+    std::uint32_t primitive = std::bit_cast<std::uint32_t>(slot[gpu::kAovIds].x);
+    std::uint32_t material = std::bit_cast<std::uint32_t>(slot[gpu::kAovIds].y);
+    image.pixels[k++] = primitive == gpu::kInvalidIndex ? -1.0f : static_cast<float>(primitive);
+    image.pixels[k++] = material == gpu::kInvalidIndex ? -1.0f : static_cast<float>(material);
+  }
+  return image;
+}
+
+} // namespace
+
+io::Image renderAovs(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+                     const RenderSettings& settings, RenderStats& stats, const ProgressFn& progress) {
+  auto start = std::chrono::steady_clock::now();
+  SceneBuffers buffers(context, scene, bvh);
+  PrimaryPass primary(context, buffers, settings.width, settings.height);
+  gpu::Timestamps timestamps(context);
+  const gpu::GpuCamera camera = gpuCamera(settings.camera, settings.width, settings.height);
+
+  // One submission per sample: keeps each dispatch short (no device timeouts on slow devices)
+  // and lets the progress line move.
+  for (std::uint32_t s = 0; s < settings.spp; ++s) {
+    context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
+      timestamps.reset(cmd);
+      timestamps.begin(cmd, "primary");
+      primary.record(cmd, camera, s, settings.seed);
+      timestamps.end(cmd, "primary");
+    });
+    timestamps.collect();
+    if (progress)
+      progress(s + 1, settings.spp,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+
+  stats.truncatedTraversals = buffers.truncatedTraversals();
+  auto& pass = stats.passes["primary"];
+  pass.rays = std::uint64_t(settings.width) * settings.height * settings.spp;
+  pass.gpuMs = timestamps.available() ? timestamps.totalsMs().at("primary") : 0.0;
+  stats.deviceBytes = buffers.bytes() + PrimaryPass::bytesNeeded(settings.width, settings.height);
+  auto aov = primary.aovs().download<glm::vec4>(context);
+  io::Image image = resolveAovs(aov, settings.width, settings.height, settings.spp);
+  stats.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return image;
+}
+
+} // namespace obscura::render

@@ -1,0 +1,129 @@
+#include "render/scene_buffers.h"
+
+#include <bit>
+#include <cstring>
+
+#include <fmt/core.h>
+
+#include "core/error.h"
+
+namespace obscura::render {
+
+bvh::TriangleSoup triangleSoup(const scene::Scene& scene) {
+  bvh::TriangleSoup soup;
+  const std::size_t n = scene.triangles.size();
+  soup.v0.resize(n);
+  soup.v1.resize(n);
+  soup.v2.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::uvec3& t = scene.triangles[i];
+    soup.v0[i] = scene.positions[t.x];
+    soup.v1[i] = scene.positions[t.y];
+    soup.v2[i] = scene.positions[t.z];
+  }
+  return soup;
+}
+
+std::vector<gpu::BindingKind> sceneBindingKinds() {
+  using K = gpu::BindingKind;
+  return {K::UniformTexelBuffer, K::UniformTexelBuffer, K::StorageBuffer, K::StorageBuffer,
+          K::StorageBuffer,      K::StorageBuffer,      K::StorageBuffer};
+}
+
+namespace {
+
+std::vector<gpu::TriangleShading> shadingData(const scene::Scene& scene) {
+  std::vector<gpu::TriangleShading> out(scene.triangles.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const glm::uvec3& t = scene.triangles[i];
+    std::uint32_t material = scene.triangleMaterial[i];
+    std::uint32_t group = i < scene.triangleLightGroup.size() ? scene.triangleLightGroup[i] : gpu::kInvalidIndex;
+    out[i].n0 = glm::vec4(scene.normals[t.x], std::bit_cast<float>(material));
+    out[i].n1 = glm::vec4(scene.normals[t.y], std::bit_cast<float>(group));
+    out[i].n2 = glm::vec4(scene.normals[t.z], 0.0f);
+    out[i].uv01 = glm::vec4(scene.uvs[t.x], scene.uvs[t.y]);
+    out[i].uv2 = glm::vec4(scene.uvs[t.z], 0.0f, 0.0f);
+  }
+  return out;
+}
+
+std::vector<gpu::GpuMaterial> materialData(const scene::Scene& scene) {
+  std::vector<gpu::GpuMaterial> out;
+  for (const auto& m : scene.materials)
+    out.push_back({.baseColor = m.baseColor,
+                   .emission = glm::vec4(m.emission, m.doubleSided ? 1.0f : 0.0f),
+                   .params = glm::vec4(m.metallic, m.roughness, m.alphaCutoff, 0.0f),
+                   .textures = glm::ivec4(m.baseColorTexture, m.metallicRoughnessTexture, m.emissiveTexture, -1)});
+  return out;
+}
+
+void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char* what) {
+  if (texels > context.info().maxTexelBufferElements)
+    throw DeviceError(fmt::format("the scene's {} need {} texels, more than the device's "
+                                  "maxTexelBufferElements ({})", what, texels,
+                                  context.info().maxTexelBufferElements));
+}
+
+} // namespace
+
+SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh)
+    : context_(&context) {
+  using Usage = vk::BufferUsageFlagBits;
+  checkTexelLimit(context, bvh.nodes.size() * gpu::kTexelsPerNode, "BVH nodes");
+  checkTexelLimit(context, bvh.triangles.size() * gpu::kTexelsPerTriangle, "triangles");
+  nodes_ = gpu::TexelBuffer(context, bvh.nodes.data(), bvh.nodes.size() * sizeof(gpu::BvhNode), "scene.bvhNodes");
+  triangles_ = gpu::TexelBuffer(context, bvh.triangles.data(), bvh.triangles.size() * sizeof(gpu::BvhTriangle),
+                                "scene.bvhTriangles");
+
+  auto shading = shadingData(scene);
+  shading_ = gpu::Buffer(context, shading.size() * sizeof(gpu::TriangleShading), Usage::eStorageBuffer, "scene.shading");
+  shading_.upload(context, shading);
+
+  auto materials = materialData(scene);
+  materials_ = gpu::Buffer(context, materials.size() * sizeof(gpu::GpuMaterial), Usage::eStorageBuffer, "scene.materials");
+  materials_.upload(context, materials);
+
+  std::vector<gpu::GpuTexture> textureTable;
+  std::size_t texelCount = 0;
+  for (const auto& t : scene.textures) {
+    textureTable.push_back({.info = glm::uvec4(static_cast<std::uint32_t>(texelCount), t.width, t.height,
+                                               t.srgb ? gpu::kTextureSrgb : 0u)});
+    texelCount += static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height);
+  }
+  textures_ = gpu::Buffer(context, textureTable.size() * sizeof(gpu::GpuTexture), Usage::eStorageBuffer, "scene.textures");
+  textures_.upload(context, textureTable);
+  texels_ = gpu::Buffer(context, texelCount * 4, Usage::eStorageBuffer, "scene.texels");
+  std::size_t offset = 0;
+  for (const auto& t : scene.textures) {
+    texels_.upload(context, t.rgba8.data(), t.rgba8.size(), offset);
+    offset += t.rgba8.size();
+  }
+
+  status_ = gpu::Buffer(context, gpu::kStatusWords * 4, Usage::eStorageBuffer, "scene.status");
+  resetStatus();
+  bytes_ = nodes_.buffer().size() + triangles_.buffer().size() + shading_.size() + materials_.size() +
+           textures_.size() + texels_.size() + status_.size();
+}
+
+void SceneBuffers::bindTo(gpu::Kernel& kernel) const {
+  kernel.bind(gpu::kBindingBvhNodes, nodes_);
+  kernel.bind(gpu::kBindingBvhTriangles, triangles_);
+  kernel.bind(gpu::kBindingShading, shading_);
+  kernel.bind(gpu::kBindingMaterials, materials_);
+  kernel.bind(gpu::kBindingTextures, textures_);
+  kernel.bind(gpu::kBindingTexels, texels_);
+  kernel.bind(gpu::kBindingStatus, status_);
+}
+
+std::uint32_t SceneBuffers::truncatedTraversals() const {
+  std::uint32_t words[gpu::kStatusWords];
+  status_.download(*context_, words, sizeof(words));
+  return words[gpu::kStatusTruncated];
+}
+
+void SceneBuffers::resetStatus() {
+  std::uint32_t zeros[gpu::kStatusWords] = {};
+  status_.upload(*context_, zeros, sizeof(zeros));
+}
+
+} // namespace obscura::render

@@ -1,0 +1,45 @@
+// scene_buffers.h — the scene and its BVH on the GPU (set 0, bindings 0..6 of every tracing
+// pass; see shaders/lib/scene_bindings.glsl). Uploaded once; lives as long as the scene.
+#pragma once
+#include <cstdint>
+
+#include "bvh/bvh.h"
+#include "gpu/buffer.h"
+#include "gpu/context.h"
+#include "gpu/kernel.h"
+#include "scene/scene.h"
+
+namespace obscura::render {
+
+// The BVH input for a scene: its triangles' world-space vertices in scene order.
+bvh::TriangleSoup triangleSoup(const scene::Scene& scene);
+
+class SceneBuffers {
+public:
+  SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh);
+
+  // Binds bindings 0..6 of `kernel`.
+  void bindTo(gpu::Kernel& kernel) const;
+
+  // Traversals cut off by kMaxTraversalSteps since the last reset (must stay 0).
+  std::uint32_t truncatedTraversals() const;
+  void resetStatus();
+
+  std::uint64_t bytes() const { return bytes_; }
+
+private:
+  const gpu::Context* context_;
+  gpu::TexelBuffer nodes_;
+  gpu::TexelBuffer triangles_;
+  gpu::Buffer shading_;
+  gpu::Buffer materials_;
+  gpu::Buffer textures_;
+  gpu::Buffer texels_;
+  gpu::Buffer status_;
+  std::uint64_t bytes_ = 0;
+};
+
+// Every kernel that traces rays starts its binding list with the scene's.
+std::vector<gpu::BindingKind> sceneBindingKinds();
+
+} // namespace obscura::render

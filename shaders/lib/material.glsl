@@ -1,0 +1,48 @@
+// material.glsl — material and texture lookups at a hit. Needs scene_bindings.glsl.
+#ifndef OBSCURA_MATERIAL_GLSL
+#define OBSCURA_MATERIAL_GLSL
+
+vec3 srgbToLinear(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+vec4 fetchTexel(GpuTexture tex, int x, int y) {
+  uint width = tex.info.y;
+  vec4 c = unpackUnorm4x8(texels[tex.info.x + uint(y) * width + uint(x)]);
+  if ((tex.info.w & kTextureSrgb) != 0u) c.rgb = srgbToLinear(c.rgb);
+  return c;
+}
+
+// Bilinear lookup with repeat wrapping (glTF's default sampler); uv (0,0) is the top-left texel.
+// Texels are decoded to linear before filtering.
+vec4 sampleTexture(int index, vec2 uv) {
+  GpuTexture tex = textures[index];
+  ivec2 size = ivec2(tex.info.yz);
+  vec2 p = fract(uv) * vec2(size) - 0.5;
+  vec2 f = fract(p);
+  ivec2 i0 = ivec2(floor(p));
+  ivec2 a = (i0 % size + size) % size;
+  ivec2 b = (a + 1) % size;
+  vec4 c00 = fetchTexel(tex, a.x, a.y), c10 = fetchTexel(tex, b.x, a.y);
+  vec4 c01 = fetchTexel(tex, a.x, b.y), c11 = fetchTexel(tex, b.x, b.y);
+  return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
+}
+
+// Base colour (albedo) = baseColorFactor x baseColorTexture.
+vec4 materialBaseColor(GpuMaterial m, vec2 uv) {
+  vec4 c = m.baseColor;
+  if (m.textures.x >= 0) c *= sampleTexture(m.textures.x, uv);
+  return c;
+}
+
+// Emitted radiance = emissiveFactor x strength x emissiveTexture [SPEC §5]; one-sided unless the
+// material is double-sided: `frontFacing` is true when the ray arrives on the side the
+// counter-clockwise winding's normal faces.
+vec3 materialEmission(GpuMaterial m, vec2 uv, bool frontFacing) {
+  if (!frontFacing && m.emission.w == 0.0) return vec3(0.0);
+  vec3 e = m.emission.rgb;
+  if (m.textures.z >= 0 && any(greaterThan(e, vec3(0.0)))) e *= sampleTexture(m.textures.z, uv).rgb;
+  return e;
+}
+
+#endif

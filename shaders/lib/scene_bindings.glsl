@@ -1,0 +1,17 @@
+// scene_bindings.glsl — set 0 bindings 0..6: the scene as every ray-tracing pass sees it.
+// Binding numbers come from shared/host_device.h; host/render/scene_buffers.cpp binds them.
+#ifndef OBSCURA_SCENE_BINDINGS_GLSL
+#define OBSCURA_SCENE_BINDINGS_GLSL
+
+// Texel buffers: lavapipe fetches a texel as one vector gather, an SSBO vec4 as four scalar
+// gathers per lane (docs/ARCHITECTURE.md, "lavapipe").
+layout(set = 0, binding = kBindingBvhNodes) uniform samplerBuffer bvhNodes;
+layout(set = 0, binding = kBindingBvhTriangles) uniform samplerBuffer bvhTriangles;
+layout(std430, set = 0, binding = kBindingShading) readonly buffer ShadingBuffer { TriangleShading triangleShading[]; };
+layout(std430, set = 0, binding = kBindingMaterials) readonly buffer MaterialBuffer { GpuMaterial materials[]; };
+layout(std430, set = 0, binding = kBindingTextures) readonly buffer TextureBuffer { GpuTexture textures[]; };
+layout(std430, set = 0, binding = kBindingTexels) readonly buffer TexelBuffer { uint texels[]; };
+// status[kStatusTruncated] counts traversals that ran out of steps (never expected; tested).
+layout(std430, set = 0, binding = kBindingStatus) buffer StatusBuffer { uint status[]; };
+
+#endif

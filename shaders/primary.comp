@@ -1,0 +1,71 @@
+#version 460
+// primary.comp — one camera ray per pixel per dispatch (sample `frame.z` of --spp): traces it,
+// writes the G-buffer for later passes, and accumulates the AOVs [RTO §4.1, step 1].
+#extension GL_GOOGLE_include_directive : require
+#include "shared/host_device.h"
+#include "lib/scene_bindings.glsl"
+#include "lib/intersect.glsl"
+#include "lib/bvh.glsl"
+#include "lib/surface.glsl"
+#include "lib/material.glsl"
+#include "lib/rng.glsl"
+#include "lib/camera.glsl"
+
+layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
+layout(push_constant) uniform Push { PrimaryPush pc; };
+layout(std430, set = 0, binding = kBindingPassFirst) writeonly buffer GBuffer { GBufferTexel gbuffer[]; };
+layout(std430, set = 0, binding = kBindingPassFirst + 1) buffer AovBuffer { vec4 aov[]; };
+
+void accumulate(uint pixel, uint slot, vec4 value, bool first) {
+  uint i = pixel * kAovSlots + slot;
+  aov[i] = first ? value : aov[i] + value;
+}
+
+void main() {
+  uvec2 size = pc.frame.xy;
+  uvec2 p = gl_GlobalInvocationID.xy;
+  if (p.x >= size.x || p.y >= size.y) return;
+  uint pixel = p.y * size.x + p.x;
+  uint sampleIndex = pc.frame.z;
+  bool first = sampleIndex == 0u;
+
+  uint rng = rngSeed(p, 0u, pc.frame.w); // the shift is per pixel, fixed over samples
+  vec2 shift = vec2(rngNext(rng), rngNext(rng));
+  vec2 position = vec2(p) + pixelSampleOffset(sampleIndex, shift);
+  vec3 origin = pc.camera.origin.xyz;
+  vec3 direction = cameraRayDirection(pc.camera, position, vec2(size));
+
+  RayHit hit = traceClosest(origin, direction, 0.0, 1.0 / 0.0);
+  if (hit.primitive == kTruncatedHit) atomicAdd(status[kStatusTruncated], 1u);
+
+  GBufferTexel g;
+  vec3 preview = vec3(0.0);
+  if (rayHitValid(hit) && hit.primitive != kInvalidIndex) {
+    Surface s = surfaceAt(hit, origin, direction);
+    GpuMaterial m = materials[s.material];
+    vec3 albedo = materialBaseColor(m, s.uv).rgb;
+    vec3 emission = materialEmission(m, s.uv, s.frontFacing);
+    float depth = distance(origin, s.position);
+    g.position = vec4(s.position, depth);
+    g.geometricNormal = vec4(s.geometricNormal, uintBitsToFloat(hit.primitive));
+    g.shadingNormal = vec4(s.shadingNormal, uintBitsToFloat(s.material));
+    g.albedo = vec4(albedo, 1.0);
+    g.emission = vec4(emission, 0.0);
+    // A light at the eye: enough to see shapes before any lighting pass runs.
+    preview = albedo * abs(dot(s.shadingNormal, direction)) + emission;
+  } else {
+    g.position = vec4(0.0);
+    g.geometricNormal = vec4(0.0, 0.0, 0.0, uintBitsToFloat(kInvalidIndex));
+    g.shadingNormal = vec4(0.0, 0.0, 0.0, uintBitsToFloat(kInvalidIndex));
+    g.albedo = vec4(0.0);
+    g.emission = vec4(0.0);
+  }
+  gbuffer[pixel] = g;
+
+  accumulate(pixel, kAovAlbedo, g.albedo, first);
+  accumulate(pixel, kAovNormal, vec4(g.shadingNormal.xyz, g.position.w), first);
+  accumulate(pixel, kAovPosition, vec4(g.position.xyz, 0.0), first);
+  accumulate(pixel, kAovEmission, g.emission, first);
+  accumulate(pixel, kAovPreview, vec4(preview, 0.0), first);
+  if (first) aov[pixel * kAovSlots + kAovIds] = vec4(g.geometricNormal.w, g.shadingNormal.w, 0.0, 0.0);
+}

@@ -1,0 +1,162 @@
+// host_device.h — the ONE header compiled by both C++ and GLSL.
+//
+// Every struct that crosses the host/GPU boundary is written here once, in std430 layout built
+// from 16-byte rows (vec4, uvec4, or four scalars). No vec3 arrays, no mat3, no bool.
+// host/gpu/host_device_test.cpp checks sizeof/offsetof, and tests/shaders/layout_test.comp fills
+// every field on the GPU so the host can read it back through these same structs.
+#ifndef OBSCURA_HOST_DEVICE_H
+#define OBSCURA_HOST_DEVICE_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace obscura::gpu {
+using vec2 = glm::vec2;
+using vec4 = glm::vec4;
+using uvec4 = glm::uvec4;
+using ivec4 = glm::ivec4;
+using mat4 = glm::mat4;
+using uint = std::uint32_t;
+#define OBS_CONST inline constexpr
+#else
+#define OBS_CONST const
+#endif
+
+// ---- Workgroup sizes. lavapipe runs 8 invocations per SIMD group: keep multiples of 8.
+OBS_CONST uint kWorkgroupSize1D = 64;
+OBS_CONST uint kWorkgroupSizeX = 8;
+OBS_CONST uint kWorkgroupSizeY = 8;
+
+// ---- BVH limits. The builder guarantees depth <= kBvhMaxDepth for ANY input (it falls back to
+// median splits near the limit), so a traversal stack of kBvhStackSize entries never overflows.
+OBS_CONST uint kBvhMaxDepth = 48;
+OBS_CONST uint kBvhStackSize = 48;
+// A child reference is either an interior node index (bit 31 clear) or a leaf:
+// bit 31 set | (triangleCount - 1) << kLeafCountShift | firstTriangle (in BVH order).
+OBS_CONST uint kLeafFlag = 0x80000000u;
+OBS_CONST uint kLeafCountShift = 27u;
+OBS_CONST uint kLeafCountMask = 0xFu;        // up to 16 triangles per leaf
+OBS_CONST uint kLeafFirstMask = 0x07FFFFFFu; // up to 134M triangles
+OBS_CONST uint kLeafMaxTriangles = 16u;
+OBS_CONST uint kInvalidIndex = 0xFFFFFFFFu;
+
+// lavapipe's loop limiter silently ends every loop of one 8-lane SIMD group after 65,535 passes
+// in total (docs/ARCHITECTURE.md). Traversal counts its passes and stops by itself well before, and
+// reports the ray as truncated, so a cut-off can never go unnoticed.
+OBS_CONST uint kMaxTraversalSteps = 60000u;
+
+// ---- BVH node: 64 bytes = 4 texels of an RGBA32F texel buffer (the child refs ride in .w as
+// float bits). Bounds of both children live in the parent (Aila & Laine, "Understanding the
+// Efficiency of Ray Traversal on GPUs", 2009), so one fetch tests two boxes.
+struct BvhNode {
+  vec4 lo0; // 0:  child 0 min xyz, w = child 0 ref (uintBitsToFloat)
+  vec4 hi0; // 16: child 0 max xyz, w = child 1 ref (uintBitsToFloat)
+  vec4 lo1; // 32: child 1 min xyz, w = unused
+  vec4 hi1; // 48: child 1 max xyz, w = unused
+};          // 64 bytes
+OBS_CONST uint kTexelsPerNode = 4;
+
+// ---- Triangle for intersection: 48 bytes = 3 texels, stored in BVH leaf order.
+struct BvhTriangle {
+  vec4 v0; // 0:  xyz, w = original triangle index (uintBitsToFloat)
+  vec4 v1; // 16: xyz, w = unused
+  vec4 v2; // 32: xyz, w = unused
+};         // 48 bytes
+OBS_CONST uint kTexelsPerTriangle = 3;
+
+// ---- Shading attributes of a triangle, indexed by the ORIGINAL triangle index; read once per
+// hit, never during traversal.
+struct TriangleShading {
+  vec4 n0;   // 0:  vertex normal 0 xyz, w = material index (uintBitsToFloat)
+  vec4 n1;   // 16: vertex normal 1 xyz, w = light group index or kInvalidIndex (uintBitsToFloat)
+  vec4 n2;   // 32: vertex normal 2 xyz, w = unused
+  vec4 uv01; // 48: uv0.xy, uv1.xy
+  vec4 uv2;  // 64: uv2.xy, unused
+};           // 80 bytes
+
+// ---- Material: only what the method uses [SPEC §5].
+struct GpuMaterial {
+  vec4 baseColor;    // 0:  linear RGBA factor
+  vec4 emission;     // 16: emissive radiance RGB (factor x strength), w = 1 if double-sided
+  vec4 params;       // 32: metallic, roughness, alphaCutoff, unused
+  ivec4 textures;    // 48: baseColor tex, metallicRoughness tex, emissive tex (-1 = none), unused
+};                   // 64 bytes
+
+// ---- Texture table: all textures live in one uint buffer of RGBA8 texels.
+struct GpuTexture {
+  uvec4 info; // 0: first texel offset, width, height, flags (bit 0 = sRGB)
+};            // 16 bytes
+OBS_CONST uint kTextureSrgb = 1u;
+
+// ---- Ray for benchmarks and tests: 32 bytes.
+struct GpuRay {
+  vec4 origin;    // 0:  xyz, w = tmin
+  vec4 direction; // 16: xyz, w = tmax
+};                // 32 bytes
+
+// ---- Hit record from traversal: 16 bytes.
+struct GpuHit {
+  float t;        // 0:  distance in units of |direction|; tmax when missed
+  float u;        // 4:  barycentric of v1
+  float v;        // 8:  barycentric of v2
+  uint primitive; // 12: original triangle index or kInvalidIndex; kTruncatedHit if steps ran out
+};                // 16 bytes
+OBS_CONST uint kTruncatedHit = 0xFFFFFFFEu;
+
+// ---- Camera (pinhole), world space.
+struct GpuCamera {
+  vec4 origin;  // 0:  xyz, w = tan(yfov / 2)
+  vec4 forward; // 16: xyz, w = aspect (width / height)
+  vec4 right;   // 32: xyz, w = unused
+  vec4 up;      // 48: xyz, w = unused
+};              // 64 bytes
+
+// ---- G-buffer texel written by primary.comp, one per pixel per sample.
+struct GBufferTexel {
+  vec4 position;        // 0:  world-space hit point, w = depth (distance from camera, 0 on miss)
+  vec4 geometricNormal; // 16: xyz (unit, faces the camera ray), w = primitive id (uintBitsToFloat)
+  vec4 shadingNormal;   // 32: xyz (unit, interpolated, same side as geometric), w = material (bits)
+  vec4 albedo;          // 48: rgb base colour x texture, a = 1 on hit, 0 on miss
+  vec4 emission;        // 64: rgb emitted radiance toward the camera, w = unused
+};                      // 80 bytes
+
+// ---- Push constants of primary.comp (<= 128 bytes, the guaranteed minimum).
+struct PrimaryPush {
+  GpuCamera camera;   // 0
+  uvec4 frame;        // 64: width, height, sample index, seed
+};                    // 80 bytes
+
+// ---- Push constants of the bench/trace kernel.
+struct TracePush {
+  uvec4 params; // 0: ray count, mode (0 closest, 1 any), record steps (0/1), first ray index
+};              // 16 bytes
+
+// ---- Descriptor bindings (set 0) shared by every pass that traces rays.
+OBS_CONST uint kBindingBvhNodes = 0;     // samplerBuffer RGBA32F, kTexelsPerNode per node
+OBS_CONST uint kBindingBvhTriangles = 1; // samplerBuffer RGBA32F, kTexelsPerTriangle per triangle
+OBS_CONST uint kBindingShading = 2;      // SSBO TriangleShading[]
+OBS_CONST uint kBindingMaterials = 3;    // SSBO GpuMaterial[]
+OBS_CONST uint kBindingTextures = 4;     // SSBO GpuTexture[]
+OBS_CONST uint kBindingTexels = 5;       // SSBO uint[] (RGBA8)
+OBS_CONST uint kBindingStatus = 6;       // SSBO uint[4]: [0] truncated traversals
+OBS_CONST uint kBindingPassFirst = 7;    // first binding owned by the pass itself
+OBS_CONST uint kSceneBindingCount = 7;
+
+// ---- status[] words (binding kBindingStatus).
+OBS_CONST uint kStatusTruncated = 0;     // traversals stopped by kMaxTraversalSteps
+OBS_CONST uint kStatusWords = 4;
+
+// ---- Per-pixel AOV accumulation of primary.comp: kAovSlots vec4 per pixel, summed over samples
+// (slot kAovIds is written by sample 0 only).
+OBS_CONST uint kAovAlbedo = 0;   // rgb albedo, a = coverage (1 on hit)
+OBS_CONST uint kAovNormal = 1;   // xyz shading normal, w = depth (distance from the camera)
+OBS_CONST uint kAovPosition = 2; // xyz world position, w = unused
+OBS_CONST uint kAovEmission = 3; // rgb visible emission, w = unused
+OBS_CONST uint kAovIds = 4;      // x = primitive id, y = material id (uintBitsToFloat), z, w unused
+OBS_CONST uint kAovPreview = 5;  // rgb albedo x |cos| to the eye + emission (a headlight view)
+OBS_CONST uint kAovSlots = 6;
+
+#ifdef __cplusplus
+} // namespace obscura::gpu
+#endif
+#endif // OBSCURA_HOST_DEVICE_H
