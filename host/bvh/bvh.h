@@ -42,6 +42,10 @@ struct TriangleSoup {
 struct Bvh {
   // GPU layout, ready to upload: nodes[0] is the root. A scene of ONE leaf still has a root node
   // (with an empty second child whose box is inverted, so it is never hit).
+  // The empty child (both children of an empty soup's root) has the box lo = +inf, hi = -inf and
+  // the ref gpu::kInvalidIndex; a traversal must skip a kInvalidIndex ref (a min/max slab test
+  // alone would "hit" the inverted box). Only the root can have empty children. An empty soup
+  // leaves `triangles` empty: pad the GPU buffer, Vulkan buffers cannot have size 0.
   std::vector<gpu::BvhNode> nodes;
   std::vector<gpu::BvhTriangle> triangles; // in leaf order; .v0.w = original index as float bits
   std::vector<std::uint32_t> order;        // order[i] = original index of triangles[i]

@@ -18,8 +18,9 @@ struct WatertightRay {
 WatertightRay prepareWatertightRay(const glm::vec3& origin, const glm::vec3& direction);
 
 // Returns true and sets t, u, v (barycentrics of v1, v2) if the ray hits the triangle with
-// tmin < t <= tmax (closed at tmax, so a caller passing its best t can break ties by id). Edges and vertices are hit by at least one of the triangles sharing them;
-// no absolute epsilon, so tiny triangles are never lost.
+// tmin < t <= tmax (closed at tmax, so a caller passing its best t can break ties by id).
+// Edges and vertices are hit by at least one of the triangles sharing them; no absolute
+// epsilon, so tiny triangles are never lost.
 bool intersectTriangle(const WatertightRay& ray, const glm::vec3& v0, const glm::vec3& v1,
                        const glm::vec3& v2, float tmin, float tmax, float& t, float& u, float& v);
 

@@ -1,6 +1,8 @@
 #include "render/scene_buffers.h"
 
 #include <bit>
+#include <cmath>
+#include <limits>
 #include <cstring>
 
 #include <fmt/core.h>
@@ -26,8 +28,40 @@ bvh::TriangleSoup triangleSoup(const scene::Scene& scene) {
 
 std::vector<gpu::BindingKind> sceneBindingKinds() {
   using K = gpu::BindingKind;
-  return {K::UniformTexelBuffer, K::UniformTexelBuffer, K::StorageBuffer, K::StorageBuffer,
-          K::StorageBuffer,      K::StorageBuffer,      K::StorageBuffer};
+  return {K::UniformTexelBuffer, K::StorageBuffer, K::StorageBuffer,
+          K::StorageBuffer,      K::StorageBuffer, K::StorageBuffer};
+}
+
+void widenBox(glm::vec4& lo, glm::vec4& hi) {
+  for (int k = 0; k < 3; ++k) {
+    if (lo[k] > hi[k]) continue; // an empty child: left as it is (its ref is kInvalidIndex)
+    lo[k] = std::nextafter(lo[k], -std::numeric_limits<float>::infinity());
+    hi[k] = std::nextafter(hi[k], std::numeric_limits<float>::infinity());
+  }
+}
+
+std::vector<gpu::BvhNode> bvhItems(const bvh::Bvh& bvh) {
+  const auto nodeCount = static_cast<std::uint32_t>(bvh.nodes.size());
+  std::vector<gpu::BvhNode> items;
+  items.reserve(bvh.nodes.size() + bvh.triangles.size());
+  auto rebase = [nodeCount](float refBits) {
+    std::uint32_t ref = std::bit_cast<std::uint32_t>(refBits);
+    if (ref != gpu::kInvalidIndex && (ref & gpu::kLeafFlag)) {
+      std::uint32_t first = (ref & gpu::kLeafFirstMask) + nodeCount;
+      if (first > gpu::kLeafFirstMask) throw DeviceError("the scene has too many triangles for the BVH item layout");
+      ref = (ref & ~gpu::kLeafFirstMask) | first;
+    }
+    return std::bit_cast<float>(ref);
+  };
+  for (gpu::BvhNode node : bvh.nodes) {
+    node.lo0.w = rebase(node.lo0.w);
+    node.hi0.w = rebase(node.hi0.w);
+    widenBox(node.lo0, node.hi0); // .w is not touched
+    widenBox(node.lo1, node.hi1);
+    items.push_back(node);
+  }
+  for (const auto& t : bvh.triangles) items.push_back({.lo0 = t.v0, .hi0 = t.v1, .lo1 = t.v2, .hi1 = glm::vec4(0.0f)});
+  return items;
 }
 
 namespace {
@@ -69,11 +103,9 @@ void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char
 SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh)
     : context_(&context) {
   using Usage = vk::BufferUsageFlagBits;
-  checkTexelLimit(context, bvh.nodes.size() * gpu::kTexelsPerNode, "BVH nodes");
-  checkTexelLimit(context, bvh.triangles.size() * gpu::kTexelsPerTriangle, "triangles");
-  nodes_ = gpu::TexelBuffer(context, bvh.nodes.data(), bvh.nodes.size() * sizeof(gpu::BvhNode), "scene.bvhNodes");
-  triangles_ = gpu::TexelBuffer(context, bvh.triangles.data(), bvh.triangles.size() * sizeof(gpu::BvhTriangle),
-                                "scene.bvhTriangles");
+  auto items = bvhItems(bvh);
+  checkTexelLimit(context, items.size() * gpu::kTexelsPerItem, "BVH nodes and triangles");
+  items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::BvhNode), "scene.bvhItems");
 
   auto shading = shadingData(scene);
   shading_ = gpu::Buffer(context, shading.size() * sizeof(gpu::TriangleShading), Usage::eStorageBuffer, "scene.shading");
@@ -101,13 +133,12 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
 
   status_ = gpu::Buffer(context, gpu::kStatusWords * 4, Usage::eStorageBuffer, "scene.status");
   resetStatus();
-  bytes_ = nodes_.buffer().size() + triangles_.buffer().size() + shading_.size() + materials_.size() +
+  bytes_ = items_.buffer().size() + shading_.size() + materials_.size() +
            textures_.size() + texels_.size() + status_.size();
 }
 
 void SceneBuffers::bindTo(gpu::Kernel& kernel) const {
-  kernel.bind(gpu::kBindingBvhNodes, nodes_);
-  kernel.bind(gpu::kBindingBvhTriangles, triangles_);
+  kernel.bind(gpu::kBindingBvhItems, items_);
   kernel.bind(gpu::kBindingShading, shading_);
   kernel.bind(gpu::kBindingMaterials, materials_);
   kernel.bind(gpu::kBindingTextures, textures_);

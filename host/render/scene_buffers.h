@@ -1,4 +1,4 @@
-// scene_buffers.h — the scene and its BVH on the GPU (set 0, bindings 0..6 of every tracing
+// scene_buffers.h — the scene and its BVH on the GPU (set 0, bindings 0..5 of every tracing
 // pass; see shaders/lib/scene_bindings.glsl). Uploaded once; lives as long as the scene.
 #pragma once
 #include <cstdint>
@@ -14,11 +14,21 @@ namespace obscura::render {
 // The BVH input for a scene: its triangles' world-space vertices in scene order.
 bvh::TriangleSoup triangleSoup(const scene::Scene& scene);
 
+// Widens a box outward by one ulp on every face (conservative: never loses a hit). The GPU slab
+// test needs it for rays with a zero direction component whose origin lies exactly on a face
+// (see safeReciprocal in shaders/lib/intersect.glsl).
+void widenBox(glm::vec4& lo, glm::vec4& hi);
+
+// The GPU item array of shared/host_device.h: the BVH's nodes, then its triangles padded to 64
+// bytes, with leaf references rebased from triangle indices to item indices and child boxes
+// widened (widenBox).
+std::vector<gpu::BvhNode> bvhItems(const bvh::Bvh& bvh);
+
 class SceneBuffers {
 public:
   SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh);
 
-  // Binds bindings 0..6 of `kernel`.
+  // Binds bindings 0..5 of `kernel`.
   void bindTo(gpu::Kernel& kernel) const;
 
   // Traversals cut off by kMaxTraversalSteps since the last reset (must stay 0).
@@ -29,8 +39,7 @@ public:
 
 private:
   const gpu::Context* context_;
-  gpu::TexelBuffer nodes_;
-  gpu::TexelBuffer triangles_;
+  gpu::TexelBuffer items_;
   gpu::Buffer shading_;
   gpu::Buffer materials_;
   gpu::Buffer textures_;

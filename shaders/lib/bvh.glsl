@@ -1,9 +1,12 @@
-// bvh.glsl — BVH2 traversal (closest hit and any hit) over the texel-buffer layout of
+// bvh.glsl — BVH2 traversal (closest hit and any hit) over the item layout of
 // shared/host_device.h. Needs scene_bindings.glsl and intersect.glsl.
 //
-// ONE loop handles one node or one triangle per pass: lavapipe runs both sides of every branch
-// for 8 lanes at once, so separate inner loops for nodes and triangles would cost the sum of the
-// lanes' work instead of the maximum (measured 1.7x faster, docs/ARCHITECTURE.md).
+// Shaped for lavapipe, which runs 8 lanes in lock-step and executes both sides of every branch
+// (docs/ARCHITECTURE.md, "lavapipe"):
+// - ONE loop handles one node or one triangle per pass, so a group of lanes pays for the maximum
+//   of their work, not the sum of separate node and triangle loops;
+// - ONE fetch path: every pass fetches the 4 texels of one item, a node or a triangle;
+// - one push site and one pop site for the (per-lane, dynamically indexed) stack.
 #ifndef OBSCURA_BVH_GLSL
 #define OBSCURA_BVH_GLSL
 
@@ -12,7 +15,7 @@ struct RayHit {
   float u;          // barycentric of v1
   float v;          // barycentric of v2
   uint primitive;   // original triangle index; kInvalidIndex on miss; kTruncatedHit if cut off
-  uint triangle;    // index into bvhTriangles (leaf order), valid when hit
+  uint item;        // item index of the hit triangle in bvhItems, valid when hit
   uint steps;       // loop passes used (for tests and statistics)
 };
 
@@ -20,7 +23,7 @@ bool rayHitValid(RayHit h) { return h.primitive < kTruncatedHit; }
 
 // Closest hit when anyHit is false (ties in t go to the lower primitive id), else the first hit
 // found with t < tmax (occlusion). Stops after kMaxTraversalSteps passes and reports
-// kTruncatedHit, well before lavapipe's loop limiter would cut the loop off silently.
+// kTruncatedHit, before lavapipe's loop limiter (65,535 passes) would cut the loop off silently.
 RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit) {
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);
@@ -29,70 +32,60 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   hit.u = 0.0;
   hit.v = 0.0;
   hit.primitive = kInvalidIndex;
-  hit.triangle = kInvalidIndex;
+  hit.item = kInvalidIndex;
   hit.steps = 0u;
 
   uint stack[kBvhStackSize];
   uint stackSize = 0u;
-  uint current = 0u;          // node index, leaf reference, or kInvalidIndex when done
-  uint triNext = 0u, triEnd = 0u;
-  bool done = false;
-  while (!done) {
+  uint node = 0u;                 // next interior node to visit; kInvalidIndex = pop next
+  uint triNext = 0u, triEnd = 0u; // pending triangle items of the current leaf
+  for (;;) {
     if (hit.steps >= kMaxTraversalSteps) {
       hit.primitive = kTruncatedHit;
       break;
     }
     hit.steps++;
-    if (triNext < triEnd) {
-      int base = int(triNext * kTexelsPerTriangle);
-      vec4 a = texelFetch(bvhTriangles, base);
-      vec4 b = texelFetch(bvhTriangles, base + 1);
-      vec4 c = texelFetch(bvhTriangles, base + 2);
+    bool onTriangle = triNext < triEnd;
+    int base = int((onTriangle ? triNext : node) * kTexelsPerItem);
+    vec4 a = texelFetch(bvhItems, base);
+    vec4 b = texelFetch(bvhItems, base + 1);
+    vec4 c = texelFetch(bvhItems, base + 2);
+    vec4 d = texelFetch(bvhItems, base + 3);
+    if (onTriangle) {
       float t, u, v;
       if (intersectTriangle(wr, a.xyz, b.xyz, c.xyz, tmin, hit.t, t, u, v)) {
         uint primitive = floatBitsToUint(a.w);
-        bool better = anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive);
-        if (better) {
+        if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
           hit.t = t;
           hit.u = u;
           hit.v = v;
           hit.primitive = primitive;
-          hit.triangle = triNext;
+          hit.item = triNext;
           if (anyHit) break;
         }
       }
       triNext++;
-    } else if (current == kInvalidIndex) {
-      done = true;
     } else {
-      // Interior node: both children's boxes are stored in it (Aila & Laine 2009).
-      int base = int(current * kTexelsPerNode);
-      vec4 lo0 = texelFetch(bvhNodes, base);
-      vec4 hi0 = texelFetch(bvhNodes, base + 1);
-      vec4 lo1 = texelFetch(bvhNodes, base + 2);
-      vec4 hi1 = texelFetch(bvhNodes, base + 3);
-      uint ref0 = floatBitsToUint(lo0.w), ref1 = floatBitsToUint(hi0.w);
-      vec2 s0 = intersectBox(lo0.xyz, hi0.xyz, origin, invDir, tmin, hit.t);
-      vec2 s1 = intersectBox(lo1.xyz, hi1.xyz, origin, invDir, tmin, hit.t);
+      // Interior node: a/b = child 0 box, c/d = child 1 box, refs in a.w and b.w.
+      uint ref0 = floatBitsToUint(a.w), ref1 = floatBitsToUint(b.w);
+      vec2 s0 = intersectBox(a.xyz, b.xyz, origin, invDir, tmin, hit.t);
+      vec2 s1 = intersectBox(c.xyz, d.xyz, origin, invDir, tmin, hit.t);
       bool hit0 = s0.x <= s0.y && ref0 != kInvalidIndex;
       bool hit1 = s1.x <= s1.y && ref1 != kInvalidIndex;
-      if (hit0 && hit1) {
-        bool swapOrder = s1.x < s0.x; // nearer child first
-        current = swapOrder ? ref1 : ref0;
-        stack[stackSize++] = swapOrder ? ref0 : ref1;
-      } else if (hit0) {
-        current = ref0;
-      } else if (hit1) {
-        current = ref1;
-      } else {
-        current = stackSize > 0u ? stack[--stackSize] : kInvalidIndex;
-      }
+      bool nearFirst = s0.x <= s1.x;
+      node = hit0 ? (hit1 && !nearFirst ? ref1 : ref0) : (hit1 ? ref1 : kInvalidIndex);
+      if (hit0 && hit1) stack[stackSize++] = nearFirst ? ref1 : ref0; // the push site
     }
-    // A leaf becomes the pending triangle range in the same pass it is reached.
-    if (triNext >= triEnd && current != kInvalidIndex && (current & kLeafFlag) != 0u) {
-      triNext = current & kLeafFirstMask;
-      triEnd = triNext + ((current >> kLeafCountShift) & kLeafCountMask) + 1u;
-      current = stackSize > 0u ? stack[--stackSize] : kInvalidIndex;
+    if (triNext >= triEnd) {
+      if (node == kInvalidIndex) {
+        if (stackSize == 0u) break;
+        node = stack[--stackSize]; // the pop site
+      }
+      if ((node & kLeafFlag) != 0u) { // a leaf becomes the pending triangle range
+        triNext = node & kLeafFirstMask;
+        triEnd = triNext + ((node >> kLeafCountShift) & kLeafCountMask) + 1u;
+        node = kInvalidIndex;
+      }
     }
   }
   return hit;
@@ -102,8 +95,8 @@ RayHit traceClosest(vec3 origin, vec3 direction, float tmin, float tmax) {
   return traverseBvh(origin, direction, tmin, tmax, false);
 }
 
-// True when something blocks the segment (tmin, tmax). A truncated traversal counts as occluded
-// and is reported through status[] by the caller.
+// Occlusion of the open segment (tmin, tmax). A truncated traversal is reported by the caller
+// through status[kStatusTruncated].
 RayHit traceAny(vec3 origin, vec3 direction, float tmin, float tmax) {
   return traverseBvh(origin, direction, tmin, tmax, true);
 }

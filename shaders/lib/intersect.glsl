@@ -3,9 +3,11 @@
 #ifndef OBSCURA_INTERSECT_GLSL
 #define OBSCURA_INTERSECT_GLSL
 
-// Per-ray constants of the watertight test, in matrix form: row i of `shear` maps a vertex
-// relative to the origin into the ray's sheared space, so each vertex costs three dot products
-// instead of dynamically indexed components (a per-lane gather on lavapipe).
+// Per-ray constants of the watertight test, in matrix form: row i of the shear maps a vertex
+// relative to the origin into the ray's sheared space. The rows hold one 1, one -S and one 0, so
+// (x*r.x + y*r.y) + z*r.z rounds exactly like the CPU's a[kx] - Sx*a[kz] (multiplying by 1 or
+// 0 and adding 0 are exact), without dynamically indexed components, which are per-lane
+// gathers on lavapipe.
 struct WatertightRay {
   vec3 origin;
   vec3 rowX;   // e_kx - Sx e_kz
@@ -15,9 +17,10 @@ struct WatertightRay {
 
 vec3 axisVector(int k) { return vec3(k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0); }
 
-// Woop, Benthin & Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013, §3:
-// kz = the axis of largest |d| (first one on ties), kx/ky the next two, swapped when d[kz] < 0 so
-// the winding is kept; shear Sx = d[kx]/d[kz], Sy = d[ky]/d[kz], Sz = 1/d[kz].
+// Woop, Benthin & Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013 ([WBW]):
+// kz = the axis of largest |d| (the lowest one on ties, as on the CPU), kx/ky the next two
+// cyclically, swapped when d[kz] < 0 so the winding is kept; Sx = d[kx]/d[kz], Sy = d[ky]/d[kz],
+// Sz = 1/d[kz].
 WatertightRay prepareWatertightRay(vec3 origin, vec3 direction) {
   vec3 a = abs(direction);
   int kz = 0;
@@ -35,37 +38,62 @@ WatertightRay prepareWatertightRay(vec3 origin, vec3 direction) {
   return r;
 }
 
+// Row times vector with a fixed, unfused evaluation order (see WatertightRay).
+float shearRow(vec3 row, vec3 p) {
+  precise float xy = p.x * row.x + p.y * row.y;
+  precise float r = xy + p.z * row.z;
+  return r;
+}
+
+// a*b - c*d with its exact sign: when the float difference rounds to 0, the difference of the
+// products' exact rounding errors (fma) decides. Exactly antisymmetric, which a shared edge needs.
+// Same as edgeFunction() in host/bvh/triangle_intersect.cpp, which explains why it is exact.
+float edgeFunction(float a, float b, float c, float d) {
+  precise float p = a * b;
+  precise float q = c * d;
+  precise float e = p - q;
+  precise float exact = fma(a, b, -p) - fma(c, d, -q);
+  return e != 0.0 ? e : exact;
+}
+
 // Returns true when the ray hits the triangle at tmin < t <= tmax (closed at tmax so callers can
-// break ties in t by primitive id). u, v are the barycentrics of v1 and v2. No epsilon: the edge
-// functions U, V, W are exact in sign for shared edges, so no ray slips between two triangles.
-// OURS: no double-precision fallback when U, V or W is exactly 0 (the paper's §3.3); such a ray
-// counts as hitting the edge, which is still watertight.
+// break ties in t by primitive id). u, v are the barycentrics of v1 and v2. The steps and their
+// rounding follow host/bvh/triangle_intersect.cpp one for one; `precise` forbids the fused
+// multiply-adds that would break the bit-exact antisymmetry of shared edges [WBW §3].
 bool intersectTriangle(WatertightRay r, vec3 p0, vec3 p1, vec3 p2, float tmin, float tmax,
                        out float t, out float u, out float v) {
-  vec3 A = p0 - r.origin, B = p1 - r.origin, C = p2 - r.origin;
-  float Ax = dot(r.rowX, A), Ay = dot(r.rowY, A);
-  float Bx = dot(r.rowX, B), By = dot(r.rowY, B);
-  float Cx = dot(r.rowX, C), Cy = dot(r.rowY, C);
-  // Scaled barycentrics (2D edge functions), paper eq. in §3.2.
-  float U = Cx * By - Cy * Bx;
-  float V = Ax * Cy - Ay * Cx;
-  float W = Bx * Ay - By * Ax;
-  t = 0.0; u = 0.0; v = 0.0;
+  precise vec3 A = p0 - r.origin;
+  precise vec3 B = p1 - r.origin;
+  precise vec3 C = p2 - r.origin;
+  float Ax = shearRow(r.rowX, A), Ay = shearRow(r.rowY, A);
+  float Bx = shearRow(r.rowX, B), By = shearRow(r.rowY, B);
+  float Cx = shearRow(r.rowX, C), Cy = shearRow(r.rowY, C);
+  // Scaled barycentrics: U weighs v0 (edge v1-v2), V weighs v1, W weighs v2 [WBW §3.2].
+  float U = edgeFunction(Cx, By, Cy, Bx);
+  float V = edgeFunction(Ax, Cy, Ay, Cx);
+  float W = edgeFunction(Bx, Ay, By, Ax);
+  t = 0.0;
+  u = 0.0;
+  v = 0.0;
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
-  float det = U + V + W;
+  precise float det = U + V + W;
   if (det == 0.0) return false;
-  float T = U * dot(r.rowZ, A) + V * dot(r.rowZ, B) + W * dot(r.rowZ, C);
-  float inv = 1.0 / det;
-  t = T * inv;
-  u = V * inv;
-  v = W * inv;
+  precise float T = (U * shearRow(r.rowZ, A) + V * shearRow(r.rowZ, B)) + W * shearRow(r.rowZ, C);
+  // Divide, then test the rounded t (not T against tmax*det): acceptance then depends on the
+  // (ray, triangle) pair alone, not on the order in which a traversal tightened tmax.
+  t = T / det;
+  u = V / det;
+  v = W / det;
   return t > tmin && t <= tmax;
 }
 
 // Direction reciprocal for slab tests. A zero component becomes a huge finite value of the same
-// sign instead of inf, so (bound - origin) * inv is never 0 * inf = NaN.
+// sign instead of inf, so (bound - origin) * inv is never 0 * inf = NaN. Such a ray stays in the
+// slab of that axis exactly when lo <= origin <= hi; the boxes are widened by one ulp on the
+// host (render::widenBox) so that an origin exactly on a face gives a nonzero, hence huge,
+// (bound - origin) * inv of the right sign.
 vec3 safeReciprocal(vec3 d) {
-  const float kTiny = 1e-30;
+  const float kTiny = 1e-37;
   vec3 m = max(abs(d), vec3(kTiny));
   return vec3(d.x < 0.0 ? -1.0 : 1.0, d.y < 0.0 ? -1.0 : 1.0, d.z < 0.0 ? -1.0 : 1.0) / m;
 }

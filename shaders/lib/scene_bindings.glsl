@@ -3,10 +3,9 @@
 #ifndef OBSCURA_SCENE_BINDINGS_GLSL
 #define OBSCURA_SCENE_BINDINGS_GLSL
 
-// Texel buffers: lavapipe fetches a texel as one vector gather, an SSBO vec4 as four scalar
+// A texel buffer: lavapipe fetches a texel as one vector gather, an SSBO vec4 as four scalar
 // gathers per lane (docs/ARCHITECTURE.md, "lavapipe").
-layout(set = 0, binding = kBindingBvhNodes) uniform samplerBuffer bvhNodes;
-layout(set = 0, binding = kBindingBvhTriangles) uniform samplerBuffer bvhTriangles;
+layout(set = 0, binding = kBindingBvhItems) uniform samplerBuffer bvhItems;
 layout(std430, set = 0, binding = kBindingShading) readonly buffer ShadingBuffer { TriangleShading triangleShading[]; };
 layout(std430, set = 0, binding = kBindingMaterials) readonly buffer MaterialBuffer { GpuMaterial materials[]; };
 layout(std430, set = 0, binding = kBindingTextures) readonly buffer TextureBuffer { GpuTexture textures[]; };

@@ -15,10 +15,10 @@ struct Surface {
 
 Surface surfaceAt(RayHit hit, vec3 origin, vec3 direction) {
   Surface s;
-  int base = int(hit.triangle * kTexelsPerTriangle);
-  vec3 p0 = texelFetch(bvhTriangles, base).xyz;
-  vec3 p1 = texelFetch(bvhTriangles, base + 1).xyz;
-  vec3 p2 = texelFetch(bvhTriangles, base + 2).xyz;
+  int base = int(hit.item * kTexelsPerItem);
+  vec3 p0 = texelFetch(bvhItems, base).xyz;
+  vec3 p1 = texelFetch(bvhItems, base + 1).xyz;
+  vec3 p2 = texelFetch(bvhItems, base + 2).xyz;
   float w = 1.0 - hit.u - hit.v;
   // Interpolating the vertices is more accurate than origin + t * direction far from the origin.
   s.position = w * p0 + hit.u * p1 + hit.v * p2;

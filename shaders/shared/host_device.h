@@ -45,24 +45,29 @@ OBS_CONST uint kInvalidIndex = 0xFFFFFFFFu;
 // reports the ray as truncated, so a cut-off can never go unnoticed.
 OBS_CONST uint kMaxTraversalSteps = 60000u;
 
-// ---- BVH node: 64 bytes = 4 texels of an RGBA32F texel buffer (the child refs ride in .w as
-// float bits). Bounds of both children live in the parent (Aila & Laine, "Understanding the
-// Efficiency of Ray Traversal on GPUs", 2009), so one fetch tests two boxes.
+// ---- BVH on the GPU: ONE RGBA32F texel buffer of 64-byte items (4 texels each): the interior
+// nodes [0, nodeCount) followed by the triangles in leaf order. A leaf reference's
+// `firstTriangle` is an ITEM index into this array. Nodes and triangles share one fetch path:
+// each traversal pass fetches 4 texels at one item index, whichever kind it is, because lavapipe
+// executes both sides of a branch and separate fetch paths would pay for both
+// (docs/ARCHITECTURE.md, "lavapipe").
+OBS_CONST uint kTexelsPerItem = 4;
+
+// Interior node: the bounds of both children live in the parent (Aila & Laine, "Understanding
+// the Efficiency of Ray Traversal on GPUs", 2009), so one fetch tests two boxes.
 struct BvhNode {
   vec4 lo0; // 0:  child 0 min xyz, w = child 0 ref (uintBitsToFloat)
   vec4 hi0; // 16: child 0 max xyz, w = child 1 ref (uintBitsToFloat)
   vec4 lo1; // 32: child 1 min xyz, w = unused
   vec4 hi1; // 48: child 1 max xyz, w = unused
 };          // 64 bytes
-OBS_CONST uint kTexelsPerNode = 4;
 
-// ---- Triangle for intersection: 48 bytes = 3 texels, stored in BVH leaf order.
+// Triangle for intersection, in leaf order.
 struct BvhTriangle {
   vec4 v0; // 0:  xyz, w = original triangle index (uintBitsToFloat)
   vec4 v1; // 16: xyz, w = unused
   vec4 v2; // 32: xyz, w = unused
-};         // 48 bytes
-OBS_CONST uint kTexelsPerTriangle = 3;
+};         // 48 bytes on the host; padded to one 64-byte item on the GPU
 
 // ---- Shading attributes of a triangle, indexed by the ORIGINAL triangle index; read once per
 // hit, never during traversal.
@@ -132,15 +137,14 @@ struct TracePush {
 };              // 16 bytes
 
 // ---- Descriptor bindings (set 0) shared by every pass that traces rays.
-OBS_CONST uint kBindingBvhNodes = 0;     // samplerBuffer RGBA32F, kTexelsPerNode per node
-OBS_CONST uint kBindingBvhTriangles = 1; // samplerBuffer RGBA32F, kTexelsPerTriangle per triangle
-OBS_CONST uint kBindingShading = 2;      // SSBO TriangleShading[]
-OBS_CONST uint kBindingMaterials = 3;    // SSBO GpuMaterial[]
-OBS_CONST uint kBindingTextures = 4;     // SSBO GpuTexture[]
-OBS_CONST uint kBindingTexels = 5;       // SSBO uint[] (RGBA8)
-OBS_CONST uint kBindingStatus = 6;       // SSBO uint[4]: [0] truncated traversals
-OBS_CONST uint kBindingPassFirst = 7;    // first binding owned by the pass itself
-OBS_CONST uint kSceneBindingCount = 7;
+OBS_CONST uint kBindingBvhItems = 0;  // samplerBuffer RGBA32F: nodes, then triangles (64-byte items)
+OBS_CONST uint kBindingShading = 1;   // SSBO TriangleShading[]
+OBS_CONST uint kBindingMaterials = 2; // SSBO GpuMaterial[]
+OBS_CONST uint kBindingTextures = 3;  // SSBO GpuTexture[]
+OBS_CONST uint kBindingTexels = 4;    // SSBO uint[] (RGBA8)
+OBS_CONST uint kBindingStatus = 5;    // SSBO uint[kStatusWords]
+OBS_CONST uint kSceneBindingCount = 6;
+OBS_CONST uint kBindingPassFirst = 6; // first binding owned by the pass itself
 
 // ---- status[] words (binding kBindingStatus).
 OBS_CONST uint kStatusTruncated = 0;     // traversals stopped by kMaxTraversalSteps

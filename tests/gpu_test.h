@@ -1,0 +1,32 @@
+// gpu_test.h — the Vulkan context shared by GPU tests, and the rule that any validation message
+// fails the test that caused it.
+#pragma once
+#include <gtest/gtest.h>
+
+#include "gpu/context.h"
+
+namespace obscura::test {
+
+// One context per test binary (device creation on lavapipe costs ~50 ms). The validation layer is
+// on: CMake runs every test with OBSCURA_VALIDATE=1, and GpuTest forces it anyway.
+gpu::Context& testContext();
+
+class GpuTest : public ::testing::Test {
+protected:
+  void SetUp() override { messagesBefore_ = gpu::Context::validationMessageCount(); }
+  void TearDown() override {
+    EXPECT_EQ(gpu::Context::validationMessageCount(), messagesBefore_)
+        << "the Vulkan validation layer reported a problem during this test (see stderr)";
+  }
+  gpu::Context& context() { return testContext(); }
+
+private:
+  std::uint64_t messagesBefore_ = 0;
+};
+
+// Path of a scene in ../shared/scenes (the real test scenes nobody here wrote).
+std::string sharedScene(const std::string& relative);
+// Path of a file in the repository.
+std::string repoPath(const std::string& relative);
+
+} // namespace obscura::test

@@ -1,0 +1,221 @@
+// GPU traversal (shaders/lib/bvh.glsl through trace.comp) against brute force over all triangles:
+// random soups, the Cornell box and modern-hall, >= 100k random rays each. Same triangle (ties by
+// t, then primitive id) and t within 1e-5 relative. Also: the loop limiter cannot cut a traversal
+// off unnoticed.
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "bvh/bvh.h"
+#include "gpu_test.h"
+#include "loop_limit_test.spv.h"
+#include "render/bench_rays.h"
+#include "render/ray_tracer.h"
+#include "render/scene_buffers.h"
+#include "scene/gltf_loader.h"
+
+namespace obscura::test {
+namespace {
+
+// Brute force on all cores: the oracle.
+std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vector<gpu::GpuRay>& rays) {
+  std::vector<bvh::Hit> out(rays.size());
+  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  std::vector<std::thread> pool;
+  for (unsigned k = 0; k < threads; ++k)
+    pool.emplace_back([&, k] {
+      for (std::size_t i = k; i < rays.size(); i += threads) {
+        const auto& r = rays[i];
+        out[i] = bvh::closestHitBruteForce(
+            soup, {glm::vec3(r.origin), glm::vec3(r.direction), r.origin.w, r.direction.w});
+      }
+    });
+  for (auto& t : pool) t.join();
+  return out;
+}
+
+struct Comparison {
+  std::size_t rays = 0, hits = 0;
+  std::size_t hitMissDisagreements = 0;
+  std::size_t tDisagreements = 0;        // |t_gpu - t_cpu| > 1e-5 relative
+  std::size_t primitiveTies = 0;         // same t, other triangle (a shared edge or vertex)
+};
+
+Comparison compare(const std::vector<gpu::GpuHit>& gpuHits, const std::vector<bvh::Hit>& cpuHits) {
+  Comparison c;
+  c.rays = gpuHits.size();
+  for (std::size_t i = 0; i < gpuHits.size(); ++i) {
+    const auto& g = gpuHits[i];
+    const auto& b = cpuHits[i];
+    bool gpuHit = g.primitive != gpu::kInvalidIndex;
+    c.hits += b.hit();
+    if (gpuHit != b.hit()) {
+      ++c.hitMissDisagreements;
+      continue;
+    }
+    if (!gpuHit) continue;
+    if (std::abs(g.t - b.t) > 1e-5f * std::max(1.0f, std::abs(b.t))) ++c.tDisagreements;
+    else if (g.primitive != b.primitive) ++c.primitiveTies;
+  }
+  return c;
+}
+
+void expectAgreement(const Comparison& c, const char* what) {
+  EXPECT_GE(c.rays, 100000u) << what;
+  EXPECT_EQ(c.hitMissDisagreements, 0u) << what;
+  EXPECT_EQ(c.tDisagreements, 0u) << what;
+  // Two triangles at the same t differ only for rays through a shared edge or vertex, where the
+  // CPU and GPU may round the edge test differently (fused multiply-adds): at most 1 in 10^4.
+  EXPECT_LE(c.primitiveTies, c.rays / 10000) << what;
+  EXPECT_GT(c.hits, 0u) << what;
+}
+
+class GpuTraversal : public GpuTest {
+protected:
+  Comparison traceAndCompare(const scene::Scene& scene, std::size_t count, std::uint64_t seed) {
+    bvh::TriangleSoup soup = render::triangleSoup(scene);
+    bvh::Bvh tree = bvh::build(soup);
+    render::SceneBuffers buffers(context(), scene, tree);
+    render::RayTracer tracer(context(), buffers);
+    auto rays = render::closestBenchRays(scene.bounds, count, seed);
+    auto result = tracer.trace(rays, render::TraceMode::Closest);
+    EXPECT_EQ(buffers.truncatedTraversals(), 0u);
+    return compare(result.hits, bruteForce(soup, rays));
+  }
+};
+
+// A scene made of a triangle soup, with one default material.
+scene::Scene soupScene(const bvh::TriangleSoup& soup) {
+  scene::Scene s;
+  for (std::size_t i = 0; i < soup.size(); ++i) {
+    auto base = static_cast<std::uint32_t>(s.positions.size());
+    for (glm::vec3 p : {soup.v0[i], soup.v1[i], soup.v2[i]}) {
+      s.positions.push_back(p);
+      s.normals.push_back(glm::vec3(0, 0, 1));
+      s.uvs.push_back(glm::vec2(0));
+      s.bounds.grow(p);
+    }
+    s.triangles.push_back(glm::uvec3(base, base + 1, base + 2));
+    s.triangleMaterial.push_back(0);
+    s.triangleLightGroup.push_back(gpu::kInvalidIndex);
+  }
+  s.materials.push_back({});
+  return s;
+}
+
+bvh::TriangleSoup randomSoup(std::size_t n, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> pos(-10.0f, 10.0f), size(-1.0f, 1.0f), scale(-4.0f, 0.5f);
+  bvh::TriangleSoup soup;
+  for (std::size_t i = 0; i < n; ++i) {
+    glm::vec3 c(pos(rng), pos(rng), pos(rng));
+    float s = std::pow(10.0f, scale(rng)); // sizes from 1e-4 to 3: some tiny
+    soup.v0.push_back(c + s * glm::vec3(size(rng), size(rng), size(rng)));
+    soup.v1.push_back(c + s * glm::vec3(size(rng), size(rng), size(rng)));
+    soup.v2.push_back(c + s * glm::vec3(size(rng), size(rng), size(rng)));
+  }
+  return soup;
+}
+
+TEST_F(GpuTraversal, RandomSoupsMatchBruteForce) {
+  for (std::uint32_t seed : {1u, 2u}) {
+    scene::Scene s = soupScene(randomSoup(seed == 1 ? 3000 : 500, seed));
+    expectAgreement(traceAndCompare(s, 100000, seed), "random soup");
+  }
+}
+
+TEST_F(GpuTraversal, CornellBoxMatchesBruteForce) {
+  scene::Scene s = scene::loadGltf(sharedScene("cornell-box/cornell-box.gltf"));
+  expectAgreement(traceAndCompare(s, 200000, 11), "cornell-box");
+}
+
+TEST_F(GpuTraversal, ModernHallMatchesBruteForce) {
+  scene::Scene s = scene::loadGltf(sharedScene("modern-hall/modern-hall.gltf"));
+  expectAgreement(traceAndCompare(s, 100000, 12), "modern-hall");
+}
+
+TEST_F(GpuTraversal, ShadowRaysMatchCpuAnyHit) {
+  scene::Scene s = scene::loadGltf(sharedScene("cornell-box/cornell-box.gltf"));
+  bvh::TriangleSoup soup = render::triangleSoup(s);
+  bvh::Bvh tree = bvh::build(soup);
+  render::SceneBuffers buffers(context(), s, tree);
+  render::RayTracer tracer(context(), buffers);
+  auto rays = render::shadowBenchRays(s.bounds, 100000, 5);
+  auto result = tracer.trace(rays, render::TraceMode::Any);
+  std::size_t disagreements = 0, occluded = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    bvh::Ray r{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
+    bool cpu = bvh::anyHit(tree, r);
+    occluded += cpu;
+    disagreements += cpu != (result.hits[i].primitive != gpu::kInvalidIndex);
+  }
+  EXPECT_EQ(disagreements, 0u);
+  EXPECT_GT(occluded, rays.size() / 10);
+}
+
+// A ray that passes through the boxes of every node but hits no triangle: n triangles stacked
+// along +z, each missing the z axis by 0.1 while its box contains it. The traversal must visit
+// them all, so its step count is known.
+scene::Scene stackedMisses(std::size_t n) {
+  bvh::TriangleSoup soup;
+  for (std::size_t i = 0; i < n; ++i) {
+    float z = static_cast<float>(i);
+    soup.v0.push_back({-0.9f, 1.1f, z});
+    soup.v1.push_back({1.1f, 1.1f, z});
+    soup.v2.push_back({1.1f, -0.9f, z});
+  }
+  return soupScene(soup);
+}
+
+TEST_F(GpuTraversal, LongTraversalIsReportedNotTruncatedSilently) {
+  for (std::size_t n : {20000u, 70000u}) {
+    scene::Scene s = stackedMisses(n);
+    bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+    render::SceneBuffers buffers(context(), s, tree);
+    render::RayTracer tracer(context(), buffers);
+    std::vector<gpu::GpuRay> rays(8, gpu::GpuRay{glm::vec4(0, 0, -1, 0), glm::vec4(0, 0, 1, INFINITY)});
+    auto result = tracer.trace(rays, render::TraceMode::Closest, true);
+    if (n == 20000) {
+      // Every triangle is tested: at least n passes, and still a clean miss.
+      EXPECT_EQ(result.hits[0].primitive, gpu::kInvalidIndex);
+      EXPECT_GE(result.steps[0], n);
+      EXPECT_LT(result.steps[0], gpu::kMaxTraversalSteps);
+      EXPECT_EQ(buffers.truncatedTraversals(), 0u);
+    } else {
+      // Too long: the traversal stops itself, says so per ray and in the status counter.
+      EXPECT_EQ(result.hits[0].primitive, gpu::kTruncatedHit);
+      EXPECT_EQ(result.steps[0], gpu::kMaxTraversalSteps);
+      EXPECT_EQ(buffers.truncatedTraversals(), rays.size());
+    }
+  }
+}
+
+class LoopLimiter : public GpuTest {};
+
+TEST_F(LoopLimiter, TraversalBudgetStaysBelowTheDriverLimit) {
+  using Usage = vk::BufferUsageFlagBits;
+  gpu::Kernel kernel(context(), {.name = "loop_limit_test", .spirv = kSpirv_loop_limit_test,
+                                 .bindings = {gpu::BindingKind::StorageBuffer}, .pushConstantBytes = 16});
+  gpu::Buffer counts(context(), 8 * 4, Usage::eStorageBuffer, "test.counts");
+  kernel.bind(0, counts);
+  auto run = [&](std::uint32_t n) {
+    glm::uvec4 push(n, 0, 0, 0);
+    context().submitAndWait([&](const vk::raii::CommandBuffer& cmd) { kernel.dispatch(cmd, 1, 1, 1, &push); });
+    return counts.download<std::uint32_t>(context())[0];
+  };
+  // Our own budget always runs to completion...
+  EXPECT_EQ(run(gpu::kMaxTraversalSteps), gpu::kMaxTraversalSteps);
+  // ...while a longer loop is silently cut off on lavapipe (and must not be on other drivers).
+  std::uint32_t long_ = run(100000);
+  if (context().info().isLavapipe) {
+    EXPECT_LT(long_, 100000u) << "lavapipe no longer limits loops: kMaxTraversalSteps could be raised";
+  } else {
+    EXPECT_EQ(long_, 100000u);
+  }
+}
+
+} // namespace
+} // namespace obscura::test

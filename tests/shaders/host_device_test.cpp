@@ -1,0 +1,80 @@
+// The one header shared by C++ and GLSL (shaders/shared/host_device.h): sizes and offsets on the
+// host, and a GPU readback that proves GLSL lays the structs out the same way.
+#include <cstddef>
+#include <cstring>
+
+#include <gtest/gtest.h>
+
+#include "gpu/buffer.h"
+#include "gpu/kernel.h"
+#include "gpu_test.h"
+#include "shared/host_device.h"
+#include "layout_test.spv.h"
+#include "shared/host_device.h"
+
+namespace obscura::gpu {
+static_assert(sizeof(BvhNode) == 64 && offsetof(BvhNode, hi1) == 48);
+static_assert(sizeof(BvhTriangle) == 48);
+static_assert(sizeof(TriangleShading) == 80 && offsetof(TriangleShading, uv2) == 64);
+static_assert(sizeof(GpuMaterial) == 64 && offsetof(GpuMaterial, textures) == 48);
+static_assert(sizeof(GpuTexture) == 16);
+static_assert(sizeof(GpuRay) == 32);
+static_assert(sizeof(GpuHit) == 16 && offsetof(GpuHit, primitive) == 12);
+static_assert(sizeof(GpuCamera) == 64);
+static_assert(sizeof(GBufferTexel) == 80 && offsetof(GBufferTexel, emission) == 64);
+static_assert(sizeof(PrimaryPush) == 80 && sizeof(PrimaryPush) <= 128);
+static_assert(sizeof(TracePush) == 16);
+static_assert(kBvhStackSize >= kBvhMaxDepth, "the traversal stack must hold the deepest path");
+static_assert(kMaxTraversalSteps < 65535u, "must stop before lavapipe's loop limiter");
+} // namespace obscura::gpu
+
+namespace obscura::test {
+namespace {
+
+struct LayoutBlock {
+  gpu::BvhNode node;
+  gpu::BvhTriangle triangle;
+  gpu::TriangleShading shading;
+  gpu::GpuMaterial material;
+  gpu::GpuTexture texture;
+  gpu::GpuRay ray;
+  gpu::GpuHit hit;
+  gpu::GpuCamera camera;
+  gpu::GBufferTexel gtexel;
+  gpu::PrimaryPush primaryPush;
+  gpu::TracePush tracePush;
+};
+static_assert(sizeof(LayoutBlock) == 140 * 4);
+
+class HostDeviceLayout : public GpuTest {};
+
+TEST_F(HostDeviceLayout, GlslWritesEveryFieldWhereCppReadsIt) {
+  using Usage = vk::BufferUsageFlagBits;
+  gpu::Kernel kernel(context(), {.name = "layout_test", .spirv = kSpirv_layout_test,
+                                 .bindings = {gpu::BindingKind::StorageBuffer}});
+  gpu::Buffer out(context(), sizeof(LayoutBlock), Usage::eStorageBuffer, "test.layout");
+  kernel.bind(0, out);
+  context().submitAndWait([&](const vk::raii::CommandBuffer& cmd) { kernel.dispatch(cmd, 1, 1, 1); });
+  LayoutBlock block{};
+  out.download(context(), &block, sizeof(block));
+  // Word i holds the value i (as float, int or uint as the field's type says).
+  const auto* words = reinterpret_cast<const std::uint32_t*>(&block);
+  const std::size_t intWords[] = {60, 61, 62, 63, 64, 65, 66, 67, 79, 132, 133, 134, 135, 136, 137, 138, 139};
+  for (std::size_t i = 0; i < sizeof(LayoutBlock) / 4; ++i) {
+    bool isInt = std::find(std::begin(intWords), std::end(intWords), i) != std::end(intWords);
+    if (isInt) {
+      EXPECT_EQ(words[i], i) << "word " << i;
+    } else {
+      float f;
+      std::memcpy(&f, &words[i], 4);
+      EXPECT_EQ(f, static_cast<float>(i)) << "word " << i;
+    }
+  }
+  EXPECT_EQ(block.hit.primitive, 79u);
+  EXPECT_EQ(block.material.textures.w, 63);
+  EXPECT_EQ(block.primaryPush.frame.x, 132u);
+  EXPECT_EQ(block.gtexel.emission.w, 115.0f);
+}
+
+} // namespace
+} // namespace obscura::test

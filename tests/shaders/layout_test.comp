@@ -1,0 +1,37 @@
+#version 460
+// Fills every field of the shared structs with a distinct value (its word index) so the host can
+// read them back through the C++ definitions of the same header: catches any layout drift.
+#extension GL_GOOGLE_include_directive : require
+#include "shared/host_device.h"
+
+layout(local_size_x = 1) in;
+layout(std430, binding = 0) writeonly buffer Out {
+  BvhNode node;
+  BvhTriangle triangle;
+  TriangleShading shading;
+  GpuMaterial material;
+  GpuTexture texture;
+  GpuRay ray;
+  GpuHit hit;
+  GpuCamera camera;
+  GBufferTexel gtexel;
+  PrimaryPush primaryPush;
+  TracePush tracePush;
+};
+
+vec4 f4(float base) { return vec4(base, base + 1.0, base + 2.0, base + 3.0); }
+uvec4 u4(uint base) { return uvec4(base, base + 1u, base + 2u, base + 3u); }
+
+void main() {
+  node = BvhNode(f4(0.0), f4(4.0), f4(8.0), f4(12.0));
+  triangle = BvhTriangle(f4(16.0), f4(20.0), f4(24.0));
+  shading = TriangleShading(f4(28.0), f4(32.0), f4(36.0), f4(40.0), f4(44.0));
+  material = GpuMaterial(f4(48.0), f4(52.0), f4(56.0), ivec4(60, 61, 62, 63));
+  texture = GpuTexture(u4(64u));
+  ray = GpuRay(f4(68.0), f4(72.0));
+  hit = GpuHit(76.0, 77.0, 78.0, 79u);
+  camera = GpuCamera(f4(80.0), f4(84.0), f4(88.0), f4(92.0));
+  gtexel = GBufferTexel(f4(96.0), f4(100.0), f4(104.0), f4(108.0), f4(112.0));
+  primaryPush = PrimaryPush(GpuCamera(f4(116.0), f4(120.0), f4(124.0), f4(128.0)), u4(132u));
+  tracePush = TracePush(u4(136u));
+}
