@@ -1,0 +1,131 @@
+// The `obscura` command as a user runs it: good input renders; bad input gets a message naming
+// the file and the problem, a non-zero exit, and no output or temporary file left behind.
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "gpu_test.h"
+
+namespace obscura::test {
+namespace {
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exitCode;
+  std::string output; // stdout and stderr together
+};
+
+RunResult runObscura(const std::string& args) {
+  std::string command = std::string(OBSCURA_BINARY_PATH) + " " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  RunResult r{-1, ""};
+  if (!pipe) return r;
+  std::array<char, 4096> buffer;
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) r.output += buffer.data();
+  int status = pclose(pipe);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+class Cli : public ::testing::Test {
+protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("obscura_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  // Files in the test folder other than `allowed`: there must be no partial outputs.
+  std::vector<std::string> strayFiles(const std::string& allowed = "") const {
+    std::vector<std::string> out;
+    for (const auto& entry : fs::directory_iterator(dir_))
+      if (entry.path().filename() != allowed) out.push_back(entry.path().filename().string());
+    return out;
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+TEST_F(Cli, RendersTheDefaultSceneToPngAndExrWithMetrics) {
+  auto r = runObscura("render " + repoPath("scenes/cornell-box/cornell-box.gltf") + " -o " + path("c.exr") +
+                      " --width 32 --height 32 --spp 2 --metrics " + path("m.json"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_TRUE(fs::exists(path("c.exr")));
+  EXPECT_TRUE(fs::exists(path("m.json")));
+  std::ifstream metrics(path("m.json"));
+  std::string text((std::istreambuf_iterator<char>(metrics)), std::istreambuf_iterator<char>());
+  for (const char* key : {"\"device\"", "\"bvh\"", "\"build_s\"", "\"gpu_ms\"", "\"mrays_per_s\"", "\"rays\""})
+    EXPECT_NE(text.find(key), std::string::npos) << key;
+  r = runObscura("render " + repoPath("scenes/cornell-box/cornell-box.gltf") + " -o " + path("c.png") +
+                 " --width 32 --spp 1 --aov albedo");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_TRUE(fs::exists(path("c.png")));
+}
+
+TEST_F(Cli, MissingSceneNamesTheFile) {
+  auto r = runObscura("render " + path("nope.gltf") + " -o " + path("out.png"));
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.output.find("nope.gltf"), std::string::npos) << r.output;
+  EXPECT_TRUE(strayFiles().empty());
+}
+
+TEST_F(Cli, MalformedSceneIsRejectedWithoutOutput) {
+  std::ofstream(path("bad.gltf")) << "{ \"asset\": { \"version\": \"2.0\" }, \"meshes\": [ ";
+  auto r = runObscura("render " + path("bad.gltf") + " -o " + path("out.exr"));
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("bad.gltf"), std::string::npos) << r.output;
+  EXPECT_EQ(strayFiles("bad.gltf"), std::vector<std::string>{});
+}
+
+TEST_F(Cli, BadFlagsAreRefused) {
+  const std::string scene = repoPath("scenes/cornell-box/cornell-box.gltf");
+  for (const std::string flags : {"--spp 0", "--spp -3", "--width 0", "--height 0", "--aov nonsense", "--camera 7"}) {
+    auto r = runObscura("render " + scene + " -o " + path("out.png") + " " + flags);
+    EXPECT_NE(r.exitCode, 0) << flags << "\n" << r.output;
+    EXPECT_FALSE(r.output.empty()) << flags;
+    EXPECT_TRUE(strayFiles().empty()) << flags;
+  }
+  auto r = runObscura("render " + scene + " -o " + path("out.jpg"));
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.output.find("out.jpg"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, UnwritableOutputLeavesNothingBehind) {
+  auto r = runObscura("render " + repoPath("scenes/cornell-box/cornell-box.gltf") + " --width 16 --spp 1 -o " +
+                      path("missing-folder/out.png"));
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("missing-folder"), std::string::npos) << r.output;
+  EXPECT_TRUE(strayFiles().empty());
+}
+
+TEST_F(Cli, ResolutionBeyondDeviceMemoryIsRefusedUpFront) {
+  auto r = runObscura("render " + repoPath("scenes/cornell-box/cornell-box.gltf") + " --width 16384 --height 16384 -o " +
+                      path("huge.exr"));
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("MiB"), std::string::npos) << r.output;
+  EXPECT_TRUE(strayFiles().empty());
+}
+
+TEST_F(Cli, InfoListsTheChosenDevice) {
+  auto r = runObscura("info");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("chosen"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, BenchRaysPrintsJson) {
+  auto r = runObscura("bench-rays " + repoPath("scenes/cornell-box/cornell-box.gltf") +
+                      " --rays 20000 --repeats 1 --verify 2000 --json");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  for (const char* key : {"closest_mrays_per_s", "shadow_mrays_per_s", "build_s", "closest_hit_fraction",
+                          "\"mismatches\":0"})
+    EXPECT_NE(r.output.find(key), std::string::npos) << key << "\n" << r.output;
+}
+
+} // namespace
+} // namespace obscura::test
