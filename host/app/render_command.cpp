@@ -126,6 +126,7 @@ void runRender(RenderOptions& o) {
                                          printProgress(d, t, s, raysPerSample);
                                        })
                                            : render::ProgressFn());
+  for (const auto& note : stats.notes) fmt::print(stderr, "note: {}\n", note);
   if (stats.truncatedTraversals > 0)
     throw DeviceError(fmt::format("{} traversals ran out of steps (kMaxTraversalSteps); the image would be wrong",
                                   stats.truncatedTraversals));

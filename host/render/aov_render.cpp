@@ -72,6 +72,7 @@ io::Image renderAovs(const gpu::Context& context, const scene::Scene& scene, con
                      const RenderSettings& settings, RenderStats& stats, const ProgressFn& progress) {
   auto start = std::chrono::steady_clock::now();
   SceneBuffers buffers(context, scene, bvh);
+  stats.notes = buffers.notes();
   PrimaryPass primary(context, buffers, settings.width, settings.height);
   gpu::Timestamps timestamps(context);
   const gpu::GpuCamera camera = gpuCamera(settings.camera, settings.width, settings.height);

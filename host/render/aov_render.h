@@ -30,6 +30,7 @@ struct RenderStats {
   double wallSeconds = 0.0;
   std::uint32_t truncatedTraversals = 0; // must be 0; reported so it can never go unnoticed
   std::uint64_t deviceBytes = 0;
+  std::vector<std::string> notes;        // what the upload changed (e.g. textures reduced)
 };
 
 // Names of the AOVs this render produces, in the order of the EXR layers.

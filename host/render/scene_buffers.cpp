@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "render/texture_fit.h"
 
 namespace obscura::render {
 
@@ -115,9 +116,11 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
   materials_ = gpu::Buffer(context, materials.size() * sizeof(gpu::GpuMaterial), Usage::eStorageBuffer, "scene.materials");
   materials_.upload(context, materials);
 
+  std::vector<scene::Texture> fitted =
+      fitTextures(scene.textures, context.info().maxStorageBufferRange, notes_);
   std::vector<gpu::GpuTexture> textureTable;
   std::size_t texelCount = 0;
-  for (const auto& t : scene.textures) {
+  for (const auto& t : fitted) {
     textureTable.push_back({.info = glm::uvec4(static_cast<std::uint32_t>(texelCount), t.width, t.height,
                                                t.srgb ? gpu::kTextureSrgb : 0u)});
     texelCount += static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height);
@@ -126,7 +129,7 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
   textures_.upload(context, textureTable);
   texels_ = gpu::Buffer(context, texelCount * 4, Usage::eStorageBuffer, "scene.texels");
   std::size_t offset = 0;
-  for (const auto& t : scene.textures) {
+  for (const auto& t : fitted) {
     texels_.upload(context, t.rgba8.data(), t.rgba8.size(), offset);
     offset += t.rgba8.size();
   }

@@ -36,6 +36,8 @@ public:
   void resetStatus();
 
   std::uint64_t bytes() const { return bytes_; }
+  // What the upload had to change (textures reduced to fit a device limit), for the log.
+  const std::vector<std::string>& notes() const { return notes_; }
 
 private:
   const gpu::Context* context_;
@@ -46,6 +48,7 @@ private:
   gpu::Buffer texels_;
   gpu::Buffer status_;
   std::uint64_t bytes_ = 0;
+  std::vector<std::string> notes_;
 };
 
 // Every kernel that traces rays starts its binding list with the scene's.

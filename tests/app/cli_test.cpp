@@ -30,6 +30,9 @@ RunResult runObscura(const std::string& args) {
   while (std::fgets(buffer.data(), buffer.size(), pipe)) r.output += buffer.data();
   int status = pclose(pipe);
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  // ctest runs every test with OBSCURA_VALIDATE=1, which the child inherits: any validation
+  // message it prints fails the test that caused it.
+  EXPECT_EQ(r.output.find("obscura: validation:"), std::string::npos) << r.output;
   return r;
 }
 
@@ -110,6 +113,34 @@ TEST_F(Cli, ResolutionBeyondDeviceMemoryIsRefusedUpFront) {
   EXPECT_EQ(r.exitCode, 2) << r.output;
   EXPECT_NE(r.output.find("MiB"), std::string::npos) << r.output;
   EXPECT_TRUE(strayFiles().empty());
+}
+
+TEST_F(Cli, DeviceSelection) {
+  const std::string scene = repoPath("scenes/cornell-box/cornell-box.gltf");
+  auto r = runObscura("render " + scene + " --width 16 --spp 1 -o " + path("a.png") + " --device 0");
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  r = runObscura("render " + scene + " --width 16 --spp 1 -o " + path("b.png") + " --device no-such-gpu");
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("no-such-gpu"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("b.png")));
+}
+
+TEST_F(Cli, NoVulkanDeviceIsAClearError) {
+  // Point the loader at a driver manifest that does not exist: no device at all.
+  auto r = runObscura("render " + repoPath("scenes/cornell-box/cornell-box.gltf") + " -o " + path("x.png") +
+                      " --width 16 --spp 1");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::string command = "env VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json OBSCURA_VALIDATE=0 ";
+  FILE* pipe = popen((command + OBSCURA_BINARY_PATH + " render " + repoPath("scenes/cornell-box/cornell-box.gltf") +
+                      " -o " + path("y.png") + " 2>&1").c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  std::array<char, 4096> buffer;
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) output += buffer.data();
+  int status = pclose(pipe);
+  EXPECT_EQ(WEXITSTATUS(status), 3) << output;
+  EXPECT_NE(output.find("Vulkan"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(path("y.png")));
 }
 
 TEST_F(Cli, InfoListsTheChosenDevice) {
