@@ -18,7 +18,8 @@ void main() {
   if (i >= pc.params.x) return;
   GpuRay ray = rays[i];
   bool anyHit = pc.params.y != 0u;
-  RayHit h = traverseBvh(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, anyHit);
+  RayHit h = traverseBvh(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, anyHit,
+                         kMaxTraversalSteps);
   if (h.primitive == kTruncatedHit) atomicAdd(status[kStatusTruncated], 1u);
   GpuHit out_;
   out_.t = h.t;

@@ -14,6 +14,7 @@
 #include "gpu/buffer.h"
 #include "io/image_io.h"
 #include "render/aov_render.h"
+#include "render/obscurance_renderer.h"
 
 namespace obscura::app {
 namespace {
@@ -28,6 +29,13 @@ struct RenderOptions {
   std::vector<std::string> aovs;
   std::string metrics;
   float exposure = 0.0f;
+  std::string method = "obscurance";
+  render::ObscuranceSettings obscurance;
+  std::string rho = "sqrt";
+  std::string sampling = "systematic";
+  bool noBleed = false;
+  float dMax = 0.0f;
+  bool dMaxGiven = false;
   DeviceOptions device;
 };
 
@@ -99,9 +107,12 @@ void runRender(RenderOptions& o) {
   std::string ext = io::extensionOf(o.output);
   if (ext != "exr" && ext != "png")
     throw InputError(fmt::format("{}: the output must be .exr or .png", o.output));
+  const auto& known = render::obscuranceAovNames();
   for (const auto& aov : o.aovs)
-    if (std::find(render::aovNames().begin(), render::aovNames().end(), aov) == render::aovNames().end())
-      throw InputError(fmt::format("--aov {}: unknown AOV (known: {})", aov, fmt::join(render::aovNames(), ", ")));
+    if (std::find(known.begin(), known.end(), aov) == known.end())
+      throw InputError(fmt::format("--aov {}: unknown AOV (known: {})", aov, fmt::join(known, ", ")));
+  if (o.dMax < 0.0f || (o.dMax == 0.0f && o.dMaxGiven))
+    throw InputError(fmt::format("--dmax {}: must be a positive distance in scene units", o.dMax));
 
   LoadedScene loaded = loadScene(o.scenePath);
   scene::Camera camera = chooseCamera(loaded.scene, o.camera);
@@ -109,23 +120,40 @@ void runRender(RenderOptions& o) {
   fmt::print(stderr, "{}\n", sceneSummary(loaded));
 
   gpu::Context context(o.device.contextOptions());
-  std::uint64_t need = render::renderBytesNeeded(o.width, o.height);
+  std::uint64_t need = render::obscuranceBytesNeeded(o.width, o.height, loaded.scene.lightGroups.size() +
+                                                                          loaded.scene.punctualLights.size());
   if (need > context.info().deviceLocalBytes || need / 6 > context.info().maxStorageBufferRange)
     throw InputError(fmt::format("{}x{}: the frame buffers would need {:.1f} MiB, more than the device "
                                  "'{}' offers", o.width, o.height, static_cast<double>(need) / 1048576.0,
                                  context.info().name));
   fmt::print(stderr, "device: {} ({})\n", context.info().name, context.info().driver);
 
-  render::RenderSettings settings{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
-                                  .camera = camera};
-  render::RenderStats stats;
+  render::ObscuranceSettings settings = o.obscurance;
+  settings.width = o.width;
+  settings.height = o.height;
+  settings.spp = o.spp;
+  settings.seed = o.seed;
+  settings.camera = camera;
+  settings.dMax = o.dMax;
+  settings.rho = o.rho == "exp" ? render::RhoKind::Exp : o.rho == "ao" ? render::RhoKind::Ao : render::RhoKind::Sqrt;
+  settings.systematic = o.sampling == "systematic";
+  settings.colourBleeding = !o.noBleed;
   const bool tty = ::isatty(STDERR_FILENO);
-  const std::uint64_t raysPerSample = std::uint64_t(o.width) * o.height;
-  io::Image image = render::renderAovs(context, loaded.scene, loaded.bvh, settings, stats,
-                                       tty ? render::ProgressFn([&](auto d, auto t, auto s) {
-                                         printProgress(d, t, s, raysPerSample);
-                                       })
-                                           : render::ProgressFn());
+  const std::uint64_t raysPerSample = std::uint64_t(o.width) * o.height *
+                                      (1 + settings.shadowRays + settings.obscuranceRays);
+  render::ObscuranceResult result = render::renderObscurances(
+      context, loaded.scene, loaded.bvh, settings,
+      tty ? render::ProgressFn([&](auto d, auto t, auto s) { printProgress(d, t, s, raysPerSample); })
+          : render::ProgressFn());
+  render::RenderStats& stats = result.stats;
+  io::Image& image = result.image;
+  const glm::vec3 ia = result.ambientIntensity, rAve = result.ambient.averageReflectance;
+  fmt::print(stderr, "obscurance: dmax {:.4g}, rho {}, {} sampling, {}; R_ave ({:.4f}, {:.4f}, {:.4f}), "
+                     "I_a ({:.4g}, {:.4g}, {:.4g}); {} lights\n",
+             result.dMax, o.rho, o.sampling, o.noBleed ? "grey" : "colour bleeding", rAve.x, rAve.y, rAve.z,
+             ia.x, ia.y, ia.z, result.lights.size());
+  if (result.ambient.reflectanceClamped)
+    fmt::print(stderr, "note: the average reflectance reaches 1; it was clamped to 0.999 (I_a would be infinite)\n");
   for (const auto& note : stats.notes) fmt::print(stderr, "note: {}\n", note);
   if (stats.truncatedTraversals > 0)
     throw DeviceError(fmt::format("{} traversals ran out of steps (kMaxTraversalSteps); the image would be wrong",
@@ -135,8 +163,10 @@ void runRender(RenderOptions& o) {
   if (ext == "exr") {
     io::writeExr(o.output, selected);
   } else {
-    std::string first = o.aovs.empty() ? "preview" : o.aovs.front();
-    io::writePng(o.output, image, image.channelIndex(render::aovChannels(first).front()), o.exposure);
+    std::string first = o.aovs.empty() ? "combined" : o.aovs.front();
+    const auto channels = render::aovChannels(first);
+    io::writePng(o.output, image, image.channelIndex(channels.front()), o.exposure,
+                 static_cast<int>(channels.size()));
   }
 
   nlohmann::json passes = nlohmann::json::object();
@@ -158,6 +188,12 @@ void runRender(RenderOptions& o) {
         {"scene", sceneJson(loaded)},
         {"image", {{"width", o.width}, {"height", o.height}, {"spp", o.spp}, {"seed", o.seed}, {"output", o.output}}},
         {"passes", passes},
+        {"obscurance",
+         {{"method", o.method}, {"dmax", result.dMax}, {"rho", o.rho}, {"tau", settings.tau},
+          {"sampling", o.sampling}, {"colour_bleeding", !o.noBleed},
+          {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
+          {"r_ave", {rAve.x, rAve.y, rAve.z}}, {"ambient_intensity", {ia.x, ia.y, ia.z}},
+          {"lights", result.lights.names}}},
         {"gpu_ms", totalMs},
         {"rays", totalRays},
         {"mrays_per_s", mrays},
@@ -185,6 +221,19 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--aov", options->aovs, "AOV(s) to write; the first goes to PNG (default: all / preview)");
   cmd->add_option("--exposure", options->exposure, "PNG exposure in stops");
   cmd->add_option("--metrics", options->metrics, "write device, scene, BVH and per-pass figures as JSON");
+  cmd->add_option("--method", options->method, "obscurance (ray-traced obscurances)")
+      ->check(CLI::IsMember({"obscurance"}));
+  cmd->add_option("--shadow-rays", options->obscurance.shadowRays, "shadow rays per hit (N_s)")
+      ->check(CLI::Range(0u, 1024u));
+  cmd->add_option("--obs-rays", options->obscurance.obscuranceRays, "obscurance rays per hit (N_obs)")
+      ->check(CLI::Range(0u, 1024u));
+  cmd->add_option("--rho", options->rho, "rho(d): sqrt (the paper's), exp, ao")->check(CLI::IsMember({"sqrt", "exp", "ao"}));
+  cmd->add_option("--tau", options->obscurance.tau, "tau of --rho exp")->check(CLI::PositiveNumber);
+  cmd->add_option("--dmax", options->dMax, "dmax in scene units (default: 1/4 of the largest bounding-box extent)")
+      ->each([options](const std::string&) { options->dMaxGiven = true; });
+  cmd->add_option("--sampling", options->sampling, "obscurance rays: systematic (default) or random")
+      ->check(CLI::IsMember({"systematic", "random"}));
+  cmd->add_flag("--no-bleed", options->noBleed, "grey obscurance W instead of colour bleeding W_c");
   addDeviceOptions(*cmd, options->device);
   cmd->callback([options] { runRender(*options); });
 }

@@ -75,14 +75,14 @@ void writeExr(const std::string& path, const Image& image) {
   });
 }
 
-void writePng(const std::string& path, const Image& image, int firstChannel, float exposure) {
+void writePng(const std::string& path, const Image& image, int firstChannel, float exposure, int count) {
   const float scale = std::exp2(exposure);
   std::vector<unsigned char> rgb(std::size_t(image.width) * image.height * 3);
   const int n = image.channelCount();
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x)
       for (int c = 0; c < 3; ++c) {
-        int source = std::min(firstChannel + c, n - 1);
+        int source = std::min(firstChannel + (count == 1 ? 0 : c), n - 1);
         float v = image.at(x, y, source) * scale;
         if (!std::isfinite(v)) v = 0.0f;
         rgb[(std::size_t(y) * image.width + x) * 3 + c] =

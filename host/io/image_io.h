@@ -22,8 +22,10 @@ struct Image {
 
 // Writes an EXR (float, all channels). Throws InputError naming the path on failure.
 void writeExr(const std::string& path, const Image& image);
-// Writes an 8-bit sRGB PNG of channels [first, first+3) after multiplying by 2^exposure.
-void writePng(const std::string& path, const Image& image, int firstChannel = 0, float exposure = 0.0f);
+// Writes an 8-bit sRGB PNG of channels [first, first + count) after multiplying by 2^exposure;
+// count 1 is shown grey (the channel in R, G and B).
+void writePng(const std::string& path, const Image& image, int firstChannel = 0, float exposure = 0.0f,
+              int count = 3);
 // Reads any image OpenImageIO reads (linear floats as stored; PNG values / 255, no decoding).
 Image readImage(const std::string& path);
 

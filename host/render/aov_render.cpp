@@ -19,6 +19,7 @@ const std::vector<std::string>& aovNames() {
 std::vector<std::string> aovChannels(const std::string& aov) {
   if (aov == "normal" || aov == "position") return {aov + ".X", aov + ".Y", aov + ".Z"};
   if (aov == "depth") return {"depth.Z"};
+  if (aov == "obscurance") return {"obscurance.Y"};
   if (aov == "coverage") return {"coverage.A"};
   if (aov == "primitive" || aov == "material") return {aov + ".id"};
   return {aov + ".R", aov + ".G", aov + ".B"};
@@ -28,10 +29,8 @@ std::uint64_t renderBytesNeeded(std::uint32_t width, std::uint32_t height) {
   return PrimaryPass::bytesNeeded(width, height);
 }
 
-namespace {
-
 // Converts the accumulated AOV slots into image channels.
-io::Image resolveAovs(const std::vector<glm::vec4>& aov, std::uint32_t width, std::uint32_t height,
+io::Image resolvePrimaryAovs(const std::vector<glm::vec4>& aov, std::uint32_t width, std::uint32_t height,
                       std::uint32_t spp) {
   io::Image image;
   image.width = static_cast<int>(width);
@@ -66,8 +65,6 @@ io::Image resolveAovs(const std::vector<glm::vec4>& aov, std::uint32_t width, st
   return image;
 }
 
-} // namespace
-
 io::Image renderAovs(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
                      const RenderSettings& settings, RenderStats& stats, const ProgressFn& progress) {
   auto start = std::chrono::steady_clock::now();
@@ -98,7 +95,7 @@ io::Image renderAovs(const gpu::Context& context, const scene::Scene& scene, con
   pass.gpuMs = timestamps.available() ? timestamps.totalsMs().at("primary") : 0.0;
   stats.deviceBytes = buffers.bytes() + PrimaryPass::bytesNeeded(settings.width, settings.height);
   auto aov = primary.aovs().download<glm::vec4>(context);
-  io::Image image = resolveAovs(aov, settings.width, settings.height, settings.spp);
+  io::Image image = resolvePrimaryAovs(aov, settings.width, settings.height, settings.spp);
   stats.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return image;
 }

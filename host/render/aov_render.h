@@ -46,6 +46,10 @@ io::Image renderAovs(const gpu::Context& context, const scene::Scene& scene, con
                      const RenderSettings& settings, RenderStats& stats,
                      const ProgressFn& progress = nullptr);
 
+// The image of primary.comp's accumulated AOV slots (kAovSlots vec4 per pixel) after `spp` samples.
+io::Image resolvePrimaryAovs(const std::vector<glm::vec4>& aov, std::uint32_t width, std::uint32_t height,
+                             std::uint32_t spp);
+
 // Device memory a render of this size needs beyond the scene.
 std::uint64_t renderBytesNeeded(std::uint32_t width, std::uint32_t height);
 

@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "render/bsdf.h"
 #include "render/texture_fit.h"
 
 namespace obscura::render {
@@ -82,13 +83,23 @@ std::vector<gpu::TriangleShading> shadingData(const scene::Scene& scene) {
   return out;
 }
 
+} // namespace
+
+glm::vec3 materialMeanAlbedo(const scene::Material& m) {
+  return meanAlbedo(glm::vec3(m.baseColor), m.metallic, m.roughness);
+}
+
+namespace {
+
 std::vector<gpu::GpuMaterial> materialData(const scene::Scene& scene) {
   std::vector<gpu::GpuMaterial> out;
   for (const auto& m : scene.materials)
     out.push_back({.baseColor = m.baseColor,
                    .emission = glm::vec4(m.emission, m.doubleSided ? 1.0f : 0.0f),
-                   .params = glm::vec4(m.metallic, m.roughness, m.alphaCutoff, 0.0f),
-                   .textures = glm::ivec4(m.baseColorTexture, m.metallicRoughnessTexture, m.emissiveTexture, -1)});
+                   .params = glm::vec4(m.metallic, m.roughness, m.alphaCutoff,
+                                       isGlossy(m.metallic, m.roughness) ? 1.0f : 0.0f),
+                   .textures = glm::ivec4(m.baseColorTexture, m.metallicRoughnessTexture, m.emissiveTexture, -1),
+                   .meanAlbedo = glm::vec4(materialMeanAlbedo(m), 0.0f)});
   return out;
 }
 
@@ -149,10 +160,12 @@ void SceneBuffers::bindTo(gpu::Kernel& kernel) const {
   kernel.bind(gpu::kBindingStatus, status_);
 }
 
-std::uint32_t SceneBuffers::truncatedTraversals() const {
-  std::uint32_t words[gpu::kStatusWords];
-  status_.download(*context_, words, sizeof(words));
-  return words[gpu::kStatusTruncated];
+std::uint32_t SceneBuffers::truncatedTraversals() const { return statusWords()[gpu::kStatusTruncated]; }
+
+std::vector<std::uint32_t> SceneBuffers::statusWords() const {
+  std::vector<std::uint32_t> words(gpu::kStatusWords);
+  status_.download(*context_, words.data(), words.size() * 4);
+  return words;
 }
 
 void SceneBuffers::resetStatus() {

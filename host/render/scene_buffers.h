@@ -14,6 +14,9 @@ namespace obscura::render {
 // The BVH input for a scene: its triangles' world-space vertices in scene order.
 bvh::TriangleSoup triangleSoup(const scene::Scene& scene);
 
+// a-bar of a material with its base colour factor [SPEC §1.2] (render/bsdf.h meanAlbedo).
+glm::vec3 materialMeanAlbedo(const scene::Material& material);
+
 // Widens a box outward by one ulp on every face (conservative: never loses a hit). The GPU slab
 // test needs it for rays with a zero direction component whose origin lies exactly on a face
 // (see safeReciprocal in shaders/lib/intersect.glsl).
@@ -33,6 +36,8 @@ public:
 
   // Traversals cut off by kMaxTraversalSteps since the last reset (must stay 0).
   std::uint32_t truncatedTraversals() const;
+  // All status words (kStatus*: truncations, rays per pass) since the last reset.
+  std::vector<std::uint32_t> statusWords() const;
   void resetStatus();
 
   std::uint64_t bytes() const { return bytes_; }

@@ -22,9 +22,11 @@ struct RayHit {
 bool rayHitValid(RayHit h) { return h.primitive < kTruncatedHit; }
 
 // Closest hit when anyHit is false (ties in t go to the lower primitive id), else the first hit
-// found with t < tmax (occlusion). Stops after kMaxTraversalSteps passes and reports
-// kTruncatedHit, before lavapipe's loop limiter (65,535 passes) would cut the loop off silently.
-RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit) {
+// found with t < tmax (occlusion). Stops after `maxSteps` passes and reports kTruncatedHit:
+// lavapipe's loop limiter (65,535 passes for ALL loops of an invocation) would otherwise cut the
+// loop off silently. A shader that traces several rays passes each the budget its earlier rays
+// left (StepBudget below), so the sum stays under kMaxTraversalSteps.
+RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit, uint maxSteps) {
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);
   RayHit hit;
@@ -40,7 +42,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   uint node = 0u;                 // next interior node to visit; kInvalidIndex = pop next
   uint triNext = 0u, triEnd = 0u; // pending triangle items of the current leaf
   for (;;) {
-    if (hit.steps >= kMaxTraversalSteps) {
+    if (hit.steps >= maxSteps) {
       hit.primitive = kTruncatedHit;
       break;
     }
@@ -92,13 +94,29 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
 }
 
 RayHit traceClosest(vec3 origin, vec3 direction, float tmin, float tmax) {
-  return traverseBvh(origin, direction, tmin, tmax, false);
+  return traverseBvh(origin, direction, tmin, tmax, false, kMaxTraversalSteps);
 }
 
 // Occlusion of the open segment (tmin, tmax). A truncated traversal is reported by the caller
 // through status[kStatusTruncated].
 RayHit traceAny(vec3 origin, vec3 direction, float tmin, float tmax) {
-  return traverseBvh(origin, direction, tmin, tmax, true);
+  return traverseBvh(origin, direction, tmin, tmax, true, kMaxTraversalSteps);
+}
+
+// The loop passes left to one invocation. A truncated ray is counted once in status[] and
+// treated by the caller as occluded / unknown; it never goes unreported.
+struct StepBudget {
+  uint left;
+  bool truncated;
+};
+
+StepBudget newStepBudget() { return StepBudget(kMaxTraversalSteps, false); }
+
+RayHit traceWithBudget(inout StepBudget budget, vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit) {
+  RayHit h = traverseBvh(origin, direction, tmin, tmax, anyHit, budget.left);
+  budget.left -= min(budget.left, h.steps);
+  if (h.primitive == kTruncatedHit) budget.truncated = true;
+  return h;
 }
 
 #endif

@@ -83,9 +83,36 @@ struct TriangleShading {
 struct GpuMaterial {
   vec4 baseColor;    // 0:  linear RGBA factor
   vec4 emission;     // 16: emissive radiance RGB (factor x strength), w = 1 if double-sided
-  vec4 params;       // 32: metallic, roughness, alphaCutoff, unused
+  vec4 params;       // 32: metallic, roughness, alphaCutoff, glossy (1) or Lambertian (0)
   ivec4 textures;    // 48: baseColor tex, metallicRoughness tex, emissive tex (-1 = none), unused
-};                   // 64 bytes
+  vec4 meanAlbedo;   // 64: rgb mean albedo a-bar of the BRDF with the base colour factor
+                     //     [SPEC §1.2, RTO eqs. 10-13], w = unused
+};                   // 80 bytes
+
+// ---- Lights. Each light is one basis buffer D_s [SPEC §3]: an emissive light GROUP (its
+// triangles in GpuEmitter[]) or a punctual light. Buffers hold transport at UNIT emission; the
+// image is sum_s E_s * D_s, so changing E_s needs no ray.
+OBS_CONST uint kLightArea = 0u;
+OBS_CONST uint kLightPoint = 1u;
+OBS_CONST uint kLightSpot = 2u;
+OBS_CONST uint kLightDirectional = 3u;
+
+struct GpuLight {
+  vec4 position;  // 0:  point/spot: world position, w = range (0 = infinite)
+  vec4 direction; // 16: spot/directional: unit direction the light travels, w = unused
+  uvec4 info;     // 32: type, first emitter, emitter count (area), group area (float bits)
+  vec4 params;    // 48: x = selection CDF (up to and including this light), y = selection
+                  //     probability, z = cos inner cone, w = cos outer cone
+};                // 64 bytes
+
+// One emissive triangle of an area light. Radiance is the material's emission divided by the
+// group's E_s (so a uniform group has unit radiance).
+struct GpuEmitter {
+  vec4 v0;        // 0:  xyz, w = CDF within the group (by area, up to and including this one)
+  vec4 v1;        // 16: xyz, w = area
+  vec4 v2;        // 32: xyz, w = 1 if it emits from both sides
+  vec4 radiance;  // 48: rgb unit-emission radiance, w = unused
+};                // 64 bytes
 
 // ---- Texture table: all textures live in one uint buffer of RGBA8 texels.
 struct GpuTexture {
@@ -147,8 +174,48 @@ OBS_CONST uint kSceneBindingCount = 6;
 OBS_CONST uint kBindingPassFirst = 6; // first binding owned by the pass itself
 
 // ---- status[] words (binding kBindingStatus).
-OBS_CONST uint kStatusTruncated = 0;     // traversals stopped by kMaxTraversalSteps
-OBS_CONST uint kStatusWords = 4;
+OBS_CONST uint kStatusTruncated = 0;       // traversals stopped by kMaxTraversalSteps
+OBS_CONST uint kStatusShadowRays = 1;      // shadow rays traced (for rays/s figures)
+OBS_CONST uint kStatusObscuranceRays = 2;  // obscurance rays traced
+OBS_CONST uint kStatusSpecularRays = 3;    // rays traced along specular paths
+OBS_CONST uint kStatusPathRays = 4;        // rays traced by the path tracer
+OBS_CONST uint kStatusWords = 8;
+
+// ---- Shading passes (shadow.comp, obscurance.comp): push constants.
+OBS_CONST uint kFlagSystematic = 1u; // obscurance rays by systematic sampling [RTO §4.2]
+OBS_CONST uint kFlagBleed = 2u;      // colour bleeding: W_c instead of W [RTO eq. 6]
+OBS_CONST uint kRhoSqrt = 0u;        // rho(d) = sqrt(d / dmax)          [RTO §3, SPEC §1.1]
+OBS_CONST uint kRhoExp = 1u;         // rho(d) = (1 - e^(-tau d/dmax)) / (1 - e^(-tau))
+OBS_CONST uint kRhoAo = 2u;          // rho(d) = 0 below dmax (ambient occlusion)
+
+struct ShadePush {
+  uvec4 frame;  // 0:  width, height, sample index, seed
+  uvec4 counts; // 16: light count, shadow rays per hit, obscurance rays per hit, flags
+  vec4 params;  // 32: dMax, tau, rho kind (as float), unused
+  vec4 rAve;    // 48: R_ave rgb (the reflectance of a miss within dmax, SPEC §1.2), w = unused
+  vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = unused
+};              // 80 bytes
+
+// ---- Bindings of the shading passes (after the scene's 0..5).
+OBS_CONST uint kBindingGBuffer = 6;   // GBufferTexel[pixels] of the current sample
+OBS_CONST uint kBindingLights = 7;    // GpuLight[lights]
+OBS_CONST uint kBindingEmitters = 8;  // GpuEmitter[]
+OBS_CONST uint kBindingBasis = 9;     // vec4[lights * pixels]: sums of D_s (unit emission)
+OBS_CONST uint kBindingAmbient = 10;  // vec4[pixels]: rgb sums of A = R(P) W_c (or R(P) W), w = W
+OBS_CONST uint kShadingBindingCount = 11;
+
+// ---- compose.comp: per pixel, AOV slots written (averaged over samples).
+OBS_CONST uint kComposeCombined = 0;   // C = sum_s E_s D_s + I_a A + emission (+ specular)
+OBS_CONST uint kComposeDirect = 1;     // sum_s E_s D_s at the primary hit
+OBS_CONST uint kComposeIndirect = 2;   // I_a * A at the primary hit (albedo I_a W_c)
+OBS_CONST uint kComposeSpecular = 3;   // everything gathered along specular paths
+OBS_CONST uint kComposeObscurance = 4; // W (grey obscurance), in .x
+OBS_CONST uint kComposeSlots = 5;
+
+struct ComposePush {
+  uvec4 frame;     // 0:  width, height, samples accumulated, light count
+  vec4 ambient;    // 16: I_a(E) rgb, w = unused
+};                 // 32 bytes
 
 // ---- Per-pixel AOV accumulation of primary.comp: kAovSlots vec4 per pixel, summed over samples
 // (slot kAovIds is written by sample 0 only).

@@ -16,7 +16,10 @@ namespace obscura::gpu {
 static_assert(sizeof(BvhNode) == 64 && offsetof(BvhNode, hi1) == 48);
 static_assert(sizeof(BvhTriangle) == 48);
 static_assert(sizeof(TriangleShading) == 80 && offsetof(TriangleShading, uv2) == 64);
-static_assert(sizeof(GpuMaterial) == 64 && offsetof(GpuMaterial, textures) == 48);
+static_assert(sizeof(GpuMaterial) == 80 && offsetof(GpuMaterial, textures) == 48 &&
+              offsetof(GpuMaterial, meanAlbedo) == 64);
+static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, params) == 48);
+static_assert(sizeof(GpuEmitter) == 64 && offsetof(GpuEmitter, radiance) == 48);
 static_assert(sizeof(GpuTexture) == 16);
 static_assert(sizeof(GpuRay) == 32);
 static_assert(sizeof(GpuHit) == 16 && offsetof(GpuHit, primitive) == 12);
@@ -43,8 +46,10 @@ struct LayoutBlock {
   gpu::GBufferTexel gtexel;
   gpu::PrimaryPush primaryPush;
   gpu::TracePush tracePush;
+  gpu::GpuLight light;
+  gpu::GpuEmitter emitter;
 };
-static_assert(sizeof(LayoutBlock) == 140 * 4);
+static_assert(sizeof(LayoutBlock) == 176 * 4);
 
 class HostDeviceLayout : public GpuTest {};
 
@@ -59,7 +64,8 @@ TEST_F(HostDeviceLayout, GlslWritesEveryFieldWhereCppReadsIt) {
   out.download(context(), &block, sizeof(block));
   // Word i holds the value i (as float, int or uint as the field's type says).
   const auto* words = reinterpret_cast<const std::uint32_t*>(&block);
-  const std::size_t intWords[] = {60, 61, 62, 63, 64, 65, 66, 67, 79, 132, 133, 134, 135, 136, 137, 138, 139};
+  const std::size_t intWords[] = {60,  61,  62,  63,  68,  69,  70,  71,  83,  136, 137, 138,
+                                  139, 140, 141, 142, 143, 152, 153, 154, 155};
   for (std::size_t i = 0; i < sizeof(LayoutBlock) / 4; ++i) {
     bool isInt = std::find(std::begin(intWords), std::end(intWords), i) != std::end(intWords);
     if (isInt) {
@@ -70,10 +76,13 @@ TEST_F(HostDeviceLayout, GlslWritesEveryFieldWhereCppReadsIt) {
       EXPECT_EQ(f, static_cast<float>(i)) << "word " << i;
     }
   }
-  EXPECT_EQ(block.hit.primitive, 79u);
+  EXPECT_EQ(block.hit.primitive, 83u);
   EXPECT_EQ(block.material.textures.w, 63);
-  EXPECT_EQ(block.primaryPush.frame.x, 132u);
-  EXPECT_EQ(block.gtexel.emission.w, 115.0f);
+  EXPECT_EQ(block.material.meanAlbedo.x, 64.0f);
+  EXPECT_EQ(block.primaryPush.frame.x, 136u);
+  EXPECT_EQ(block.gtexel.emission.w, 119.0f);
+  EXPECT_EQ(block.light.info.x, 152u);
+  EXPECT_EQ(block.emitter.radiance.w, 175.0f);
 }
 
 } // namespace

@@ -1,0 +1,69 @@
+#include "render/ambient.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace obscura::render {
+
+// Largest R_ave we accept: at 1 a closed scene never loses light and I_a diverges.
+constexpr float kMaxAverageReflectance = 0.999f;
+
+glm::vec3 meanTextureColour(const scene::Texture& texture) {
+  glm::dvec3 sum(0.0);
+  const std::size_t n = std::size_t(texture.width) * texture.height;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      double v = texture.rgba8[i * 4 + c] / 255.0;
+      if (texture.srgb) v = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+      sum[c] += v;
+    }
+  return n ? glm::vec3(sum / static_cast<double>(n)) : glm::vec3(1.0f);
+}
+
+glm::vec3 AmbientTerm::intensity(const std::vector<glm::vec3>& emission) const {
+  glm::vec3 ia(0.0f);
+  for (std::size_t s = 0; s < weight.size() && s < emission.size(); ++s) ia += emission[s] * weight[s];
+  return ia;
+}
+
+AmbientTerm computeAmbient(const scene::Scene& scene, const LightSet& lights,
+                           const std::vector<glm::vec3>& meanAlbedo, bool colourBleeding) {
+  AmbientTerm term;
+  std::vector<glm::vec3> textureMean(scene.textures.size());
+  for (std::size_t t = 0; t < scene.textures.size(); ++t) textureMean[t] = meanTextureColour(scene.textures[t]);
+  std::vector<glm::vec3> reflectance(scene.materials.size());
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    reflectance[m] = meanAlbedo[m];
+    int tex = scene.materials[m].baseColorTexture;
+    if (tex >= 0 && tex < static_cast<int>(textureMean.size())) reflectance[m] *= textureMean[tex];
+  }
+  glm::dvec3 weighted(0.0);
+  for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
+    const glm::uvec3 t = scene.triangles[i];
+    double area = 0.5 * glm::length(glm::cross(glm::dvec3(scene.positions[t.y] - scene.positions[t.x]),
+                                               glm::dvec3(scene.positions[t.z] - scene.positions[t.x])));
+    term.totalArea += area;
+    weighted += area * glm::dvec3(reflectance[scene.triangleMaterial[i]]);
+  }
+  glm::vec3 rAve = term.totalArea > 0.0 ? glm::vec3(weighted / term.totalArea) : glm::vec3(0.0f);
+  for (int c = 0; c < 3; ++c)
+    if (rAve[c] > kMaxAverageReflectance) {
+      rAve[c] = kMaxAverageReflectance;
+      term.reflectanceClamped = true;
+    }
+  term.averageReflectance = rAve;
+  // [RTO eq. 4] (grey) or [RTO eq. 12] (colour bleeding), per unit E_s. The paper's I_a is a
+  // radiosity (E_i = pi L_e); our images are radiance, so I_a is divided by pi: for a Lambertian
+  // reflector the indirect radiance is R(P) I_a W / pi. OURS [SPEC §5: no hidden scale].
+  for (std::size_t s = 0; s < lights.size(); ++s) {
+    glm::vec3 w(0.0f);
+    if (term.totalArea > 0.0) {
+      glm::vec3 perArea = lights.unitFlux[s] / static_cast<float>(term.totalArea * std::numbers::pi);
+      w = (colourBleeding ? glm::vec3(1.0f) : rAve) / (glm::vec3(1.0f) - rAve) * perArea;
+    }
+    term.weight.push_back(w);
+  }
+  return term;
+}
+
+} // namespace obscura::render

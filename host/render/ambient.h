@@ -1,0 +1,36 @@
+// ambient.h — the ambient intensity I_a of ray-traced obscurances [RTO eqs. 3-5, 12; SPEC §1.2].
+//
+//   R_ave = sum_i A_i R_i / A_t                       (per channel, R_i the mean albedo a-bar)
+//   grey:            I_a = R_ave / (1 - R_ave) * sum_i A_i E_i / A_t    (with W)
+//   colour bleeding: I_a =     1 / (1 - R_ave) * sum_i A_i E_i / A_t    (with W_c)
+//
+// I_a is kept in RADIANCE units (the paper's radiosity / pi), so the indirect term R(P) I_a W
+// adds directly to the image. sum_i A_i E_i is the emitted flux. It is linear in the lights' scales E_s, so I_a is kept as
+// one weight per light: I_a(E) = sum_s E_s * weight_s (relighting recomputes it for free).
+#pragma once
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "render/light_set.h"
+#include "scene/scene.h"
+
+namespace obscura::render {
+
+struct AmbientTerm {
+  glm::vec3 averageReflectance{0.0f}; // R_ave (clamped below 1, see clampedReflectance)
+  bool reflectanceClamped = false;    // R_ave reached 1 in a channel: I_a would be infinite
+  double totalArea = 0.0;             // A_t
+  std::vector<glm::vec3> weight;      // per light: I_a per unit E_s
+  glm::vec3 intensity(const std::vector<glm::vec3>& emission) const; // I_a(E)
+};
+
+// `meanAlbedo[m]` is a-bar of material m with its base colour factor; textured materials are
+// scaled by their texture's mean (linear) colour. OURS: a texture modulates a-bar linearly.
+AmbientTerm computeAmbient(const scene::Scene& scene, const LightSet& lights,
+                           const std::vector<glm::vec3>& meanAlbedo, bool colourBleeding);
+
+// Mean linear colour of a texture (sRGB decoded when the texture is sRGB).
+glm::vec3 meanTextureColour(const scene::Texture& texture);
+
+} // namespace obscura::render

@@ -1,0 +1,115 @@
+#include "render/light_set.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numbers>
+
+namespace obscura::render {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+float triangleArea(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  return 0.5f * glm::length(glm::cross(b - a, c - a));
+}
+
+// Per-channel ratio that makes a group's emission "unit": e / E, and 1 where E is 0 so a channel
+// switched on later by relighting still has transport in D_s.
+glm::vec3 unitRadiance(const glm::vec3& e, const glm::vec3& scale) {
+  glm::vec3 out;
+  for (int c = 0; c < 3; ++c) out[c] = scale[c] > 0.0f ? e[c] / scale[c] : 1.0f;
+  return out;
+}
+
+// Area of the scene's bounding box seen along `direction`: a directional light's "power" is its
+// irradiance times the cross-section it lights. OURS [SPEC §5 defines power for area and
+// punctual lights only].
+float projectedBoxArea(const scene::Bounds& b, const glm::vec3& direction) {
+  glm::vec3 e = b.extent();
+  glm::vec3 d = glm::abs(direction);
+  return d.x * e.y * e.z + d.y * e.x * e.z + d.z * e.x * e.y;
+}
+
+} // namespace
+
+float luminanceWeight(const glm::vec3& rgb) { return (rgb.x + rgb.y + rgb.z) / 3.0f; }
+
+bool LightSet::anySampled() const {
+  return std::any_of(power.begin(), power.end(), [](double p) { return p > 0.0; });
+}
+
+LightSet buildLightSet(const scene::Scene& scene) {
+  LightSet set;
+  // Area lights: one per light group.
+  for (const auto& group : scene.lightGroups) {
+    gpu::GpuLight light{};
+    light.info = glm::uvec4(gpu::kLightArea, static_cast<std::uint32_t>(set.emitters.size()),
+                            static_cast<std::uint32_t>(group.triangles.size()), 0u);
+    const glm::vec3 scale = group.emission;
+    float area = 0.0f;
+    glm::vec3 flux(0.0f);
+    std::size_t first = set.emitters.size();
+    for (std::uint32_t t : group.triangles) {
+      const glm::uvec3 tri = scene.triangles[t];
+      const scene::Material& m = scene.materials[scene.triangleMaterial[t]];
+      glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
+      float triArea = triangleArea(a, b, c);
+      float sides = m.doubleSided ? 2.0f : 1.0f;
+      area += triArea;
+      // Flux of a Lambertian emitter: pi * L * area per emitting side.
+      flux += kPi * sides * triArea * unitRadiance(m.emission, scale);
+      set.emitters.push_back({.v0 = glm::vec4(a, area), .v1 = glm::vec4(b, triArea),
+                              .v2 = glm::vec4(c, m.doubleSided ? 1.0f : 0.0f),
+                              .radiance = glm::vec4(unitRadiance(m.emission, scale), 0.0f)});
+    }
+    for (std::size_t i = first; i < set.emitters.size(); ++i) // normalise the area CDF
+      set.emitters[i].v0.w = area > 0.0f ? set.emitters[i].v0.w / area : 0.0f;
+    if (!set.emitters.empty() && set.emitters.size() > first) set.emitters.back().v0.w = 1.0f;
+    light.info.w = std::bit_cast<std::uint32_t>(area); // the group's area, for the sample pdf
+    set.lights.push_back(light);
+    set.names.push_back(group.name);
+    set.emission.push_back(scale);
+    set.unitFlux.push_back(flux);
+    set.power.push_back(static_cast<double>(luminanceWeight(flux * scale)));
+  }
+  // Punctual lights (KHR_lights_punctual): E_s = colour x intensity, unit transport per light.
+  for (const auto& p : scene.punctualLights) {
+    gpu::GpuLight light{};
+    std::uint32_t type = p.type == scene::PunctualType::Point ? gpu::kLightPoint
+                         : p.type == scene::PunctualType::Spot ? gpu::kLightSpot
+                                                               : gpu::kLightDirectional;
+    light.info = glm::uvec4(type, 0u, 0u, 0u);
+    light.position = glm::vec4(p.position, p.range);
+    light.direction = glm::vec4(glm::normalize(p.direction), 0.0f);
+    light.params = glm::vec4(0.0f, 0.0f, std::cos(p.innerConeAngle), std::cos(p.outerConeAngle));
+    glm::vec3 scale = p.color * p.intensity;
+    // Unit flux: 4 pi sr for point and spot (glTF's spot intensity is that of a point light
+    // masked by the cone; we count the full sphere, OURS); irradiance x cross-section for the sun.
+    float unit = type == gpu::kLightDirectional ? projectedBoxArea(scene.bounds, p.direction) : 4.0f * kPi;
+    set.lights.push_back(light);
+    set.names.push_back(p.name.empty() ? "punctual" : p.name);
+    set.emission.push_back(scale);
+    set.unitFlux.push_back(glm::vec3(unit));
+    set.power.push_back(static_cast<double>(unit * luminanceWeight(scale)));
+  }
+  // Selection CDF by power.
+  double total = 0.0;
+  for (double p : set.power) total += std::max(0.0, p);
+  // The last light with positive power closes the CDF at exactly 1 (no rounding gap); lights
+  // after it, and every zero-power light, get an empty interval and are never chosen.
+  std::size_t lastPositive = set.lights.size();
+  for (std::size_t i = 0; i < set.lights.size(); ++i)
+    if (set.power[i] > 0.0) lastPositive = i;
+  double running = 0.0;
+  for (std::size_t i = 0; i < set.lights.size(); ++i) {
+    double p = total > 0.0 ? std::max(0.0, set.power[i]) / total : 0.0;
+    running += p;
+    bool closed = lastPositive < set.lights.size() && i >= lastPositive;
+    set.lights[i].params.x = static_cast<float>(closed ? 1.0 : running);
+    set.lights[i].params.y = static_cast<float>(p);
+  }
+  return set;
+}
+
+} // namespace obscura::render

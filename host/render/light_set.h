@@ -1,0 +1,37 @@
+// light_set.h — the scene's lights as the shading passes see them: one entry (and one basis
+// buffer D_s) per emissive light group or punctual light [SPEC §3].
+//
+// Every light s has an emission scale E_s (RGB). The passes compute transport at unit scale, so
+// the image is sum_s E_s * D_s + I_a(E) * A + emission, linear in every E_s: relighting changes
+// E_s and recomposes without tracing a ray.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+#include "shared/host_device.h"
+
+namespace obscura::render {
+
+struct LightSet {
+  std::vector<gpu::GpuLight> lights;     // selection CDF filled in; probability 0 = never sampled
+  std::vector<gpu::GpuEmitter> emitters; // area lights' triangles, grouped per light
+  std::vector<std::string> names;        // light group or punctual light name
+  std::vector<glm::vec3> emission;       // E_s: the scene's own emission scale of each light
+  std::vector<glm::vec3> unitFlux;       // emitted flux of light s at E_s = 1 (W, per channel)
+  std::vector<double> power;             // selection weight ("power", SPEC §5)
+
+  std::size_t size() const { return lights.size(); }
+  bool anySampled() const;               // some light has positive power
+};
+
+// Builds the light set. Zero-area emitters and lights of zero power stay in the set (their basis
+// buffer is simply 0) but are never sampled.
+LightSet buildLightSet(const scene::Scene& scene);
+
+// Scalar "brightness" of an RGB value for selection weights: the channel mean.
+float luminanceWeight(const glm::vec3& rgb);
+
+} // namespace obscura::render

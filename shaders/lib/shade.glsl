@@ -1,0 +1,83 @@
+// shade.glsl — a shading point and its direct light, shared by the shadow pass (primary hits) and
+// the specular pass (diffuse vertices of specular paths). Needs scene/shading bindings, bvh.glsl,
+// ray.glsl, sampling.glsl, bsdf.glsl, lights.glsl.
+#ifndef OBSCURA_SHADE_GLSL
+#define OBSCURA_SHADE_GLSL
+
+struct ShadingPoint {
+  vec3 position;
+  vec3 ng;        // geometric normal, facing wo
+  vec3 ns;        // shading normal, same side as ng
+  vec3 wo;        // unit direction towards the viewer (or the previous path vertex)
+  vec3 baseColor; // base colour x texture
+  float metallic;
+  float roughness;
+  bool glossy;    // has a specular lobe [SPEC §5]
+  uint material;
+};
+
+ShadingPoint shadingPoint(vec3 position, vec3 ng, vec3 ns, vec3 wo, vec3 baseColor, uint material) {
+  ShadingPoint sp;
+  sp.position = position;
+  sp.ng = ng;
+  sp.ns = ns;
+  sp.wo = wo;
+  sp.baseColor = baseColor;
+  sp.material = material;
+  GpuMaterial m = materials[material];
+  sp.metallic = m.params.x;
+  sp.roughness = m.params.y;
+  sp.glossy = m.params.w != 0.0;
+  return sp;
+}
+
+ShadingPoint shadingPointFromGBuffer(GBufferTexel g, vec3 eye) {
+  return shadingPoint(g.position.xyz, g.geometricNormal.xyz, g.shadingNormal.xyz, normalize(eye - g.position.xyz),
+                      g.albedo.rgb, floatBitsToUint(g.shadingNormal.w));
+}
+
+// f(wo, wi) of the shading point's BSDF (without the cosine), in world space.
+vec3 shadingBsdf(ShadingPoint sp, vec3 wi) {
+  if (!sp.glossy) return sp.baseColor * (1.0 / kPi);
+  vec3 t, b;
+  orthonormalBasis(sp.ns, t, b);
+  vec3 woLocal = vec3(dot(sp.wo, t), dot(sp.wo, b), dot(sp.wo, sp.ns));
+  vec3 wiLocal = vec3(dot(wi, t), dot(wi, b), dot(wi, sp.ns));
+  return evalBsdf(sp.baseColor, sp.metallic, sp.roughness, woLocal, wiLocal);
+}
+
+// The reflectance R(P) the obscurance term multiplies [RTO eq. 1]. OURS: at a glossy point
+// only the diffuse part, because the specular pass traces the glossy lobe's reflections itself
+// (a-bar there would count them twice); a-bar is used for R(Q) and R_ave [SPEC §1.2].
+vec3 obscuranceReflectance(ShadingPoint sp) {
+  return sp.glossy ? sp.baseColor * (1.0 - sp.metallic) : sp.baseColor;
+}
+
+// One shadow ray: contribution (unit emission, before E_s) and the light it belongs to.
+// Light arriving below the geometric surface is dropped, so interpolated normals never leak
+// light through a surface.
+void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, inout StepBudget budget,
+                       out vec3 contribution, out uint light) {
+  contribution = vec3(0.0);
+  LightSample ls = sampleLight(sp.position, u, lightCount);
+  light = ls.light;
+  float cosG = dot(sp.ng, ls.wi);
+  float cosS = dot(sp.ns, ls.wi);
+  if (cosG <= 0.0 || cosS <= 0.0 || all(equal(ls.weight, vec3(0.0)))) return;
+  vec3 origin = offsetRayOrigin(sp.position, sp.ng);
+  vec3 direction = ls.wi;
+  float tmax = 1.0 / 0.0;
+  if (!ls.infinite) {
+    // Both ends leave their surfaces (Wächter & Binder), so neither the receiver nor the light's
+    // own triangle can occlude the segment.
+    vec3 target = ls.targetNormal == vec3(0.0) ? ls.target : offsetRayOrigin(ls.target, ls.targetNormal);
+    vec3 d = target - origin;
+    tmax = length(d);
+    direction = d / tmax;
+  }
+  RayHit h = traceWithBudget(budget, origin, direction, 0.0, tmax, true);
+  if (h.primitive != kInvalidIndex) return; // occluded (or truncated, reported by the caller)
+  contribution = shadingBsdf(sp, ls.wi) * ls.weight * cosS;
+}
+
+#endif

@@ -1,0 +1,16 @@
+// shading_bindings.glsl — bindings 6..10 shared by the shading passes (shadow, obscurance,
+// specular): the G-buffer, the lights and the accumulation buffers [SPEC §3].
+#ifndef OBSCURA_SHADING_BINDINGS_GLSL
+#define OBSCURA_SHADING_BINDINGS_GLSL
+
+layout(std430, set = 0, binding = kBindingGBuffer) readonly buffer GBuffer { GBufferTexel gbuffer[]; };
+layout(std430, set = 0, binding = kBindingLights) readonly buffer LightBuffer { GpuLight lights[]; };
+layout(std430, set = 0, binding = kBindingEmitters) readonly buffer EmitterBuffer { GpuEmitter emitters[]; };
+// basis[light * pixelCount + pixel] += D_s contributions (unit emission), summed over samples.
+layout(std430, set = 0, binding = kBindingBasis) buffer BasisBuffer { vec4 basis[]; };
+// ambient[pixel].rgb += R(P) W_c (or R(P) W), .w += W, summed over samples.
+layout(std430, set = 0, binding = kBindingAmbient) buffer AmbientBuffer { vec4 ambient[]; };
+
+layout(push_constant) uniform Push { ShadePush pc; };
+
+#endif

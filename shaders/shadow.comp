@@ -1,0 +1,44 @@
+#version 460
+// shadow.comp — direct light at the primary hit: N_s shadow rays per hit [RTO §4.1 step 2],
+// each to a light chosen by power and a point uniform on it, accumulated per light into the
+// basis buffers D_s at unit emission [SPEC §3]:
+//   D_s += f(P, wo, wi) L_e cos(theta_P) cos(theta_L) / r^2 / pdf / N_s
+#extension GL_GOOGLE_include_directive : require
+#include "shared/host_device.h"
+#include "lib/scene_bindings.glsl"
+#include "lib/shading_bindings.glsl"
+#include "lib/intersect.glsl"
+#include "lib/bvh.glsl"
+#include "lib/ray.glsl"
+#include "lib/rng.glsl"
+#include "lib/sampling.glsl"
+#include "lib/bsdf.glsl"
+#include "lib/lights.glsl"
+#include "lib/shade.glsl"
+
+layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
+
+void main() {
+  uvec2 size = pc.frame.xy;
+  uvec2 p = gl_GlobalInvocationID.xy;
+  if (p.x >= size.x || p.y >= size.y) return;
+  uint pixel = p.y * size.x + p.x;
+  uint pixelCount = size.x * size.y;
+  GBufferTexel g = gbuffer[pixel];
+  if (g.albedo.a == 0.0) return; // no hit: nothing to light
+
+  ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);
+  uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x5bd1e995u);
+  StepBudget budget = newStepBudget();
+  uint count = pc.counts.y;
+  float invCount = 1.0 / float(count);
+  for (uint k = 0u; k < count; ++k) {
+    vec4 u = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
+    vec3 contribution;
+    uint light;
+    directLightSample(sp, u, pc.counts.x, budget, contribution, light);
+    basis[light * pixelCount + pixel] += vec4(contribution * invCount, 0.0);
+  }
+  atomicAdd(status[kStatusShadowRays], count);
+  if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
+}
