@@ -23,6 +23,7 @@
 // twin needs the same care: declare the edge functions `precise`.
 #include "bvh/triangle_intersect.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -46,7 +47,40 @@ inline float edgeFunction(float a, float b, float c, float d) {
   return e != 0.0f ? e : std::fma(a, b, -p) - std::fma(c, d, -q);
 }
 
+// gamma(n) = n eps / (1 - n eps), eps = 2^-24: the bound on n float roundings [PBR3 §3.9.1].
+inline float gammaBound(float n) {
+  constexpr float kEpsilon = 0x1p-24f;
+  return n * kEpsilon / (1.0f - n * kEpsilon);
+}
+
 } // namespace
+
+// Bound on the absolute error of t = T / det, after Pharr, Jakob & Humphreys, "Physically Based
+// Rendering" 3rd ed. (PBR3), §3.9.5, with one tightening (OURS): PBR3 multiplies the error of
+// the edge functions by max|z|; but t = sum e_i z_i / sum e_i is a weighted mean of the z_i, and
+// writing z_i = z0 + d_i shows that errors De_i in the weights move t by at most
+// 2 sum|De_i| max|d_i| / |det|, i.e. by the SPREAD of the z_i, not their size. Without this a
+// 1e-6 triangle seen from distance 1 (spread 1e-6, |z| = 1) got a bound above t and was lost,
+// while a 2000-unit floor under a ray's origin (spread ~1e3) still gets the bound it needs.
+// The GLSL twin computes the same expression in the same order.
+float triangleTError(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy, float cz,
+                     float e0, float e1, float e2, float det) {
+  const float maxZ = std::max(std::max(std::abs(az), std::abs(bz)), std::abs(cz));
+  const float spreadZ = std::max(std::max(az, bz), cz) - std::min(std::min(az, bz), cz);
+  const float deltaZ = gammaBound(3.0f) * maxZ;
+  const float maxX = std::max(std::max(std::abs(ax), std::abs(bx)), std::abs(cx));
+  const float maxY = std::max(std::max(std::abs(ay), std::abs(by)), std::abs(cy));
+  const float deltaX = gammaBound(5.0f) * (maxX + maxZ);
+  const float deltaY = gammaBound(5.0f) * (maxY + maxZ);
+  const float deltaE = 2.0f * ((gammaBound(2.0f) * maxX * maxY + deltaY * maxX) + deltaX * maxY);
+  const float maxE = std::max(std::max(std::abs(e0), std::abs(e1)), std::abs(e2));
+  // When every vertex lies in front of the origin (beyond its own rounding error), t is a convex
+  // combination of positive z_i for any same-signed weights: it cannot be <= 0, so no bound is
+  // needed. This keeps grazing hits on slivers far from the origin, where the bound exceeds t.
+  const float minZ = std::min(std::min(az, bz), cz);
+  if (minZ > deltaZ) return 0.0f;
+  return (3.0f * (gammaBound(3.0f) * maxE * maxZ + deltaZ * maxE) + 6.0f * deltaE * spreadZ) * std::abs(1.0f / det);
+}
 
 // [WBW], per-ray precomputation: the axis of largest |d| becomes z (so Sz is finite and as
 // large as it can be), kx/ky are the next two axes cyclically, swapped when d[kz] < 0 so that the
@@ -123,9 +157,16 @@ bool intersectTriangle(const WatertightRay& ray, const glm::vec3& v0, const glm:
   u = vv / det; // barycentric of v1
   v = ww / det; // barycentric of v2
 
-  // 8. Range test, open at tmin, closed at tmax so the caller can pass its best t and break ties
+  // 8. A t that rounding could have made positive is no hit: the conservative bound on the error
+  //    of t from Pharr, Jakob & Humphreys, "Physically Based Rendering" 3rd ed., §3.9.5
+  //    ("Ensuring that t is positive"). For a huge triangle the error of t grows with the
+  //    vertices' distance from the origin, not with the hit point, so offsetting a secondary
+  //    ray's origin (which scales with the hit point) cannot prevent a self-hit alone.
+  const float tError = triangleTError(ax, ay, az, bx, by, bz, cx, cy, cz, uu, vv, ww, det);
+
+  // 9. Range test, open at tmin, closed at tmax so the caller can pass its best t and break ties
   //    by primitive id. A NaN t (zero direction) compares false and is rejected.
-  return t > tmin && t <= tmax;
+  return t > tmin && t > tError && t <= tmax;
 }
 
 } // namespace obscura::bvh

@@ -24,4 +24,9 @@ WatertightRay prepareWatertightRay(const glm::vec3& origin, const glm::vec3& dir
 bool intersectTriangle(const WatertightRay& ray, const glm::vec3& v0, const glm::vec3& v1,
                        const glm::vec3& v2, float tmin, float tmax, float& t, float& u, float& v);
 
+// Conservative bound on the absolute error of the t computed from these sheared coordinates
+// (a*, b*, c*), edge functions e0..e2 and det [PBR3 §3.9.5]; hits with t <= it are rejected.
+float triangleTError(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy, float cz,
+                     float e0, float e1, float e2, float det);
+
 } // namespace obscura::bvh

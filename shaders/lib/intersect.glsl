@@ -56,6 +56,33 @@ float edgeFunction(float a, float b, float c, float d) {
   return e != 0.0 ? e : exact;
 }
 
+// gamma(n) = n eps / (1 - n eps), eps = 2^-24: the bound on n float roundings [PBR3 §3.9.1].
+float gammaBound(float n) {
+  const float kEpsilon = 5.9604644775390625e-8; // 2^-24
+  return n * kEpsilon / (1.0 - n * kEpsilon);
+}
+
+// Bound on the absolute error of t = T / det (Pharr, Jakob & Humphreys, "Physically Based
+// Rendering" 3rd ed., §3.9.5, with the edge-function term scaled by the spread of the z_i
+// instead of max|z|: see triangleTError() in host/bvh/triangle_intersect.cpp for why). A hit
+// with t <= this bound may really lie behind the origin. Same expression, same order as there.
+float triangleTError(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy, float cz,
+                     float e0, float e1, float e2, float det) {
+  precise float maxZ = max(max(abs(az), abs(bz)), abs(cz));
+  precise float spreadZ = max(max(az, bz), cz) - min(min(az, bz), cz);
+  precise float deltaZ = gammaBound(3.0) * maxZ;
+  precise float maxX = max(max(abs(ax), abs(bx)), abs(cx));
+  precise float maxY = max(max(abs(ay), abs(by)), abs(cy));
+  precise float deltaX = gammaBound(5.0) * (maxX + maxZ);
+  precise float deltaY = gammaBound(5.0) * (maxY + maxZ);
+  precise float deltaE = 2.0 * ((gammaBound(2.0) * maxX * maxY + deltaY * maxX) + deltaX * maxY);
+  precise float maxE = max(max(abs(e0), abs(e1)), abs(e2));
+  precise float bound = (3.0 * (gammaBound(3.0) * maxE * maxZ + deltaZ * maxE) + 6.0 * deltaE * spreadZ) * abs(1.0 / det);
+  // All vertices in front of the origin: t is a convex combination of positive z_i, never <= 0.
+  float minZ = min(min(az, bz), cz);
+  return minZ > deltaZ ? 0.0 : bound;
+}
+
 // Returns true when the ray hits the triangle at tmin < t <= tmax (closed at tmax so callers can
 // break ties in t by primitive id). u, v are the barycentrics of v1 and v2. The steps and their
 // rounding follow host/bvh/triangle_intersect.cpp one for one; `precise` forbids the fused
@@ -78,13 +105,17 @@ bool intersectTriangle(WatertightRay r, vec3 p0, vec3 p1, vec3 p2, float tmin, f
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   precise float det = U + V + W;
   if (det == 0.0) return false;
-  precise float T = (U * shearRow(r.rowZ, A) + V * shearRow(r.rowZ, B)) + W * shearRow(r.rowZ, C);
+  float Az = shearRow(r.rowZ, A), Bz = shearRow(r.rowZ, B), Cz = shearRow(r.rowZ, C);
+  precise float T = (U * Az + V * Bz) + W * Cz;
   // Divide, then test the rounded t (not T against tmax*det): acceptance then depends on the
   // (ray, triangle) pair alone, not on the order in which a traversal tightened tmax.
   t = T / det;
   u = V / det;
   v = W / det;
-  return t > tmin && t <= tmax;
+  // A t that rounding could have made positive is no hit [PBR3 §3.9.5]: for a huge triangle the
+  // error of t grows with its vertices, so the origin offset of a secondary ray cannot cover it.
+  float tError = triangleTError(Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz, U, V, W, det);
+  return t > tmin && t > tError && t <= tmax;
 }
 
 // Direction reciprocal for slab tests. A zero component becomes a huge finite value of the same

@@ -1,0 +1,194 @@
+// Ray-traced obscurances against analytic answers [RTO; SPEC §1]: obscurance of an open plane
+// and of a floor under an infinite parallel ceiling (every rho, both sampling modes, with colour
+// bleeding), direct light from a point light and from a square area light, determinism, and
+// the passes a scene does not need are not dispatched.
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "bvh/bvh.h"
+#include "gpu_test.h"
+#include "render/obscurance_renderer.h"
+#include "render/scene_buffers.h"
+#include "render/test_scenes.h"
+#include "scene/gltf_loader.h"
+
+namespace obscura::test {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+constexpr float kHalfSize = 1000.0f; // "infinite" planes: far larger than dMax
+
+class Obscurance : public GpuTest {
+protected:
+  render::ObscuranceResult render(const scene::Scene& s, render::ObscuranceSettings settings) {
+    bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+    auto result = render::renderObscurances(context(), s, tree, settings);
+    EXPECT_EQ(result.stats.truncatedTraversals, 0u);
+    for (float v : result.image.pixels) EXPECT_TRUE(std::isfinite(v));
+    return result;
+  }
+  // Mean of one channel over the pixels that hit something.
+  static double mean(const io::Image& image, const std::string& channel) {
+    int c = image.channelIndex(channel), coverage = image.channelIndex("coverage.A");
+    double sum = 0.0;
+    int n = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        if (image.at(x, y, coverage) == 1.0f) {
+          sum += image.at(x, y, c);
+          ++n;
+        }
+    EXPECT_GT(n, 0);
+    return n ? sum / n : 0.0;
+  }
+};
+
+scene::Scene floorScene(glm::vec3 albedo = glm::vec3(0.5f)) {
+  SceneBuilder b;
+  auto m = b.lambertian(albedo);
+  b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, m); // faces +y
+  return b.build();
+}
+
+// Floor at y = 0 and a ceiling at y = h facing it.
+scene::Scene slabScene(float h, glm::vec3 ceilingAlbedo, glm::vec3 floorAlbedo = glm::vec3(0.5f)) {
+  SceneBuilder b;
+  auto floor = b.lambertian(floorAlbedo);
+  auto ceiling = b.lambertian(ceilingAlbedo);
+  b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, floor);
+  b.quad({-kHalfSize, h, -kHalfSize}, {2 * kHalfSize, 0, 0}, {0, 0, 2 * kHalfSize}, ceiling);
+  // A faint point light far away, so that I_a > 0 and the indirect AOV carries W_c.
+  b.pointLight({0, 0.5f * h, 0}, glm::vec3(1.0f), 1.0f);
+  return b.build();
+}
+
+render::ObscuranceSettings lookDown(float height, float yfov, std::uint32_t size, std::uint32_t spp) {
+  render::ObscuranceSettings s;
+  s.width = s.height = size;
+  s.spp = spp;
+  s.camera = lookCamera({0, height, 0}, {0, -1, 0}, {0, 0, -1}, yfov);
+  return s;
+}
+
+TEST_F(Obscurance, OpenPlaneIsFullyOpenForEveryRhoAndSampling) {
+  scene::Scene s = floorScene();
+  for (auto rho : {render::RhoKind::Sqrt, render::RhoKind::Exp, render::RhoKind::Ao})
+    for (bool systematic : {true, false}) {
+      auto settings = lookDown(1.0f, 1.0f, 16, 2);
+      settings.rho = rho;
+      settings.systematic = systematic;
+      settings.obscuranceRays = 8;
+      auto r = render(s, settings);
+      int c = r.image.channelIndex("obscurance.Y");
+      for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) ASSERT_EQ(r.image.at(x, y, c), 1.0f) << x << "," << y;
+    }
+}
+
+struct SlabCase {
+  render::RhoKind rho;
+  bool systematic;
+};
+
+TEST_F(Obscurance, FloorUnderParallelCeilingMatchesTheClosedForm) {
+  const float h = 1.0f, dMax = 2.0f, k = h / dMax;
+  const glm::vec3 ceilingAlbedo(0.2f, 0.5f, 0.8f);
+  scene::Scene s = slabScene(h, ceilingAlbedo);
+  // AO: rho = 0 wherever the ceiling is within dMax (cos theta > k), so W = k^2.
+  // sqrt: W = 2 int_0^1 rho(d) c dc with d = h/c: (4/3) sqrt(k) - k^2 / 3.
+  const double wAo = k * k, wSqrt = 4.0 / 3.0 * std::sqrt(k) - k * k / 3.0;
+  for (SlabCase c : {SlabCase{render::RhoKind::Ao, true}, SlabCase{render::RhoKind::Ao, false},
+                     SlabCase{render::RhoKind::Sqrt, true}, SlabCase{render::RhoKind::Sqrt, false}}) {
+    // Two budgets: the tolerance (4 sigma of a mean of values in [0, 1]) shrinks with samples.
+    for (std::uint32_t spp : {1u, 8u}) {
+      auto settings = lookDown(0.5f * h, 0.3f, 32, spp);
+      settings.rho = c.rho;
+      settings.systematic = c.systematic;
+      settings.obscuranceRays = 16;
+      settings.dMax = dMax;
+      auto r = render(s, settings);
+      const double n = 32.0 * 32.0 * spp * settings.obscuranceRays;
+      const double tolerance = 4.0 * 0.5 / std::sqrt(n);
+      const double expectedW = c.rho == render::RhoKind::Ao ? wAo : wSqrt;
+      EXPECT_NEAR(mean(r.image, "obscurance.Y"), expectedW, tolerance)
+          << "rho " << int(c.rho) << (c.systematic ? " systematic" : " random") << " spp " << spp;
+      // Colour bleeding: W_c = a (hit part) + R_ave (miss part) [RTO eq. 6, SPEC §1.2]; the
+      // indirect AOV is I_a R(P) W_c with R(P) the floor's albedo 0.5.
+      const glm::vec3 rAve = r.ambient.averageReflectance;
+      for (int ch = 0; ch < 3; ++ch) {
+        double hitPart = c.rho == render::RhoKind::Ao ? 0.0 : wSqrt - wAo;
+        double expectedWc = ceilingAlbedo[ch] * hitPart + rAve[ch] * wAo;
+        double indirect = mean(r.image, std::string("indirect.") + "RGB"[ch]);
+        double wc = indirect / (r.ambientIntensity[ch] * 0.5);
+        EXPECT_NEAR(wc, expectedWc, tolerance) << "channel " << ch;
+      }
+    }
+  }
+}
+
+TEST_F(Obscurance, PointLightOverAPlaneIsExact) {
+  SceneBuilder b;
+  auto floor = b.lambertian(glm::vec3(0.5f));
+  b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, floor);
+  const glm::vec3 light(0.3f, 2.0f, -0.2f);
+  const float intensity = 10.0f;
+  b.pointLight(light, glm::vec3(1.0f), intensity);
+  scene::Scene s = b.build();
+  auto settings = lookDown(1.0f, 1.2f, 24, 1); // one sample: the position AOV is that sample's
+  settings.shadowRays = 1;
+  settings.obscuranceRays = 0;
+  auto r = render(s, settings);
+  int direct = r.image.channelIndex("direct.R"), position = r.image.channelIndex("position.X");
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 24; ++x) {
+      glm::vec3 p(r.image.at(x, y, position), r.image.at(x, y, position + 1), r.image.at(x, y, position + 2));
+      glm::vec3 d = light - p;
+      float r2 = glm::dot(d, d);
+      float expected = 0.5f / kPi * intensity * (d.y / std::sqrt(r2)) / r2; // f E cos / r^2
+      EXPECT_NEAR(r.image.at(x, y, direct), expected, 1e-4f * expected) << x << "," << y;
+    }
+}
+
+TEST_F(Obscurance, SquareAreaLightMatchesTheFormFactor) {
+  // A square emitter of half-side a at height h, centred over the origin and facing down, with
+  // unit radiance: irradiance at the origin E = pi L F with the differential-area-to-parallel-
+  // square form factor F = (4/pi) X/sqrt(1+X^2) atan(X/sqrt(1+X^2)), X = a/h (four corner
+  // rectangles); the floor's radiance is albedo * L * F.
+  const float a = 0.5f, h = 1.0f, albedo = 0.5f;
+  SceneBuilder b;
+  auto floor = b.lambertian(glm::vec3(albedo));
+  auto emitter = b.lambertian(glm::vec3(0.0f), glm::vec3(1.0f));
+  b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, floor);
+  b.quad({-a, h, -a}, {2 * a, 0, 0}, {0, 0, 2 * a}, emitter, "square"); // faces -y
+  scene::Scene s = b.build();
+  auto settings = lookDown(0.5f, 0.002f, 16, 16); // every pixel within 1e-3 of the origin
+  settings.shadowRays = 16;
+  settings.obscuranceRays = 0;
+  auto r = render(s, settings);
+  const double x = a / h, q = x / std::sqrt(1.0 + x * x);
+  const double formFactor = 4.0 / std::numbers::pi * q * std::atan(q);
+  EXPECT_NEAR(mean(r.image, "direct.G"), albedo * formFactor, 0.01 * albedo * formFactor);
+}
+
+TEST_F(Obscurance, SameSeedSameImageNoNaNAndOnlyNeededPasses) {
+  scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
+  render::ObscuranceSettings settings;
+  settings.width = settings.height = 24;
+  settings.spp = 2;
+  settings.camera = s.cameras.at(0);
+  auto a = render(s, settings), b2 = render(s, settings);
+  ASSERT_EQ(a.image.pixels.size(), b2.image.pixels.size());
+  for (std::size_t i = 0; i < a.image.pixels.size(); ++i) ASSERT_EQ(a.image.pixels[i], b2.image.pixels[i]) << i;
+  EXPECT_TRUE(a.stats.passes.contains("shadow"));
+  EXPECT_GT(a.stats.passes.at("shadow").rays, 0u);
+  // A scene without lights: no shadow pass at all, and obscurance still renders.
+  scene::Scene dark = floorScene();
+  auto d = render(dark, lookDown(1.0f, 1.0f, 8, 1));
+  EXPECT_FALSE(d.stats.passes.contains("shadow"));
+  EXPECT_TRUE(d.stats.passes.contains("obscurance"));
+}
+
+} // namespace
+} // namespace obscura::test

@@ -1,0 +1,90 @@
+#include "render/test_scenes.h"
+
+#include "shared/host_device.h"
+
+namespace obscura::test {
+
+std::uint32_t SceneBuilder::lambertian(glm::vec3 albedo, glm::vec3 emission, bool doubleSided) {
+  scene::Material m;
+  m.name = "lambertian" + std::to_string(scene_.materials.size());
+  m.baseColor = glm::vec4(albedo, 1.0f);
+  m.metallic = 0.0f;
+  m.roughness = 1.0f;
+  m.emission = emission;
+  m.doubleSided = doubleSided;
+  scene_.materials.push_back(m);
+  return static_cast<std::uint32_t>(scene_.materials.size() - 1);
+}
+
+std::uint32_t SceneBuilder::glossy(glm::vec3 baseColor, float metallic, float roughness) {
+  scene::Material m;
+  m.name = "glossy" + std::to_string(scene_.materials.size());
+  m.baseColor = glm::vec4(baseColor, 1.0f);
+  m.metallic = metallic;
+  m.roughness = roughness;
+  scene_.materials.push_back(m);
+  return static_cast<std::uint32_t>(scene_.materials.size() - 1);
+}
+
+void SceneBuilder::quad(glm::vec3 corner, glm::vec3 u, glm::vec3 v, std::uint32_t material, const std::string& group) {
+  auto base = static_cast<std::uint32_t>(scene_.positions.size());
+  glm::vec3 n = glm::normalize(glm::cross(u, v));
+  for (glm::vec3 p : {corner, corner + u, corner + u + v, corner + v}) {
+    scene_.positions.push_back(p);
+    scene_.normals.push_back(n);
+    scene_.uvs.push_back(glm::vec2(0.0f));
+    scene_.bounds.grow(p);
+  }
+  std::uint32_t lightGroup = gpu::kInvalidIndex;
+  if (!group.empty()) {
+    for (std::size_t g = 0; g < scene_.lightGroups.size(); ++g)
+      if (scene_.lightGroups[g].name == group) lightGroup = static_cast<std::uint32_t>(g);
+    if (lightGroup == gpu::kInvalidIndex) {
+      scene_.lightGroups.push_back({.name = group, .triangles = {}, .emission = scene_.materials[material].emission});
+      lightGroup = static_cast<std::uint32_t>(scene_.lightGroups.size() - 1);
+    }
+  }
+  for (glm::uvec3 t : {glm::uvec3(base, base + 1, base + 2), glm::uvec3(base, base + 2, base + 3)}) {
+    if (lightGroup != gpu::kInvalidIndex)
+      scene_.lightGroups[lightGroup].triangles.push_back(static_cast<std::uint32_t>(scene_.triangles.size()));
+    scene_.triangles.push_back(t);
+    scene_.triangleMaterial.push_back(material);
+    scene_.triangleLightGroup.push_back(lightGroup);
+  }
+}
+
+void SceneBuilder::pointLight(glm::vec3 position, glm::vec3 color, float intensity) {
+  scene::PunctualLight l;
+  l.name = "point";
+  l.type = scene::PunctualType::Point;
+  l.position = position;
+  l.color = color;
+  l.intensity = intensity;
+  scene_.punctualLights.push_back(l);
+}
+
+void SceneBuilder::directionalLight(glm::vec3 direction, glm::vec3 color, float intensity) {
+  scene::PunctualLight l;
+  l.name = "sun";
+  l.type = scene::PunctualType::Directional;
+  l.direction = glm::normalize(direction);
+  l.color = color;
+  l.intensity = intensity;
+  scene_.punctualLights.push_back(l);
+}
+
+scene::Scene SceneBuilder::build() {
+  if (scene_.materials.empty()) lambertian(glm::vec3(0.5f));
+  return scene_;
+}
+
+scene::Camera lookCamera(glm::vec3 position, glm::vec3 forward, glm::vec3 up, float yfov) {
+  scene::Camera c;
+  c.position = position;
+  c.forward = glm::normalize(forward);
+  c.up = glm::normalize(up);
+  c.yfov = yfov;
+  return c;
+}
+
+} // namespace obscura::test

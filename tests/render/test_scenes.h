@@ -1,0 +1,30 @@
+// test_scenes.h — scenes built in code for analytic tests: quads with Lambertian materials,
+// emissive quads (light groups), punctual lights.
+#pragma once
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace obscura::test {
+
+class SceneBuilder {
+public:
+  // A Lambertian material (metallic 0, roughness 1: no specular lobe [SPEC §5]).
+  std::uint32_t lambertian(glm::vec3 albedo, glm::vec3 emission = glm::vec3(0.0f), bool doubleSided = false);
+  std::uint32_t glossy(glm::vec3 baseColor, float metallic, float roughness);
+  // Quad corner, edge u, edge v: two triangles, front face = the side cross(u, v) points to.
+  void quad(glm::vec3 corner, glm::vec3 u, glm::vec3 v, std::uint32_t material, const std::string& group = "");
+  void pointLight(glm::vec3 position, glm::vec3 color, float intensity);
+  void directionalLight(glm::vec3 direction, glm::vec3 color, float intensity);
+  scene::Scene build();
+
+private:
+  scene::Scene scene_;
+};
+
+// A camera at `position` looking along `forward` with the given vertical field of view.
+scene::Camera lookCamera(glm::vec3 position, glm::vec3 forward, glm::vec3 up, float yfov);
+
+} // namespace obscura::test
