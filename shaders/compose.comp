@@ -12,6 +12,8 @@ layout(std430, binding = 1) readonly buffer Ambient { vec4 ambient[]; };  // rgb
 layout(std430, binding = 2) readonly buffer Aovs { vec4 aov[]; };         // primary AOV sums
 layout(std430, binding = 3) readonly buffer Scales { vec4 emission[]; };  // E_s per light
 layout(std430, binding = 4) writeonly buffer Out { vec4 composed[]; };    // kComposeSlots per pixel
+layout(std430, binding = 5) readonly buffer SpecularBasis { vec4 specularBasis[]; };
+layout(std430, binding = 6) readonly buffer SpecularAmbient { vec4 specularAmbient[]; };
 
 void main() {
   uint pixel = gl_GlobalInvocationID.x;
@@ -19,12 +21,17 @@ void main() {
   if (pixel >= pixelCount) return;
   float inv = 1.0 / float(max(pc.frame.z, 1u));
   vec3 direct = vec3(0.0);
-  for (uint s = 0u; s < pc.frame.w; ++s) direct += emission[s].rgb * basis[s * pixelCount + pixel].rgb;
+  vec3 specular = vec3(0.0);
+  const bool withSpecular = pc.ambient.w != 0.0;
+  for (uint s = 0u; s < pc.frame.w; ++s) {
+    direct += emission[s].rgb * basis[s * pixelCount + pixel].rgb;
+    if (withSpecular) specular += emission[s].rgb * specularBasis[s * pixelCount + pixel].rgb;
+  }
   direct *= inv;
+  if (withSpecular) specular = (specular + pc.ambient.rgb * specularAmbient[pixel].rgb) * inv;
   vec4 a = ambient[pixel] * inv;
   vec3 indirect = pc.ambient.rgb * a.rgb;
   vec3 emitted = aov[pixel * kAovSlots + kAovEmission].rgb * inv;
-  vec3 specular = vec3(0.0);
   uint o = pixel * kComposeSlots;
   composed[o + kComposeCombined] = vec4(direct + indirect + emitted + specular, 1.0);
   composed[o + kComposeDirect] = vec4(direct, 1.0);

@@ -1,6 +1,7 @@
 #include "render/obscurance_renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 
 #include "compose.spv.h"
@@ -9,7 +10,10 @@
 #include "obscurance.spv.h"
 #include "render/primary_pass.h"
 #include "render/scene_buffers.h"
+#include "render/bsdf.h"
 #include "shadow.spv.h"
+#include "specular.spv.h"
+#include "specular_queue.spv.h"
 
 namespace obscura::render {
 namespace {
@@ -24,7 +28,7 @@ gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_
 
 gpu::KernelDesc composeKernelDesc() {
   return {.name = "compose", .spirv = kSpirv_compose,
-          .bindings = std::vector<gpu::BindingKind>(5, gpu::BindingKind::StorageBuffer),
+          .bindings = std::vector<gpu::BindingKind>(7, gpu::BindingKind::StorageBuffer),
           .pushConstantBytes = sizeof(gpu::ComposePush)};
 }
 
@@ -35,6 +39,15 @@ gpu::Buffer uploadArray(const gpu::Context& context, const std::vector<T>& data,
   gpu::Buffer buffer(context, std::max<std::size_t>(data.size(), 1) * sizeof(T), Usage::eStorageBuffer, name);
   buffer.upload(context, data);
   return buffer;
+}
+
+// Whether any triangle has a glossy material: only then does the specular pass run.
+bool hasGlossy(const scene::Scene& scene) {
+  std::vector<bool> glossy;
+  for (const auto& m : scene.materials) glossy.push_back(isGlossy(m.metallic, m.roughness));
+  for (std::uint32_t m : scene.triangleMaterial)
+    if (glossy[m]) return true;
+  return false;
 }
 
 const std::vector<std::string> kComposeAovs = {"combined", "direct", "indirect", "specular", "obscurance"};
@@ -85,16 +98,31 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
   for (const auto& e : lights.emission) scales.emplace_back(e, 0.0f);
   gpu::Buffer scaleBuffer = uploadArray(context, scales, "compose.emission");
   gpu::Buffer composed(context, pixels * gpu::kComposeSlots * 16, Usage::eStorageBuffer, "compose.output");
+  // The specular buffers exist in full only when a glossy material does (a pass the scene does
+  // not need is not dispatched, and needs no memory).
+  const bool runSpecular = hasGlossy(scene) && settings.maxDepth > 1;
+  const std::uint64_t specularPixels = runSpecular ? pixels : 1;
+  gpu::Buffer specularBasis(context, std::max<std::uint64_t>(lightCount, 1) * specularPixels * 16,
+                            Usage::eStorageBuffer, "specular.basis");
+  gpu::Buffer specularAmbient(context, specularPixels * 16, Usage::eStorageBuffer, "specular.ambient");
+  gpu::Buffer queue(context, (gpu::kQueueHeader + specularPixels) * 4,
+                    Usage::eStorageBuffer | Usage::eIndirectBuffer, "specular.queue");
 
   gpu::Kernel shadow(context, shadingKernelDesc("shadow", kSpirv_shadow));
   gpu::Kernel obscurance(context, shadingKernelDesc("obscurance", kSpirv_obscurance));
-  for (gpu::Kernel* k : {&shadow, &obscurance}) {
+  gpu::Kernel specularQueue(context, shadingKernelDesc("specular.queue", kSpirv_specular_queue));
+  gpu::Kernel specular(context, shadingKernelDesc("specular", kSpirv_specular));
+  for (gpu::Kernel* k : {&shadow, &obscurance, &specularQueue, &specular}) {
     buffers.bindTo(*k);
     k->bind(gpu::kBindingGBuffer, primary.gbuffer());
     k->bind(gpu::kBindingLights, lightBuffer);
     k->bind(gpu::kBindingEmitters, emitterBuffer);
     k->bind(gpu::kBindingBasis, basis);
     k->bind(gpu::kBindingAmbient, ambient);
+    k->bind(gpu::kBindingSpecularBasis, specularBasis);
+    k->bind(gpu::kBindingSpecularAmbient, specularAmbient);
+    k->bind(gpu::kBindingSpecularQueue, queue);
+    k->bind(gpu::kBindingLightScales, scaleBuffer);
   }
   gpu::Kernel compose(context, composeKernelDesc());
   compose.bind(0, basis);
@@ -102,6 +130,8 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
   compose.bind(2, primary.aovs());
   compose.bind(3, scaleBuffer);
   compose.bind(4, composed);
+  compose.bind(5, specularBasis);
+  compose.bind(6, specularAmbient);
 
   const bool runShadow = lights.anySampled() && settings.shadowRays > 0;
   const bool runObscurance = settings.obscuranceRays > 0;
@@ -109,7 +139,8 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
   std::uint32_t flags = (settings.systematic ? gpu::kFlagSystematic : 0u) | (settings.colourBleeding ? gpu::kFlagBleed : 0u);
   gpu::ShadePush push{.frame = glm::uvec4(settings.width, settings.height, 0u, settings.seed),
                       .counts = glm::uvec4(lightCount, settings.shadowRays, settings.obscuranceRays, flags),
-                      .params = glm::vec4(result.dMax, settings.tau, static_cast<float>(settings.rho), 0.0f),
+                      .params = glm::vec4(result.dMax, settings.tau, static_cast<float>(settings.rho),
+                                          static_cast<float>(settings.maxDepth)),
                       .rAve = glm::vec4(result.ambient.averageReflectance, 0.0f),
                       .eye = glm::vec4(settings.camera.position, 0.0f)};
   const std::uint32_t groupsX = gpu::groupsFor(settings.width, gpu::kWorkgroupSizeX);
@@ -119,7 +150,10 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
   context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
     cmd.fillBuffer(basis.handle(), 0, VK_WHOLE_SIZE, 0u);
     cmd.fillBuffer(ambient.handle(), 0, VK_WHOLE_SIZE, 0u);
+    cmd.fillBuffer(specularBasis.handle(), 0, VK_WHOLE_SIZE, 0u);
+    cmd.fillBuffer(specularAmbient.handle(), 0, VK_WHOLE_SIZE, 0u);
   });
+  const std::array<std::uint32_t, gpu::kQueueHeader> emptyQueue = {0u, 1u, 1u, 0u};
   for (std::uint32_t s = 0; s < settings.spp; ++s) {
     push.frame.z = s;
     context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
@@ -138,13 +172,22 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
         obscurance.dispatch(cmd, groupsX, groupsY, 1, &push);
         timestamps.end(cmd, "obscurance");
       }
+      if (runSpecular) {
+        timestamps.begin(cmd, "specular");
+        cmd.updateBuffer<std::uint32_t>(queue.handle(), 0, emptyQueue);
+        gpu::computeBarrier(cmd);
+        specularQueue.dispatch(cmd, groupsX, groupsY, 1, &push);
+        gpu::computeBarrier(cmd);
+        specular.dispatchIndirect(cmd, queue, 0, &push);
+        timestamps.end(cmd, "specular");
+      }
     });
     timestamps.collect();
     if (progress)
       progress(s + 1, settings.spp, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   gpu::ComposePush composePush{.frame = glm::uvec4(settings.width, settings.height, settings.spp, lightCount),
-                               .ambient = glm::vec4(result.ambientIntensity, 0.0f)};
+                               .ambient = glm::vec4(result.ambientIntensity, runSpecular ? 1.0f : 0.0f)};
   context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
     timestamps.reset(cmd);
     timestamps.begin(cmd, "compose");
@@ -163,6 +206,7 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
   pass("primary", pixels * settings.spp);
   pass("shadow", status[gpu::kStatusShadowRays]);
   pass("obscurance", status[gpu::kStatusObscuranceRays]);
+  pass("specular", status[gpu::kStatusSpecularRays]);
   pass("compose", 0);
   st.deviceBytes = buffers.bytes() + obscuranceBytesNeeded(settings.width, settings.height, lights.size());
 

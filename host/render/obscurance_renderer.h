@@ -3,6 +3,8 @@
 //
 //   primary.comp -> G-buffer -> shadow.comp     -> D_s  (one basis buffer per light, unit E_s)
 //                            -> obscurance.comp -> A, W
+//                            -> specular_queue.comp -> glossy pixels -> specular.comp (indirect
+//                               dispatch): specular paths, D_s and A gathered at their vertices
 //   after the last iteration: compose.comp  C = sum_s E_s D_s + I_a(E) A + emission [SPEC §3]
 //
 // A pass the scene does not need is not dispatched (no light with power: no shadow pass).
@@ -36,6 +38,7 @@ struct ObscuranceSettings {
   float dMax = 0.0f;                 // 0 = a quarter of the largest bounding-box extent [SPEC §1.3]
   bool systematic = true;            // [RTO §4.2]
   bool colourBleeding = true;        // W_c [RTO eq. 6]; false: grey W [RTO eq. 2]
+  std::uint32_t maxDepth = 6;        // specular paths: scattering vertices, the primary hit is 1
 };
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.

@@ -1,4 +1,4 @@
-// shading_bindings.glsl — bindings 6..10 shared by the shading passes (shadow, obscurance,
+// shading_bindings.glsl — bindings 6..14 shared by the shading passes (shadow, obscurance,
 // specular): the G-buffer, the lights and the accumulation buffers [SPEC §3].
 #ifndef OBSCURA_SHADING_BINDINGS_GLSL
 #define OBSCURA_SHADING_BINDINGS_GLSL
@@ -10,6 +10,13 @@ layout(std430, set = 0, binding = kBindingEmitters) readonly buffer EmitterBuffe
 layout(std430, set = 0, binding = kBindingBasis) buffer BasisBuffer { vec4 basis[]; };
 // ambient[pixel].rgb += R(P) W_c (or R(P) W), .w += W, summed over samples.
 layout(std430, set = 0, binding = kBindingAmbient) buffer AmbientBuffer { vec4 ambient[]; };
+
+// The same two along specular paths (specular.comp), kept apart for the "specular" AOV.
+layout(std430, set = 0, binding = kBindingSpecularBasis) buffer SpecularBasisBuffer { vec4 specularBasis[]; };
+layout(std430, set = 0, binding = kBindingSpecularAmbient) buffer SpecularAmbientBuffer { vec4 specularAmbient[]; };
+// queue[0..3] = indirect dispatch groups (x, y, z) and the entry count; pixel indices follow.
+layout(std430, set = 0, binding = kBindingSpecularQueue) buffer SpecularQueue { uint queue[]; };
+layout(std430, set = 0, binding = kBindingLightScales) readonly buffer LightScales { vec4 lightScales[]; };
 
 layout(push_constant) uniform Push { ShadePush pc; };
 

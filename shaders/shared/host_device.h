@@ -191,7 +191,7 @@ OBS_CONST uint kRhoAo = 2u;          // rho(d) = 0 below dmax (ambient occlusion
 struct ShadePush {
   uvec4 frame;  // 0:  width, height, sample index, seed
   uvec4 counts; // 16: light count, shadow rays per hit, obscurance rays per hit, flags
-  vec4 params;  // 32: dMax, tau, rho kind (as float), unused
+  vec4 params;  // 32: dMax, tau, rho kind (as float), maximum path depth (as float)
   vec4 rAve;    // 48: R_ave rgb (the reflectance of a miss within dmax, SPEC §1.2), w = unused
   vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = unused
 };              // 80 bytes
@@ -202,7 +202,16 @@ OBS_CONST uint kBindingLights = 7;    // GpuLight[lights]
 OBS_CONST uint kBindingEmitters = 8;  // GpuEmitter[]
 OBS_CONST uint kBindingBasis = 9;     // vec4[lights * pixels]: sums of D_s (unit emission)
 OBS_CONST uint kBindingAmbient = 10;  // vec4[pixels]: rgb sums of A = R(P) W_c (or R(P) W), w = W
-OBS_CONST uint kShadingBindingCount = 11;
+OBS_CONST uint kBindingSpecularBasis = 11;   // vec4[lights * pixels]: D_s gathered along specular paths
+OBS_CONST uint kBindingSpecularAmbient = 12; // vec4[pixels]: A gathered along specular paths
+OBS_CONST uint kBindingSpecularQueue = 13;   // uint[]: kQueueHeader words, then glossy pixel indices
+OBS_CONST uint kBindingLightScales = 14;     // vec4[lights]: E_s (to make seen emission unit)
+OBS_CONST uint kShadingBindingCount = 15;
+
+// Header of the specular queue: an indirect dispatch (groups x, y, z) and the entry count.
+OBS_CONST uint kQueueGroupsX = 0;
+OBS_CONST uint kQueueCount = 3;
+OBS_CONST uint kQueueHeader = 4;
 
 // ---- compose.comp: per pixel, AOV slots written (averaged over samples).
 OBS_CONST uint kComposeCombined = 0;   // C = sum_s E_s D_s + I_a A + emission (+ specular)
@@ -214,7 +223,7 @@ OBS_CONST uint kComposeSlots = 5;
 
 struct ComposePush {
   uvec4 frame;     // 0:  width, height, samples accumulated, light count
-  vec4 ambient;    // 16: I_a(E) rgb, w = unused
+  vec4 ambient;    // 16: I_a(E) rgb, w = 1 when the specular buffers hold data
 };                 // 32 bytes
 
 // ---- Per-pixel AOV accumulation of primary.comp: kAovSlots vec4 per pixel, summed over samples

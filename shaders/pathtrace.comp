@@ -1,0 +1,207 @@
+#version 460
+// pathtrace.comp — the reference: unbiased path tracing [RTO §5.1, SPEC §1.5], one path per pixel
+// per dispatch (dispatch i = sample i), added to a per-pixel radiance sum.
+//
+// The same scene bindings, traversal, intersection, surface, material, BSDF, light-sampling and
+// shadow-ray code as the obscurance passes (lib/*.glsl), so the two methods differ only in the
+// light transport they estimate. At each scattering vertex of the path:
+//   * emission seen along the ray that reached it (one-sided unless doubleSided, SPEC §5);
+//   * next-event estimation: one light by power, a point uniform by area on it (lights.glsl
+//     sampleLight), a shadow ray (shade.glsl directLightSample, unchanged);
+//   * one BSDF sample (bsdf.glsl sampleBsdf) continues the path;
+// area-light contributions reached by both techniques are combined with the power heuristic
+// (Veach & Guibas 1995, lib/mis.glsl); punctual lights (light sampling only) and emitters seen
+// through a mirror's delta lobe or by the camera (BSDF sampling only) count fully.
+//
+// Depth [SPEC §5]: d = maxDepth counts scattering vertices, like pbrt's maxdepth: d = 1 is
+// camera -> surface -> light (direct light only); a furnace of albedo a gives
+// L_e (1 - a^(d+1)) / (1 - a).
+//
+// Russian roulette (Pharr, Jakob & Humphreys, "Physically Based Rendering", 3rd ed., §13.7 /
+// 4th ed. §14.1.5): once a path has rrDepth scattering vertices, it continues past each further
+// vertex with probability q = min(max component of the throughput, kRrMaxSurvival) and the
+// throughput is divided by q, which keeps the estimator unbiased. OURS: the cap 0.95 so that even
+// a white furnace ends its paths (expected 20 extra vertices); it never lowers q below the
+// throughput, so a path whose throughput is 1 after division is not rouletted harder.
+//
+// The loop limiter (docs/ARCHITECTURE.md, lavapipe): ONE StepBudget per invocation is shared by
+// every traversal of the path (camera, shadow and bounce rays). A truncated traversal ends the
+// path where it is (the sample keeps what it gathered so far) and the invocation counts once in
+// status[kStatusTruncated], which the host reports and the commands refuse.
+//
+// Non-finite guard: a sample whose radiance has a NaN or inf component is dropped (adds 0) and
+// counted in the .w of its pixel's sum; the host sums those counts (PathTraceResult). The divisor
+// stays spp, as pbrt does when it zeroes such samples.
+#extension GL_GOOGLE_include_directive : require
+#include "shared/host_device.h"
+
+// ---- TODO(lead): move to shared/host_device.h, then delete this block (and the twin in
+// host/render/path_tracer.cpp, which static_asserts the same layout).
+// Push constants of pathtrace.comp (96 bytes <= 128).
+struct PathPush {
+  GpuCamera camera; // 0
+  uvec4 frame;      // 64: width, height, sample index, seed
+  uvec4 params;     // 80: light count (0 = no light with power), max depth d, RR depth, strategy
+};
+const uint kPathStrategyMis = 0u;       // MIS of light and BSDF sampling (the reference)
+const uint kPathStrategyLightOnly = 1u; // area lights by light sampling only (tests)
+const uint kPathStrategyBsdfOnly = 2u;  // area lights by BSDF sampling only (tests)
+const uint kBindingPathRadiance = 6u;   // = kBindingPassFirst: vec4[pixels] rgb sums, w = dropped
+const uint kBindingPathLights = 7u;     // = kBindingLights: GpuLight[]
+const uint kBindingPathEmitters = 8u;   // = kBindingEmitters: GpuEmitter[]
+const uint kBindingPathScales = 9u;     // vec4[lights]: E_s, each light's emission scale
+// ---- end of TODO(lead)
+
+#include "lib/scene_bindings.glsl"
+
+layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
+layout(push_constant) uniform Push { PathPush pc; };
+layout(std430, set = 0, binding = kBindingPathRadiance) buffer RadianceBuffer { vec4 radiance[]; };
+layout(std430, set = 0, binding = kBindingPathLights) readonly buffer LightBuffer { GpuLight lights[]; };
+layout(std430, set = 0, binding = kBindingPathEmitters) readonly buffer EmitterBuffer { GpuEmitter emitters[]; };
+layout(std430, set = 0, binding = kBindingPathScales) readonly buffer ScaleBuffer { vec4 emissionScale[]; };
+
+#include "lib/intersect.glsl"
+#include "lib/bvh.glsl"
+#include "lib/surface.glsl"
+#include "lib/material.glsl"
+#include "lib/ray.glsl"
+#include "lib/rng.glsl"
+#include "lib/camera.glsl"
+#include "lib/sampling.glsl"
+#include "lib/bsdf.glsl"
+#include "lib/lights.glsl"
+#include "lib/shade.glsl"
+#include "lib/mis.glsl"
+
+// OURS: the largest survival probability of Russian roulette (see the header).
+const float kRrMaxSurvival = 0.95;
+
+// Exponent all ones: inf or NaN, tested on the bits so no fast-math assumption can remove it.
+bool nonFinite(vec3 v) {
+  uvec3 e = (floatBitsToUint(v) >> 23u) & 0xFFu;
+  return any(equal(e, uvec3(0xFFu)));
+}
+
+float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
+
+void main() {
+  uvec2 size = pc.frame.xy;
+  uvec2 p = gl_GlobalInvocationID.xy;
+  if (p.x >= size.x || p.y >= size.y) return;
+  uint pixel = p.y * size.x + p.x;
+  const uint lightCount = pc.params.x;
+  const uint maxDepth = pc.params.y;
+  const uint rrDepth = pc.params.z;
+  const uint strategy = pc.params.w;
+
+  // The camera ray exactly as primary.comp makes it: the same per-pixel shift of the same R2
+  // sub-pixel sequence, so sample i of both renderers goes through the same point of the pixel.
+  uint rng = rngSeed(p, 0u, pc.frame.w);
+  vec2 shift = vec2(rngNext(rng), rngNext(rng));
+  vec2 position = vec2(p) + pixelSampleOffset(pc.frame.z, shift);
+  vec3 origin = pc.camera.origin.xyz;
+  vec3 direction = cameraRayDirection(pc.camera, position, vec2(size));
+  // The path's own stream (a constant of ours keeps it apart from the shading passes' streams).
+  rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu);
+
+  StepBudget budget = newStepBudget();
+  uint rays = 1u;
+  RayHit hit = traceWithBudget(budget, origin, direction, 0.0, 1.0 / 0.0, false);
+
+  vec3 L = vec3(0.0);
+  vec3 beta = vec3(1.0);        // path throughput: f cos / pdf products (and 1/q of roulette)
+  bool specularBounce = true;   // the ray came from the camera or a mirror's delta lobe
+  float bsdfPdfPrev = 0.0;      // solid-angle pdf of the BSDF sample that made the ray
+  vec3 previous = origin;       // the vertex the ray left from
+
+  // Vertex `depth` (1 = the camera ray's hit): its emission ends a path of depth - 1 scattering
+  // vertices, its scattering (light sample, BSDF sample) makes depth of them.
+  for (uint depth = 1u; depth <= maxDepth + 1u; ++depth) {
+    if (hit.primitive == kInvalidIndex || !rayHitValid(hit)) break; // miss (black) or truncated
+    Surface s = surfaceAt(hit, origin, direction);
+    GpuMaterial m = materials[s.material];
+
+    // ---- Emission seen along the ray [SPEC §5: one-sided unless doubleSided].
+    vec3 emitted = materialEmission(m, s.uv, s.frontFacing);
+    if (any(greaterThan(emitted, vec3(0.0)))) {
+      float w = 1.0;
+      if (!specularBounce && s.lightGroup < lightCount && strategy != kPathStrategyBsdfOnly) {
+        // This point could also have come from sampleLight at the previous vertex [MIS].
+        vec3 d = s.position - previous;
+        float lightPdf = areaLightPdf(s.lightGroup, dot(d, d), abs(dot(s.geometricNormal, direction)));
+        w = strategy == kPathStrategyLightOnly ? (lightPdf > 0.0 ? 0.0 : 1.0)
+                                               : powerHeuristic(bsdfPdfPrev, lightPdf);
+      }
+      L += beta * w * emitted;
+    }
+    if (depth > maxDepth) break;
+
+    // ---- The shading point. Reflection is two-sided [SPEC §5]: the shading normal is turned to
+    // the side of wo, so wo lies in the upper hemisphere of the BSDF's local frame (the geometric
+    // normal already faces the ray, surface.glsl).
+    vec3 wo = -direction;
+    vec3 ns = dot(s.shadingNormal, wo) < 0.0 ? -s.shadingNormal : s.shadingNormal;
+    vec3 baseColor = materialBaseColor(m, s.uv).rgb;
+    ShadingPoint sp = shadingPoint(s.position, s.geometricNormal, ns, wo, baseColor, s.material);
+    vec3 t, b;
+    orthonormalBasis(sp.ns, t, b);
+    vec3 woLocal = vec3(dot(wo, t), dot(wo, b), dot(wo, sp.ns));
+
+    // ---- Next-event estimation: one light sample, one shadow ray.
+    vec4 uLight = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
+    if (lightCount > 0u) {
+      // sampleLight is deterministic in (p, u): this is the sample directLightSample draws below;
+      // drawing it first gives its pdf for the MIS weight and skips shadow rays of weight 0.
+      LightSample ls = sampleLight(sp.position, uLight, lightCount);
+      bool area = lights[ls.light].info.x == kLightArea;
+      float w = 1.0;
+      if (area && strategy == kPathStrategyBsdfOnly) {
+        w = 0.0;
+      } else if (area && strategy == kPathStrategyMis) {
+        vec3 wiLocal = vec3(dot(ls.wi, t), dot(ls.wi, b), dot(ls.wi, sp.ns));
+        w = powerHeuristic(ls.pdf, bsdfPdf(sp.baseColor, sp.metallic, sp.roughness, woLocal, wiLocal));
+      }
+      if (w > 0.0 && any(greaterThan(ls.weight, vec3(0.0)))) {
+        vec3 contribution; // unit emission; x E_s below
+        uint light;
+        uint stepsLeft = budget.left;
+        directLightSample(sp, uLight, lightCount, budget, contribution, light);
+        if (budget.left != stepsLeft) rays++; // it traced (a traversal takes at least one step)
+        L += beta * w * emissionScale[light].rgb * contribution;
+      }
+      if (budget.truncated) break;
+    }
+
+    // ---- BSDF sampling continues the path.
+    vec3 uBsdf = vec3(rngNext(rng), rngNext(rng), rngNext(rng));
+    float uRr = rngNext(rng);
+    vec3 wiLocal;
+    float pdf;
+    bool delta;
+    vec3 weight = sampleBsdf(sp.baseColor, sp.metallic, sp.roughness, woLocal, uBsdf, wiLocal, pdf, delta);
+    if (pdf <= 0.0) break;
+    vec3 wi = toWorld(wiLocal, t, b, sp.ns);
+    if (dot(wi, sp.ng) <= 0.0) break; // below the geometric surface: no light reflects that way
+    beta *= weight;
+    if (depth >= rrDepth) {
+      float q = min(maxComponent(beta), kRrMaxSurvival);
+      if (!(uRr < q)) break;
+      beta /= q;
+    }
+    specularBounce = delta;
+    bsdfPdfPrev = pdf;
+    previous = s.position;
+    origin = offsetRayOrigin(s.position, sp.ng);
+    direction = wi;
+    hit = traceWithBudget(budget, origin, direction, 0.0, 1.0 / 0.0, false);
+    rays++;
+  }
+
+  vec4 sum = radiance[pixel];
+  if (nonFinite(L)) sum.w += 1.0; // dropped and counted (see the header)
+  else sum.rgb += L;
+  radiance[pixel] = sum;
+  atomicAdd(status[kStatusPathRays], rays);
+  if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
+}

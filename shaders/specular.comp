@@ -1,0 +1,100 @@
+#version 460
+// specular.comp — specular paths from the glossy primary hits in the queue [RTO §4.1 step 4]:
+// follow the specular lobe up to the maximum depth (6, SPEC §1.3); at every vertex reached,
+// gather direct light and obscurance as at P, weighted by the path throughput, into the
+// specular basis buffers (still linear in every E_s [SPEC §3]).
+//
+// The primary hit's own direct light (full BSDF) and obscurance (diffuse part) come from
+// shadow.comp and obscurance.comp; this pass adds what arrives through the specular lobe.
+// Emitters seen through the lobe count only after a mirror (delta) bounce: for a glossy lobe the
+// shadow rays already sample that light (no MIS here, so counting both would double it).
+#extension GL_GOOGLE_include_directive : require
+#include "shared/host_device.h"
+#include "lib/scene_bindings.glsl"
+#include "lib/shading_bindings.glsl"
+#include "lib/intersect.glsl"
+#include "lib/bvh.glsl"
+#include "lib/surface.glsl"
+#include "lib/material.glsl"
+#include "lib/ray.glsl"
+#include "lib/rng.glsl"
+#include "lib/sampling.glsl"
+#include "lib/bsdf.glsl"
+#include "lib/lights.glsl"
+#include "lib/shade.glsl"
+#include "lib/obscurance.glsl"
+
+layout(local_size_x = kWorkgroupSize1D) in;
+
+// One sample of the specular lobe alone, in the local frame (z = shading normal): GGX visible
+// normals (Heitz 2018), whose weight f cos / pdf is F G2 / G1; a mirror below kMirrorRoughness.
+bool sampleSpecularLobe(ShadingPoint sp, vec3 wo, vec2 u, out vec3 wi, out vec3 weight, out bool delta) {
+  vec3 f0 = mix(vec3(kDielectricF0), sp.baseColor, sp.metallic);
+  delta = isMirror(sp.roughness);
+  vec3 h = vec3(0.0, 0.0, 1.0);
+  float alpha = ggxAlpha(sp.roughness);
+  if (!delta) h = sampleGgxVisibleNormal(wo, alpha, u);
+  wi = reflect(-wo, h);
+  float cosOH = max(dot(wo, h), 0.0);
+  vec3 fresnel = fresnelSchlick(f0, cosOH);
+  if (wi.z <= 0.0) { weight = vec3(0.0); return false; }
+  weight = delta ? fresnel : fresnel * (smithG2(wo.z, wi.z, alpha) / smithG1(wo.z, alpha));
+  return true;
+}
+
+void main() {
+  uint entry = gl_GlobalInvocationID.x;
+  if (entry >= queue[kQueueCount]) return;
+  uint pixel = queue[kQueueHeader + entry];
+  uvec2 size = pc.frame.xy;
+  uvec2 p = uvec2(pixel % size.x, pixel / size.x);
+  uint pixelCount = size.x * size.y;
+  const uint lightCount = pc.counts.x;
+  const uint shadowRays = lightCount > 0u ? pc.counts.y : 0u;
+  const uint maxDepth = uint(pc.params.w);
+
+  ShadingPoint sp = shadingPointFromGBuffer(gbuffer[pixel], pc.eye.xyz);
+  uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu);
+  StepBudget budget = newStepBudget();
+  vec3 throughput = vec3(1.0);
+  uint rays = 0u;
+  for (uint depth = 1u; depth < maxDepth && sp.glossy; ++depth) {
+    vec3 t, b;
+    orthonormalBasis(sp.ns, t, b);
+    vec3 wo = vec3(dot(sp.wo, t), dot(sp.wo, b), dot(sp.wo, sp.ns));
+    vec3 wiLocal, weight;
+    bool delta;
+    if (wo.z <= 0.0 || !sampleSpecularLobe(sp, wo, vec2(rngNext(rng), rngNext(rng)), wiLocal, weight, delta)) break;
+    vec3 wi = toWorld(wiLocal, t, b, sp.ns);
+    if (dot(wi, sp.ng) <= 0.0) break; // below the geometric surface: no leaks
+    throughput *= weight;
+    if (all(equal(throughput, vec3(0.0)))) break;
+    vec3 origin = offsetRayOrigin(sp.position, sp.ng);
+    RayHit h = traceWithBudget(budget, origin, wi, 0.0, 1.0 / 0.0, false);
+    ++rays;
+    if (!rayHitValid(h) || h.primitive == kInvalidIndex) break;
+    Surface s = surfaceAt(h, origin, wi);
+    GpuMaterial m = materials[s.material];
+    vec3 baseColor = materialBaseColor(m, s.uv).rgb;
+    if (delta && s.lightGroup != kInvalidIndex) {
+      // Seen emission in unit-emission terms: divided by the group's E_s (1 where E_s is 0).
+      vec3 scale = lightScales[s.lightGroup].rgb;
+      vec3 unit = materialEmission(m, s.uv, s.frontFacing) / mix(scale, vec3(1.0), equal(scale, vec3(0.0)));
+      specularBasis[s.lightGroup * pixelCount + pixel] += vec4(throughput * unit, 0.0);
+    }
+    sp = shadingPoint(s.position, s.geometricNormal, s.shadingNormal, -wi, baseColor, s.material);
+    // Gather as at P [RTO §4.1 step 4]: direct light, then obscurance.
+    for (uint k = 0u; k < shadowRays; ++k) {
+      vec4 u = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
+      vec3 contribution;
+      uint light;
+      directLightSample(sp, u, lightCount, budget, contribution, light);
+      specularBasis[light * pixelCount + pixel] += vec4(throughput * contribution / float(shadowRays), 0.0);
+    }
+    vec4 aw = gatherObscurance(sp, rng, budget);
+    specularAmbient[pixel] += vec4(throughput * aw.rgb, 0.0);
+    rays += shadowRays + pc.counts.z;
+  }
+  atomicAdd(status[kStatusSpecularRays], rays);
+  if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
+}

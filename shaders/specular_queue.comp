@@ -1,0 +1,22 @@
+#version 460
+// specular_queue.comp — compacts the pixels whose primary hit is glossy into a queue and sizes
+// the indirect dispatch of specular.comp, so only those pixels pay for specular paths
+// [RTO §4.1 step 4]. The host resets the header to (0, 1, 1, 0) before each iteration.
+#extension GL_GOOGLE_include_directive : require
+#include "shared/host_device.h"
+#include "lib/scene_bindings.glsl"
+#include "lib/shading_bindings.glsl"
+
+layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
+
+void main() {
+  uvec2 size = pc.frame.xy;
+  uvec2 p = gl_GlobalInvocationID.xy;
+  if (p.x >= size.x || p.y >= size.y) return;
+  uint pixel = p.y * size.x + p.x;
+  GBufferTexel g = gbuffer[pixel];
+  if (g.albedo.a == 0.0 || materials[floatBitsToUint(g.shadingNormal.w)].params.w == 0.0) return;
+  uint slot = atomicAdd(queue[kQueueCount], 1u);
+  queue[kQueueHeader + slot] = pixel;
+  atomicMax(queue[kQueueGroupsX], slot / kWorkgroupSize1D + 1u);
+}
