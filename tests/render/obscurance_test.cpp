@@ -172,6 +172,28 @@ TEST_F(Obscurance, SquareAreaLightMatchesTheFormFactor) {
   EXPECT_NEAR(mean(r.image, "direct.G"), albedo * formFactor, 0.01 * albedo * formFactor);
 }
 
+TEST_F(Obscurance, MirrorReflectsAnEmitterExactly) {
+  // A perfect mirror floor (metallic 1, roughness 0, white: F = 1) under an emitter of radiance
+  // (2, 1, 0.5) facing it: the camera sees the emitter through one delta bounce, so the specular
+  // AOV, and the whole image, is that radiance. The mirror has no diffuse part, so neither
+  // shadow rays nor obscurance add anything at the primary hit.
+  SceneBuilder b;
+  auto mirror = b.glossy(glm::vec3(1.0f), 1.0f, 0.0f);
+  auto emitter = b.lambertian(glm::vec3(0.0f), glm::vec3(2.0f, 1.0f, 0.5f));
+  b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, mirror);
+  b.quad({-kHalfSize, 2, -kHalfSize}, {2 * kHalfSize, 0, 0}, {0, 0, 2 * kHalfSize}, emitter, "sky"); // faces -y
+  scene::Scene s = b.build();
+  auto settings = lookDown(1.0f, 0.8f, 16, 2);
+  auto r = render(s, settings);
+  ASSERT_TRUE(r.stats.passes.contains("specular"));
+  for (const char* channel : {"specular.R", "combined.R"})
+    EXPECT_NEAR(mean(r.image, channel), 2.0, 1e-4) << channel;
+  EXPECT_NEAR(mean(r.image, "specular.G"), 1.0, 1e-4);
+  EXPECT_NEAR(mean(r.image, "specular.B"), 0.5, 1e-4);
+  EXPECT_NEAR(mean(r.image, "direct.R"), 0.0, 1e-6);
+  EXPECT_NEAR(mean(r.image, "indirect.R"), 0.0, 1e-6);
+}
+
 TEST_F(Obscurance, SameSeedSameImageNoNaNAndOnlyNeededPasses) {
   scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
   render::ObscuranceSettings settings;
@@ -182,6 +204,7 @@ TEST_F(Obscurance, SameSeedSameImageNoNaNAndOnlyNeededPasses) {
   ASSERT_EQ(a.image.pixels.size(), b2.image.pixels.size());
   for (std::size_t i = 0; i < a.image.pixels.size(); ++i) ASSERT_EQ(a.image.pixels[i], b2.image.pixels[i]) << i;
   EXPECT_TRUE(a.stats.passes.contains("shadow"));
+  EXPECT_FALSE(a.stats.passes.contains("specular")); // the Cornell box is all Lambertian
   EXPECT_GT(a.stats.passes.at("shadow").rays, 0u);
   // A scene without lights: no shadow pass at all, and obscurance still renders.
   scene::Scene dark = floorScene();
