@@ -7,6 +7,7 @@ packages=(
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libopenimageio-dev
   libcli11-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev
+  python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do

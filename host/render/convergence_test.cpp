@@ -1,0 +1,34 @@
+#include "render/convergence.h"
+
+#include <gtest/gtest.h>
+
+namespace obscura::render {
+namespace {
+
+Curve monteCarloCurve() {
+  // RMSE = 1 / sqrt(t): an unbiased estimator.
+  Curve c{.method = "pt", .points = {}};
+  for (double t : {1.0, 4.0, 16.0, 64.0})
+    c.points.push_back({.spp = 1, .raysPerPixel = 1, .gpuMs = t, .rmseNoise = 1.0 / std::sqrt(t),
+                        .relMseNoise = 0, .rmseReference = 1.0 / std::sqrt(t), .relMseReference = 0});
+  return c;
+}
+
+TEST(Convergence, InterpolatesInLogLog) {
+  TimeAt t = timeToReach(monteCarloCurve(), 1.0 / std::sqrt(8.0), ErrorKind::Noise);
+  ASSERT_TRUE(t.valid);
+  EXPECT_FALSE(t.extrapolated);
+  EXPECT_NEAR(t.ms, 8.0, 1e-9);
+}
+
+TEST(Convergence, ExtrapolatesAtTheMonteCarloRate) {
+  TimeAt t = timeToReach(monteCarloCurve(), 1.0 / 32.0, ErrorKind::AgainstReference);
+  ASSERT_TRUE(t.valid);
+  EXPECT_TRUE(t.extrapolated);
+  EXPECT_NEAR(t.ms, 1024.0, 1e-6);
+  EXPECT_NEAR(timeToReach(monteCarloCurve(), 2.0, ErrorKind::Noise).ms, 1.0, 1e-12); // already there
+  EXPECT_FALSE(timeToReach(Curve{}, 1.0, ErrorKind::Noise).valid);
+}
+
+} // namespace
+} // namespace obscura::render
