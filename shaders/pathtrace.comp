@@ -17,12 +17,13 @@
 // camera -> surface -> light (direct light only); a furnace of albedo a gives
 // L_e (1 - a^(d+1)) / (1 - a).
 //
-// Russian roulette (Pharr, Jakob & Humphreys, "Physically Based Rendering", 3rd ed., §13.7 /
-// 4th ed. §14.1.5): once a path has rrDepth scattering vertices, it continues past each further
-// vertex with probability q = min(max component of the throughput, kRrMaxSurvival) and the
-// throughput is divided by q, which keeps the estimator unbiased. OURS: the cap 0.95 so that even
-// a white furnace ends its paths (expected 20 extra vertices); it never lowers q below the
-// throughput, so a path whose throughput is 1 after division is not rouletted harder.
+// Russian roulette (Pharr, Jakob & Humphreys, "Physically Based Rendering", 3rd ed., §13.7):
+// from the rrDepth-th scattering vertex on, the path continues past each vertex with probability
+// q = min(max component of the throughput, kRrMaxSurvival), and the throughput is divided by q,
+// which keeps the estimator unbiased (E[X/q · 1{survive}] = X). Paths that carry little light
+// end early; a surviving path's throughput is lifted back to about 1. OURS: the cap 0.95, so that
+// even a white furnace ends its paths (about 20 further vertices on average); rrDepth >= maxDepth
+// turns roulette off.
 //
 // The loop limiter (docs/ARCHITECTURE.md, lavapipe): ONE StepBudget per invocation is shared by
 // every traversal of the path (camera, shadow and bounce rays). A truncated traversal ends the
@@ -35,22 +36,6 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 
-// ---- TODO(lead): move to shared/host_device.h, then delete this block (and the twin in
-// host/render/path_tracer.cpp, which static_asserts the same layout).
-// Push constants of pathtrace.comp (96 bytes <= 128).
-struct PathPush {
-  GpuCamera camera; // 0
-  uvec4 frame;      // 64: width, height, sample index, seed
-  uvec4 params;     // 80: light count (0 = no light with power), max depth d, RR depth, strategy
-};
-const uint kPathStrategyMis = 0u;       // MIS of light and BSDF sampling (the reference)
-const uint kPathStrategyLightOnly = 1u; // area lights by light sampling only (tests)
-const uint kPathStrategyBsdfOnly = 2u;  // area lights by BSDF sampling only (tests)
-const uint kBindingPathRadiance = 6u;   // = kBindingPassFirst: vec4[pixels] rgb sums, w = dropped
-const uint kBindingPathLights = 7u;     // = kBindingLights: GpuLight[]
-const uint kBindingPathEmitters = 8u;   // = kBindingEmitters: GpuEmitter[]
-const uint kBindingPathScales = 9u;     // vec4[lights]: E_s, each light's emission scale
-// ---- end of TODO(lead)
 
 #include "lib/scene_bindings.glsl"
 

@@ -17,5 +17,6 @@ void addDeviceOptions(CLI::App& command, DeviceOptions& options);
 void addRenderCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addBenchRaysCommand(CLI::App& app);
+void addConvergeCommand(CLI::App& app);
 
 } // namespace obscura::app

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   obscura::app::addRenderCommand(app);
   obscura::app::addInfoCommand(app);
   obscura::app::addBenchRaysCommand(app);
+  obscura::app::addConvergeCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

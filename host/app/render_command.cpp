@@ -15,6 +15,7 @@
 #include "io/image_io.h"
 #include "render/aov_render.h"
 #include "render/obscurance_renderer.h"
+#include "render/path_tracer.h"
 
 namespace obscura::app {
 namespace {
@@ -103,11 +104,60 @@ void writeMetrics(const std::string& path, const nlohmann::json& json) {
   }
 }
 
+// Writes the image (EXR layers or PNG of one AOV) and the metrics; fails on truncated traversals.
+void writeOutputs(const RenderOptions& o, const io::Image& image, const render::RenderStats& stats,
+                  const gpu::Context& context, const LoadedScene& loaded, const nlohmann::json& method) {
+  for (const auto& note : stats.notes) fmt::print(stderr, "note: {}\n", note);
+  if (stats.truncatedTraversals > 0)
+    throw DeviceError(fmt::format("{} traversals ran out of steps (kMaxTraversalSteps); the image would be wrong",
+                                  stats.truncatedTraversals));
+
+  io::Image selected = selectAovs(image, o.aovs);
+  if (io::extensionOf(o.output) == "exr") {
+    io::writeExr(o.output, selected);
+  } else {
+    std::string first = o.aovs.empty() ? "combined" : o.aovs.front();
+    const auto channels = render::aovChannels(first);
+    io::writePng(o.output, image, image.channelIndex(channels.front()), o.exposure,
+                 static_cast<int>(channels.size()));
+  }
+
+  nlohmann::json passes = nlohmann::json::object();
+  double totalMs = 0.0;
+  std::uint64_t totalRays = 0;
+  for (const auto& [name, pass] : stats.passes) {
+    passes[name] = {{"gpu_ms", pass.gpuMs}, {"rays", pass.rays},
+                    {"mrays_per_s", pass.gpuMs > 0 ? static_cast<double>(pass.rays) / (pass.gpuMs * 1e3) : 0.0}};
+    totalMs += pass.gpuMs;
+    totalRays += pass.rays;
+  }
+  double mrays = totalMs > 0 ? static_cast<double>(totalRays) / (totalMs * 1e3) : 0.0;
+  fmt::print(stderr, "render: {}x{}, {} spp, {} rays in {:.1f} ms GPU ({:.2f} Mrays/s), {:.2f} s wall -> {}\n",
+             o.width, o.height, o.spp, totalRays, totalMs, mrays, stats.wallSeconds, o.output);
+  if (!o.metrics.empty()) {
+    nlohmann::json json = {
+        {"device", {{"name", context.info().name}, {"driver", context.info().driver},
+                    {"type", context.info().type}, {"api", context.info().apiVersion}}},
+        {"scene", sceneJson(loaded)},
+        {"image", {{"width", o.width}, {"height", o.height}, {"spp", o.spp}, {"seed", o.seed}, {"output", o.output}}},
+        {"passes", passes},
+        {"method", method},
+        {"gpu_ms", totalMs},
+        {"rays", totalRays},
+        {"mrays_per_s", mrays},
+        {"wall_s", stats.wallSeconds},
+        {"device_bytes", stats.deviceBytes},
+        {"truncated_traversals", stats.truncatedTraversals}};
+    writeMetrics(o.metrics, json);
+  }
+}
+
 void runRender(RenderOptions& o) {
   std::string ext = io::extensionOf(o.output);
   if (ext != "exr" && ext != "png")
     throw InputError(fmt::format("{}: the output must be .exr or .png", o.output));
-  const auto& known = render::obscuranceAovNames();
+  static const std::vector<std::string> pathAovs = {"combined"};
+  const auto& known = o.method == "pathtrace" ? pathAovs : render::obscuranceAovNames();
   for (const auto& aov : o.aovs)
     if (std::find(known.begin(), known.end(), aov) == known.end())
       throw InputError(fmt::format("--aov {}: unknown AOV (known: {})", aov, fmt::join(known, ", ")));
@@ -141,10 +191,17 @@ void runRender(RenderOptions& o) {
   const bool tty = ::isatty(STDERR_FILENO);
   const std::uint64_t raysPerSample = std::uint64_t(o.width) * o.height *
                                       (1 + settings.shadowRays + settings.obscuranceRays);
-  render::ObscuranceResult result = render::renderObscurances(
-      context, loaded.scene, loaded.bvh, settings,
+  const render::ProgressFn progress =
       tty ? render::ProgressFn([&](auto d, auto t, auto s) { printProgress(d, t, s, raysPerSample); })
-          : render::ProgressFn());
+          : render::ProgressFn();
+  if (o.method == "pathtrace") {
+    render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
+                                 .camera = camera, .maxDepth = settings.maxDepth};
+    render::PathTraceResult traced = render::renderPathTraced(context, loaded.scene, loaded.bvh, pt, progress);
+    writeOutputs(o, traced.image, traced.stats, context, loaded, {{"method", "pathtrace"}, {"max_depth", pt.maxDepth}});
+    return;
+  }
+  render::ObscuranceResult result = render::renderObscurances(context, loaded.scene, loaded.bvh, settings, progress);
   render::RenderStats& stats = result.stats;
   io::Image& image = result.image;
   const glm::vec3 ia = result.ambientIntensity, rAve = result.ambient.averageReflectance;
@@ -154,54 +211,12 @@ void runRender(RenderOptions& o) {
              ia.x, ia.y, ia.z, result.lights.size());
   if (result.ambient.reflectanceClamped)
     fmt::print(stderr, "note: the average reflectance reaches 1; it was clamped to 0.999 (I_a would be infinite)\n");
-  for (const auto& note : stats.notes) fmt::print(stderr, "note: {}\n", note);
-  if (stats.truncatedTraversals > 0)
-    throw DeviceError(fmt::format("{} traversals ran out of steps (kMaxTraversalSteps); the image would be wrong",
-                                  stats.truncatedTraversals));
-
-  io::Image selected = selectAovs(image, o.aovs);
-  if (ext == "exr") {
-    io::writeExr(o.output, selected);
-  } else {
-    std::string first = o.aovs.empty() ? "combined" : o.aovs.front();
-    const auto channels = render::aovChannels(first);
-    io::writePng(o.output, image, image.channelIndex(channels.front()), o.exposure,
-                 static_cast<int>(channels.size()));
-  }
-
-  nlohmann::json passes = nlohmann::json::object();
-  double totalMs = 0.0;
-  std::uint64_t totalRays = 0;
-  for (const auto& [name, pass] : stats.passes) {
-    passes[name] = {{"gpu_ms", pass.gpuMs}, {"rays", pass.rays},
-                    {"mrays_per_s", pass.gpuMs > 0 ? static_cast<double>(pass.rays) / (pass.gpuMs * 1e3) : 0.0}};
-    totalMs += pass.gpuMs;
-    totalRays += pass.rays;
-  }
-  double mrays = totalMs > 0 ? static_cast<double>(totalRays) / (totalMs * 1e3) : 0.0;
-  fmt::print(stderr, "render: {}x{}, {} spp, {} rays in {:.1f} ms GPU ({:.2f} Mrays/s), {:.2f} s wall -> {}\n",
-             o.width, o.height, o.spp, totalRays, totalMs, mrays, stats.wallSeconds, o.output);
-  if (!o.metrics.empty()) {
-    nlohmann::json json = {
-        {"device", {{"name", context.info().name}, {"driver", context.info().driver},
-                    {"type", context.info().type}, {"api", context.info().apiVersion}}},
-        {"scene", sceneJson(loaded)},
-        {"image", {{"width", o.width}, {"height", o.height}, {"spp", o.spp}, {"seed", o.seed}, {"output", o.output}}},
-        {"passes", passes},
-        {"obscurance",
-         {{"method", o.method}, {"dmax", result.dMax}, {"rho", o.rho}, {"tau", settings.tau},
-          {"sampling", o.sampling}, {"colour_bleeding", !o.noBleed},
-          {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
-          {"r_ave", {rAve.x, rAve.y, rAve.z}}, {"ambient_intensity", {ia.x, ia.y, ia.z}},
-          {"lights", result.lights.names}}},
-        {"gpu_ms", totalMs},
-        {"rays", totalRays},
-        {"mrays_per_s", mrays},
-        {"wall_s", stats.wallSeconds},
-        {"device_bytes", stats.deviceBytes},
-        {"truncated_traversals", stats.truncatedTraversals}};
-    writeMetrics(o.metrics, json);
-  }
+  writeOutputs(o, image, stats, context, loaded,
+               {{"method", o.method}, {"dmax", result.dMax}, {"rho", o.rho}, {"tau", settings.tau},
+                {"sampling", o.sampling}, {"colour_bleeding", !o.noBleed}, {"max_depth", settings.maxDepth},
+                {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
+                {"r_ave", {rAve.x, rAve.y, rAve.z}}, {"ambient_intensity", {ia.x, ia.y, ia.z}},
+                {"lights", result.lights.names}});
 }
 
 } // namespace
@@ -221,8 +236,11 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--aov", options->aovs, "AOV(s) to write; the first goes to PNG (default: all / preview)");
   cmd->add_option("--exposure", options->exposure, "PNG exposure in stops");
   cmd->add_option("--metrics", options->metrics, "write device, scene, BVH and per-pass figures as JSON");
-  cmd->add_option("--method", options->method, "obscurance (ray-traced obscurances)")
-      ->check(CLI::IsMember({"obscurance"}));
+  cmd->add_option("--method", options->method, "obscurance (ray-traced obscurances) or pathtrace (the reference)")
+      ->check(CLI::IsMember({"obscurance", "pathtrace"}));
+  cmd->add_option("--max-depth", options->obscurance.maxDepth,
+                  "path depth in scattering vertices (specular paths; path tracing), default 6")
+      ->check(CLI::Range(1u, 1024u));
   cmd->add_option("--shadow-rays", options->obscurance.shadowRays, "shadow rays per hit (N_s)")
       ->check(CLI::Range(0u, 1024u));
   cmd->add_option("--obs-rays", options->obscurance.obscuranceRays, "obscurance rays per hit (N_obs)")

@@ -4,6 +4,7 @@
 // with resizable BAR) uploads and readbacks are plain memcpy; otherwise they go through a
 // temporary staging buffer.
 #pragma once
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -71,6 +72,16 @@ private:
   Buffer buffer_;
   vk::raii::BufferView view_ = nullptr;
 };
+
+// A storage buffer holding `data`, at least one element long: Vulkan has no empty buffers, and
+// a scene without lights still binds its light buffers.
+template <typename T>
+Buffer uploadArray(const Context& context, const std::vector<T>& data, const std::string& name) {
+  Buffer buffer(context, std::max<std::size_t>(data.size(), 1) * sizeof(T), vk::BufferUsageFlagBits::eStorageBuffer,
+                name);
+  if (!data.empty()) buffer.upload(context, data);
+  return buffer;
+}
 
 // Bytes of device memory allocated through Buffer so far in this process (cumulative), for the
 // metrics.

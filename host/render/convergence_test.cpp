@@ -1,5 +1,7 @@
 #include "render/convergence.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 namespace obscura::render {

@@ -32,15 +32,6 @@ gpu::KernelDesc composeKernelDesc() {
           .pushConstantBytes = sizeof(gpu::ComposePush)};
 }
 
-// A buffer of at least one element: Vulkan has no empty buffers, and a scene without lights
-// still binds the light buffers.
-template <typename T>
-gpu::Buffer uploadArray(const gpu::Context& context, const std::vector<T>& data, const char* name) {
-  gpu::Buffer buffer(context, std::max<std::size_t>(data.size(), 1) * sizeof(T), Usage::eStorageBuffer, name);
-  buffer.upload(context, data);
-  return buffer;
-}
-
 // Whether any triangle has a glossy material: only then does the specular pass run.
 bool hasGlossy(const scene::Scene& scene) {
   std::vector<bool> glossy;
@@ -90,13 +81,13 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
   const std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
   const auto lightCount = static_cast<std::uint32_t>(lights.size());
 
-  gpu::Buffer lightBuffer = uploadArray(context, lights.lights, "shadow.lights");
-  gpu::Buffer emitterBuffer = uploadArray(context, lights.emitters, "shadow.emitters");
+  gpu::Buffer lightBuffer = gpu::uploadArray(context, lights.lights, "shadow.lights");
+  gpu::Buffer emitterBuffer = gpu::uploadArray(context, lights.emitters, "shadow.emitters");
   gpu::Buffer basis(context, std::max<std::uint64_t>(lightCount, 1) * pixels * 16, Usage::eStorageBuffer, "shadow.basis");
   gpu::Buffer ambient(context, pixels * 16, Usage::eStorageBuffer, "obscurance.ambient");
   std::vector<glm::vec4> scales;
   for (const auto& e : lights.emission) scales.emplace_back(e, 0.0f);
-  gpu::Buffer scaleBuffer = uploadArray(context, scales, "compose.emission");
+  gpu::Buffer scaleBuffer = gpu::uploadArray(context, scales, "compose.emission");
   gpu::Buffer composed(context, pixels * gpu::kComposeSlots * 16, Usage::eStorageBuffer, "compose.output");
   // The specular buffers exist in full only when a glossy material does (a pass the scene does
   // not need is not dispatched, and needs no memory).

@@ -213,6 +213,21 @@ OBS_CONST uint kQueueGroupsX = 0;
 OBS_CONST uint kQueueCount = 3;
 OBS_CONST uint kQueueHeader = 4;
 
+// ---- pathtrace.comp: push constants and its own bindings after the scene's (0..5).
+struct PathPush {
+  GpuCamera camera; // 0
+  uvec4 frame;      // 64: width, height, sample index, seed
+  uvec4 params;     // 80: light count (0 = no light with power), max depth d, RR depth, strategy
+};                  // 96 bytes
+OBS_CONST uint kPathStrategyMis = 0u;       // MIS of light and BSDF sampling (the reference)
+OBS_CONST uint kPathStrategyLightOnly = 1u; // area lights by light sampling only (tests)
+OBS_CONST uint kPathStrategyBsdfOnly = 2u;  // area lights by BSDF sampling only (tests)
+OBS_CONST uint kBindingPathRadiance = 6u;   // vec4[pixels]: rgb sums, w = dropped samples
+OBS_CONST uint kBindingPathLights = 7u;     // GpuLight[] (= kBindingLights)
+OBS_CONST uint kBindingPathEmitters = 8u;   // GpuEmitter[] (= kBindingEmitters)
+OBS_CONST uint kBindingPathScales = 9u;     // vec4[lights]: E_s, each light's emission scale
+OBS_CONST uint kPathBindingCount = 10u;
+
 // ---- compose.comp: per pixel, AOV slots written (averaged over samples).
 OBS_CONST uint kComposeCombined = 0;   // C = sum_s E_s D_s + I_a A + emission (+ specular)
 OBS_CONST uint kComposeDirect = 1;     // sum_s E_s D_s at the primary hit

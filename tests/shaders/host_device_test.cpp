@@ -27,6 +27,8 @@ static_assert(sizeof(GpuCamera) == 64);
 static_assert(sizeof(GBufferTexel) == 80 && offsetof(GBufferTexel, emission) == 64);
 static_assert(sizeof(PrimaryPush) == 80 && sizeof(PrimaryPush) <= 128);
 static_assert(sizeof(TracePush) == 16);
+static_assert(sizeof(PathPush) == 96 && offsetof(PathPush, params) == 80 && sizeof(PathPush) <= 128);
+static_assert(sizeof(ShadePush) == 80 && sizeof(ComposePush) == 32);
 static_assert(kBvhStackSize >= kBvhMaxDepth, "the traversal stack must hold the deepest path");
 static_assert(kMaxTraversalSteps < 65535u, "must stop before lavapipe's loop limiter");
 } // namespace obscura::gpu

@@ -1,0 +1,52 @@
+// path_tracer.h — the reference renderer: unbiased path tracing [RTO §5.1, SPEC §1.5] with the
+// same scene buffers, traversal, BSDF and light sampling as the obscurance passes
+// (shaders/pathtrace.comp). Progressive: iteration i traces one path per pixel (sample i) and
+// adds it to a per-pixel radiance sum; the image is the sum / spp.
+#pragma once
+#include <cstdint>
+
+#include "bvh/bvh.h"
+#include "gpu/context.h"
+#include "io/image_io.h"
+#include "render/aov_render.h"
+#include "scene/scene.h"
+
+namespace obscura::render {
+
+// Which techniques estimate the light of AREA emitters. Punctual lights are always sampled
+// (nothing else can reach them) and emitters seen by the camera or through a mirror always
+// count. Everything but Mis is for tests: all three converge to the same image.
+enum class PathStrategy : std::uint32_t {
+  Mis = 0,       // light sampling + BSDF sampling, power heuristic (Veach & Guibas 1995)
+  LightOnly = 1, // next-event estimation only
+  BsdfOnly = 2,  // emitters found by BSDF-sampled rays only
+};
+
+struct PathTraceSettings {
+  std::uint32_t width = 512, height = 512;
+  std::uint32_t spp = 64;          // paths per pixel (iterations)
+  std::uint32_t seed = 1;
+  scene::Camera camera;
+  std::uint32_t maxDepth = 6;      // scattering vertices d [SPEC §5]: 1 = direct light only
+  std::uint32_t rrDepth = 3;       // Russian roulette after this many vertices (>= maxDepth: never)
+  PathStrategy strategy = PathStrategy::Mis;
+};
+
+// The largest maxDepth accepted (each vertex costs loop passes of lavapipe's limiter; a deeper
+// path is far past what Russian roulette lets through anyway).
+inline constexpr std::uint32_t kMaxPathDepth = 1024;
+
+struct PathTraceResult {
+  io::Image image;                      // combined.R/G/B: mean radiance per pixel
+  RenderStats stats;                    // pass "pathtrace": GPU ms and rays (camera, shadow, bounce)
+  std::uint64_t nonFiniteSamples = 0;   // samples dropped because they were NaN or inf (expect 0)
+};
+
+// Throws InputError for maxDepth > kMaxPathDepth, a zero-sized image or spp 0.
+PathTraceResult renderPathTraced(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+                                 const PathTraceSettings& settings, const ProgressFn& progress = nullptr);
+
+// Device memory the frame buffers need (beyond the scene).
+std::uint64_t pathTraceBytesNeeded(std::uint32_t width, std::uint32_t height);
+
+} // namespace obscura::render
