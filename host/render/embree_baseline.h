@@ -12,6 +12,7 @@ namespace obscura::render {
 
 struct EmbreeSetResult {
   double bestMs = 0.0, medianMs = 0.0;
+  double bestCpuMs = 0.0;   // least process CPU time (all threads) of one repeat
   double hitFraction = 0.0; // closest: rays that hit; shadow: rays occluded
 };
 
