@@ -10,6 +10,8 @@
 #ifndef OBSCURA_BVH_GLSL
 #define OBSCURA_BVH_GLSL
 
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
 struct RayHit {
   float t;
   float u;          // barycentric of v1
@@ -24,6 +26,14 @@ bool rayHitValid(RayHit h) { return h.primitive < kTruncatedHit; }
 // Closest hit when anyHit is false (ties in t go to the lower primitive id), else the first hit
 // found with t < tmax (occlusion). Stops after kMaxTraversalSteps passes and reports
 // kTruncatedHit, before lavapipe's loop limiter (65,535 passes) would cut the loop off silently.
+//
+// The stack: on lavapipe a per-lane, dynamically indexed array costs ~40 ns per 8-lane pass even
+// where no lane touches it (masked gathers/scatters run anyway), about a third of a pass. So the
+// main loop keeps the top kBvhRegisterStack entries in four uvec4 registers (a push or pop shifts
+// them: 32 vector selects) and never touches memory. A ray whose stack would grow deeper stops
+// there and is finished by a second loop with the array stack, restarting from the root with the
+// hit found so far (re-testing a triangle never changes the result, so this is exact). That loop
+// costs every 8-lane group one (masked) pass when no ray overflowed.
 RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit) {
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);
@@ -35,10 +45,11 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   hit.item = kInvalidIndex;
   hit.steps = 0u;
 
-  uint stack[kBvhStackSize];
+  uvec4 top0 = uvec4(0u), top1 = uvec4(0u), top2 = uvec4(0u), top3 = uvec4(0u); // top0.x = top
   uint stackSize = 0u;
   uint node = 0u;                 // next interior node to visit; kInvalidIndex = pop next
   uint triNext = 0u, triEnd = 0u; // pending triangle items of the current leaf
+  bool overflow = false;
   for (;;) {
     if (hit.steps >= kMaxTraversalSteps) {
       hit.primitive = kTruncatedHit;
@@ -74,6 +85,80 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
       bool hit1 = s1.x <= s1.y && ref1 != kInvalidIndex;
       bool nearFirst = s0.x <= s1.x;
       node = hit0 ? (hit1 && !nearFirst ? ref1 : ref0) : (hit1 ? ref1 : kInvalidIndex);
+      if (hit0 && hit1) { // the push site
+        if (stackSize == kBvhRegisterStack) {
+          overflow = true; // finished by the second loop
+          break;
+        }
+        top3 = uvec4(top2.w, top3.xyz);
+        top2 = uvec4(top1.w, top2.xyz);
+        top1 = uvec4(top0.w, top1.xyz);
+        top0 = uvec4(nearFirst ? ref1 : ref0, top0.xyz);
+        stackSize++;
+      }
+    }
+    if (triNext >= triEnd) {
+      if (node == kInvalidIndex) {
+        if (stackSize == 0u) break;
+        node = top0.x; // the pop site
+        top0 = uvec4(top0.yzw, top1.x);
+        top1 = uvec4(top1.yzw, top2.x);
+        top2 = uvec4(top2.yzw, top3.x);
+        top3 = uvec4(top3.yzw, 0u);
+        stackSize--;
+      }
+      if ((node & kLeafFlag) != 0u) { // a leaf becomes the pending triangle range
+        triNext = node & kLeafFirstMask;
+        triEnd = triNext + ((node >> kLeafCountShift) & kLeafCountMask) + 1u;
+        node = kInvalidIndex;
+      }
+    }
+  }
+
+  // The second loop. lavapipe's loop limiter counts the passes of both loops of the 8-lane group,
+  // which ran the first loop for as many passes as its longest ray: an overflowed ray continues
+  // counting from there, so the group stays within kMaxTraversalSteps passes in total.
+  uint groupSteps = subgroupMax(hit.steps);
+  if (overflow) hit.steps = groupSteps;
+  uint stack[kBvhStackSize];
+  stackSize = 0u;
+  node = 0u;
+  triNext = 0u;
+  triEnd = 0u;
+  while (overflow) {
+    if (hit.steps >= kMaxTraversalSteps) {
+      hit.primitive = kTruncatedHit;
+      break;
+    }
+    hit.steps++;
+    bool onTriangle = triNext < triEnd;
+    int base = int((onTriangle ? triNext : node) * kTexelsPerItem);
+    vec4 a = texelFetch(bvhItems, base);
+    vec4 b = texelFetch(bvhItems, base + 1);
+    vec4 c = texelFetch(bvhItems, base + 2);
+    vec4 d = texelFetch(bvhItems, base + 3);
+    if (onTriangle) {
+      float t, u, v;
+      if (intersectTriangle(wr, a.xyz, b.xyz, c.xyz, tmin, hit.t, t, u, v)) {
+        uint primitive = floatBitsToUint(a.w);
+        if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
+          hit.t = t;
+          hit.u = u;
+          hit.v = v;
+          hit.primitive = primitive;
+          hit.item = triNext;
+          if (anyHit) break;
+        }
+      }
+      triNext++;
+    } else {
+      uint ref0 = floatBitsToUint(a.w), ref1 = floatBitsToUint(b.w);
+      vec2 s0 = intersectBox(a.xyz, b.xyz, origin, invDir, tmin, hit.t);
+      vec2 s1 = intersectBox(c.xyz, d.xyz, origin, invDir, tmin, hit.t);
+      bool hit0 = s0.x <= s0.y && ref0 != kInvalidIndex;
+      bool hit1 = s1.x <= s1.y && ref1 != kInvalidIndex;
+      bool nearFirst = s0.x <= s1.x;
+      node = hit0 ? (hit1 && !nearFirst ? ref1 : ref0) : (hit1 ? ref1 : kInvalidIndex);
       if (hit0 && hit1) stack[stackSize++] = nearFirst ? ref1 : ref0; // the push site
     }
     if (triNext >= triEnd) {
@@ -81,7 +166,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
         if (stackSize == 0u) break;
         node = stack[--stackSize]; // the pop site
       }
-      if ((node & kLeafFlag) != 0u) { // a leaf becomes the pending triangle range
+      if ((node & kLeafFlag) != 0u) {
         triNext = node & kLeafFirstMask;
         triEnd = triNext + ((node >> kLeafCountShift) & kLeafCountMask) + 1u;
         node = kInvalidIndex;
