@@ -29,8 +29,9 @@ bool rayHitValid(RayHit h) { return h.primitive < kTruncatedHit; }
 //
 // The stack: on lavapipe a per-lane, dynamically indexed array costs ~40 ns per 8-lane pass even
 // where no lane touches it (masked gathers/scatters run anyway), about a third of a pass. So the
-// main loop keeps the top kBvhRegisterStack entries in four uvec4 registers (a push or pop shifts
-// them: 32 vector selects) and never touches memory. A ray whose stack would grow deeper stops
+// main loop keeps the top kBvhRegisterStack (12) entries in three uvec4 registers (a push or pop
+// shifts them: 24 vector selects) and never touches memory. (Measured: 8 entries send too many
+// Sponza rays to the slow path, 16 or more cost registers and selects on every pass.) A ray whose stack would grow deeper stops
 // there and is finished by a second loop with the array stack, restarting from the root with the
 // hit found so far (re-testing a triangle never changes the result, so this is exact). That loop
 // costs every 8-lane group one (masked) pass when no ray overflowed.
@@ -45,7 +46,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   hit.item = kInvalidIndex;
   hit.steps = 0u;
 
-  uvec4 top0 = uvec4(0u), top1 = uvec4(0u), top2 = uvec4(0u), top3 = uvec4(0u); // top0.x = top
+  uvec4 top0 = uvec4(0u), top1 = uvec4(0u), top2 = uvec4(0u); // top0.x = top; kBvhRegisterStack = 12
   uint stackSize = 0u;
   uint node = 0u;                 // next interior node to visit; kInvalidIndex = pop next
   uint triNext = 0u, triEnd = 0u; // pending triangle items of the current leaf
@@ -90,7 +91,6 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
           overflow = true; // finished by the second loop
           break;
         }
-        top3 = uvec4(top2.w, top3.xyz);
         top2 = uvec4(top1.w, top2.xyz);
         top1 = uvec4(top0.w, top1.xyz);
         top0 = uvec4(nearFirst ? ref1 : ref0, top0.xyz);
@@ -103,8 +103,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
         node = top0.x; // the pop site
         top0 = uvec4(top0.yzw, top1.x);
         top1 = uvec4(top1.yzw, top2.x);
-        top2 = uvec4(top2.yzw, top3.x);
-        top3 = uvec4(top3.yzw, 0u);
+        top2 = uvec4(top2.yzw, 0u);
         stackSize--;
       }
       if ((node & kLeafFlag) != 0u) { // a leaf becomes the pending triangle range
