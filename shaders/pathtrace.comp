@@ -150,9 +150,9 @@ void main() {
       if (w > 0.0 && any(greaterThan(ls.weight, vec3(0.0)))) {
         vec3 contribution; // unit emission; x E_s below
         uint light;
-        uint stepsLeft = budget.left;
+        uint tracedBefore = budget.traced;
         directLightSample(sp, uLight, lightCount, budget, contribution, light);
-        if (budget.left != stepsLeft) rays++; // it traced (a traversal takes at least one step)
+        if (budget.traced != tracedBefore) rays++; // it traced a shadow ray
         L += beta * w * emissionScale[light].rgb * contribution;
       }
       if (budget.truncated) break;

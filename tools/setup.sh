@@ -6,6 +6,7 @@ packages=(
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools glslang-tools
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libopenimageio-dev
   libcli11-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libembree-dev
   clang libclang-rt-14-dev
   python3-matplotlib
 )

@@ -10,6 +10,8 @@
 #ifndef OBSCURA_BVH_GLSL
 #define OBSCURA_BVH_GLSL
 
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
 struct RayHit {
   float t;
   float u;          // barycentric of v1
@@ -26,6 +28,16 @@ bool rayHitValid(RayHit h) { return h.primitive < kTruncatedHit; }
 // lavapipe's loop limiter (65,535 passes for ALL loops of an invocation) would otherwise cut the
 // loop off silently. A shader that traces several rays passes each the budget its earlier rays
 // left (StepBudget below), so the sum stays under kMaxTraversalSteps.
+//
+// The stack: on lavapipe a per-lane, dynamically indexed array costs ~40 ns per 8-lane pass even
+// where no lane touches it (masked gathers/scatters run anyway), about a third of a pass. So the
+// main loop keeps the top kBvhRegisterStack (12) entries in three uvec4 registers (a push or pop
+// shifts them: 24 vector selects) and never touches memory. (Measured: 8 entries send too many
+// Sponza rays to the slow path, 16 or more cost registers and selects on every pass.) A ray
+// whose stack would grow deeper stops
+// there and is finished by a second loop with the array stack, restarting from the root with the
+// hit found so far (re-testing a triangle never changes the result, so this is exact). That loop
+// costs every 8-lane group one (masked) pass when no ray overflowed.
 RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit, uint maxSteps) {
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);
@@ -37,10 +49,11 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   hit.item = kInvalidIndex;
   hit.steps = 0u;
 
-  uint stack[kBvhStackSize];
+  uvec4 top0 = uvec4(0u), top1 = uvec4(0u), top2 = uvec4(0u); // top0.x = top; kBvhRegisterStack = 12
   uint stackSize = 0u;
   uint node = 0u;                 // next interior node to visit; kInvalidIndex = pop next
   uint triNext = 0u, triEnd = 0u; // pending triangle items of the current leaf
+  bool overflow = false;
   for (;;) {
     if (hit.steps >= maxSteps) {
       hit.primitive = kTruncatedHit;
@@ -76,6 +89,78 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
       bool hit1 = s1.x <= s1.y && ref1 != kInvalidIndex;
       bool nearFirst = s0.x <= s1.x;
       node = hit0 ? (hit1 && !nearFirst ? ref1 : ref0) : (hit1 ? ref1 : kInvalidIndex);
+      if (hit0 && hit1) { // the push site
+        if (stackSize == kBvhRegisterStack) {
+          overflow = true; // finished by the second loop
+          break;
+        }
+        top2 = uvec4(top1.w, top2.xyz);
+        top1 = uvec4(top0.w, top1.xyz);
+        top0 = uvec4(nearFirst ? ref1 : ref0, top0.xyz);
+        stackSize++;
+      }
+    }
+    if (triNext >= triEnd) {
+      if (node == kInvalidIndex) {
+        if (stackSize == 0u) break;
+        node = top0.x; // the pop site
+        top0 = uvec4(top0.yzw, top1.x);
+        top1 = uvec4(top1.yzw, top2.x);
+        top2 = uvec4(top2.yzw, 0u);
+        stackSize--;
+      }
+      if ((node & kLeafFlag) != 0u) { // a leaf becomes the pending triangle range
+        triNext = node & kLeafFirstMask;
+        triEnd = triNext + ((node >> kLeafCountShift) & kLeafCountMask) + 1u;
+        node = kInvalidIndex;
+      }
+    }
+  }
+
+  // The second loop. lavapipe's loop limiter counts the passes of both loops of the 8-lane group,
+  // which ran the first loop for as many passes as its longest ray: an overflowed ray continues
+  // counting from there, so the group stays within kMaxTraversalSteps passes in total.
+  uint groupSteps = subgroupMax(hit.steps);
+  if (overflow) hit.steps = groupSteps;
+  uint stack[kBvhStackSize];
+  stackSize = 0u;
+  node = 0u;
+  triNext = 0u;
+  triEnd = 0u;
+  while (overflow) {
+    if (hit.steps >= maxSteps) {
+      hit.primitive = kTruncatedHit;
+      break;
+    }
+    hit.steps++;
+    bool onTriangle = triNext < triEnd;
+    int base = int((onTriangle ? triNext : node) * kTexelsPerItem);
+    vec4 a = texelFetch(bvhItems, base);
+    vec4 b = texelFetch(bvhItems, base + 1);
+    vec4 c = texelFetch(bvhItems, base + 2);
+    vec4 d = texelFetch(bvhItems, base + 3);
+    if (onTriangle) {
+      float t, u, v;
+      if (intersectTriangle(wr, a.xyz, b.xyz, c.xyz, tmin, hit.t, t, u, v)) {
+        uint primitive = floatBitsToUint(a.w);
+        if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
+          hit.t = t;
+          hit.u = u;
+          hit.v = v;
+          hit.primitive = primitive;
+          hit.item = triNext;
+          if (anyHit) break;
+        }
+      }
+      triNext++;
+    } else {
+      uint ref0 = floatBitsToUint(a.w), ref1 = floatBitsToUint(b.w);
+      vec2 s0 = intersectBox(a.xyz, b.xyz, origin, invDir, tmin, hit.t);
+      vec2 s1 = intersectBox(c.xyz, d.xyz, origin, invDir, tmin, hit.t);
+      bool hit0 = s0.x <= s0.y && ref0 != kInvalidIndex;
+      bool hit1 = s1.x <= s1.y && ref1 != kInvalidIndex;
+      bool nearFirst = s0.x <= s1.x;
+      node = hit0 ? (hit1 && !nearFirst ? ref1 : ref0) : (hit1 ? ref1 : kInvalidIndex);
       if (hit0 && hit1) stack[stackSize++] = nearFirst ? ref1 : ref0; // the push site
     }
     if (triNext >= triEnd) {
@@ -83,7 +168,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
         if (stackSize == 0u) break;
         node = stack[--stackSize]; // the pop site
       }
-      if ((node & kLeafFlag) != 0u) { // a leaf becomes the pending triangle range
+      if ((node & kLeafFlag) != 0u) {
         triNext = node & kLeafFirstMask;
         triEnd = triNext + ((node >> kLeafCountShift) & kLeafCountMask) + 1u;
         node = kInvalidIndex;
@@ -103,19 +188,34 @@ RayHit traceAny(vec3 origin, vec3 direction, float tmin, float tmax) {
   return traverseBvh(origin, direction, tmin, tmax, true, kMaxTraversalSteps);
 }
 
-// The loop passes left to one invocation. A truncated ray is counted once in status[] and
-// treated by the caller as occluded / unknown; it never goes unreported.
+// The loop budget of a shader that traces several rays per invocation. lavapipe's limiter counts
+// the passes of every loop of an 8-lane group together, including traversals that only some
+// lanes run (masked lanes still go round). So the passes are counted per SUBGROUP, in shared
+// memory: each traversal adds its group-wide pass count (subgroupMax of its steps), and the next
+// one may use what is left of kMaxTraversalSteps. Divergent traversals of different lanes add up,
+// as they do in the limiter. A truncated ray is counted once in status[] by the caller.
+shared uint subgroupPasses[kWorkgroupSize1D]; // indexed by gl_SubgroupID (>= 1 lane per subgroup)
+
 struct StepBudget {
-  uint left;
-  bool truncated;
+  bool truncated; // some traversal of this invocation ran out of passes
+  uint traced;    // traversals this invocation ran (for ray counts)
 };
 
-StepBudget newStepBudget() { return StepBudget(kMaxTraversalSteps, false); }
+StepBudget newStepBudget() {
+  if (subgroupElect()) subgroupPasses[gl_SubgroupID] = 0u;
+  subgroupMemoryBarrierShared();
+  return StepBudget(false, 0u);
+}
 
 RayHit traceWithBudget(inout StepBudget budget, vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit) {
-  RayHit h = traverseBvh(origin, direction, tmin, tmax, anyHit, budget.left);
-  budget.left -= min(budget.left, h.steps);
+  uint used = subgroupPasses[gl_SubgroupID];
+  uint left = used < kMaxTraversalSteps ? kMaxTraversalSteps - used : 0u;
+  RayHit h = traverseBvh(origin, direction, tmin, tmax, anyHit, left);
+  uint passes = subgroupMax(h.steps);
+  if (subgroupElect()) subgroupPasses[gl_SubgroupID] = used + passes;
+  subgroupMemoryBarrierShared();
   if (h.primitive == kTruncatedHit) budget.truncated = true;
+  budget.traced++;
   return h;
 }
 

@@ -31,6 +31,8 @@ OBS_CONST uint kWorkgroupSizeY = 8;
 // median splits near the limit), so a traversal stack of kBvhStackSize entries never overflows.
 OBS_CONST uint kBvhMaxDepth = 48;
 OBS_CONST uint kBvhStackSize = 48;
+// Stack entries traversal keeps in registers (shaders/lib/bvh.glsl); deeper stacks take a slower path.
+OBS_CONST uint kBvhRegisterStack = 12;
 // A child reference is either an interior node index (bit 31 clear) or a leaf:
 // bit 31 set | (triangleCount - 1) << kLeafCountShift | firstTriangle (in BVH order).
 OBS_CONST uint kLeafFlag = 0x80000000u;

@@ -158,5 +158,21 @@ TEST_F(Cli, BenchRaysPrintsJson) {
     EXPECT_NE(r.output.find(key), std::string::npos) << key << "\n" << r.output;
 }
 
+// With Embree, the same rays traced by it agree with ours and the ratio is printed; without, the
+// option is refused with a message that says why.
+TEST_F(Cli, BenchRaysEmbreeBaseline) {
+  auto r = runObscura("bench-rays " + repoPath("scenes/cornell-box/cornell-box.gltf") +
+                      " --rays 20000 --repeats 1 --json --baseline embree");
+#ifdef OBSCURA_HAVE_EMBREE
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  for (const char* key : {"embree_closest_mrays_per_s", "embree_shadow_mrays_per_s", "embree_build_s",
+                          "closest_ratio_vs_embree", "shadow_ratio_vs_embree"})
+    EXPECT_NE(r.output.find(key), std::string::npos) << key << "\n" << r.output;
+#else
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.output.find("without Embree"), std::string::npos) << r.output;
+#endif
+}
+
 } // namespace
 } // namespace obscura::test

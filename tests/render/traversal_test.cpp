@@ -193,6 +193,54 @@ TEST_F(GpuTraversal, LongTraversalIsReportedNotTruncatedSilently) {
   }
 }
 
+// Stacks deeper than the registers hold (gpu::kBvhRegisterStack) take the second, array-stack
+// loop of shaders/lib/bvh.glsl. Triangles at x = 2^i make binned SAH peel off the farthest one
+// per level, a chain of depth ~n; a ray along +x overlaps every box, so it pushes at every level.
+// All but the last triangle miss the x axis (their boxes contain it).
+TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
+  const int n = 100;
+  bvh::TriangleSoup soup;
+  for (int i = 0; i < n; ++i) {
+    float x = std::ldexp(1.0f, i);
+    if (i + 1 < n) {
+      soup.v0.push_back({x, -0.9f, 1.1f});
+      soup.v1.push_back({x, 1.1f, 1.1f});
+      soup.v2.push_back({x, 1.1f, -0.9f});
+    } else {
+      soup.v0.push_back({x, -1.0f, -1.0f});
+      soup.v1.push_back({x, 3.0f, -1.0f});
+      soup.v2.push_back({x, -1.0f, 3.0f});
+    }
+  }
+  scene::Scene s = soupScene(soup);
+  bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+  ASSERT_GT(tree.stats.maxDepth, gpu::kBvhRegisterStack + 2) << "the scene no longer exercises the deep-stack path";
+  render::SceneBuffers buffers(context(), s, tree);
+  render::RayTracer tracer(context(), buffers);
+  std::vector<gpu::GpuRay> rays;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> jitter(-0.05f, 0.05f);
+  for (int i = 0; i < 64; ++i)
+    rays.push_back({glm::vec4(0.5f, jitter(rng), jitter(rng), 0.0f), glm::vec4(1.0f, 0.0f, 0.0f, INFINITY)});
+  auto result = tracer.trace(rays, render::TraceMode::Closest, true);
+  auto cpu = bruteForce(render::triangleSoup(s), rays);
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    EXPECT_EQ(result.hits[i].primitive, cpu[i].primitive) << i;
+    EXPECT_EQ(result.hits[i].t, cpu[i].t) << i;
+  }
+  EXPECT_EQ(result.hits[0].primitive, static_cast<std::uint32_t>(n - 1));
+  // Any hit: not occluded short of the last triangle's plane, occluded beyond it.
+  for (auto& r : rays) r.direction.w = std::ldexp(1.0f, n - 1) - 1.0f;
+  auto blocked = tracer.trace(rays, render::TraceMode::Any);
+  for (auto& r : rays) r.direction.w = INFINITY;
+  auto open = tracer.trace(rays, render::TraceMode::Any);
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    EXPECT_EQ(blocked.hits[i].primitive, gpu::kInvalidIndex) << i;
+    EXPECT_EQ(open.hits[i].primitive, static_cast<std::uint32_t>(n - 1)) << i;
+  }
+  EXPECT_EQ(buffers.truncatedTraversals(), 0u);
+}
+
 class LoopLimiter : public GpuTest {};
 
 TEST_F(LoopLimiter, TraversalBudgetStaysBelowTheDriverLimit) {
