@@ -4,6 +4,7 @@
 // Changing a light's E_s reruns this pass alone: relighting needs no ray.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
+#include "lib/accumulate.glsl"
 
 layout(local_size_x = kWorkgroupSize1D) in;
 layout(push_constant) uniform Push { ComposePush pc; };
@@ -24,14 +25,14 @@ void main() {
   vec3 specular = vec3(0.0);
   const bool withSpecular = pc.ambient.w != 0.0;
   for (uint s = 0u; s < pc.frame.w; ++s) {
-    direct += emission[s].rgb * basis[s * pixelCount + pixel].rgb;
-    if (withSpecular) specular += emission[s].rgb * specularBasis[s * pixelCount + pixel].rgb;
+    direct += emission[s].rgb * OBS_SUM(basis, s * pixelCount + pixel).rgb;
+    if (withSpecular) specular += emission[s].rgb * OBS_SUM(specularBasis, s * pixelCount + pixel).rgb;
   }
   direct *= inv;
-  if (withSpecular) specular = (specular + pc.ambient.rgb * specularAmbient[pixel].rgb) * inv;
-  vec4 a = ambient[pixel] * inv;
+  if (withSpecular) specular = (specular + pc.ambient.rgb * OBS_SUM(specularAmbient, pixel).rgb) * inv;
+  vec4 a = OBS_SUM(ambient, pixel) * inv;
   vec3 indirect = pc.ambient.rgb * a.rgb;
-  vec3 emitted = aov[pixel * kAovSlots + kAovEmission].rgb * inv;
+  vec3 emitted = OBS_SUM(aov, pixel * kAovSlots + kAovEmission).rgb * inv;
   uint o = pixel * kComposeSlots;
   composed[o + kComposeCombined] = vec4(direct + indirect + emitted + specular, 1.0);
   composed[o + kComposeDirect] = vec4(direct, 1.0);

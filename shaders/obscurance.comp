@@ -16,10 +16,12 @@
 #include "lib/lights.glsl"
 #include "lib/shade.glsl"
 #include "lib/obscurance.glsl"
+#include "lib/accumulate.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
 void main() {
+  gSceneScale = pc.eye.w;
   uvec2 size = pc.frame.xy;
   uvec2 p = gl_GlobalInvocationID.xy;
   if (p.x >= size.x || p.y >= size.y) return;
@@ -30,7 +32,7 @@ void main() {
   ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);
   uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x9e3779b9u);
   StepBudget budget = newStepBudget();
-  ambient[pixel] += gatherObscurance(sp, rng, budget);
+  OBS_ACCUMULATE(ambient, pixel, gatherObscurance(sp, rng, budget))
   atomicAdd(status[kStatusObscuranceRays], pc.counts.z);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

@@ -58,6 +58,7 @@ layout(std430, set = 0, binding = kBindingPathScales) readonly buffer ScaleBuffe
 #include "lib/lights.glsl"
 #include "lib/shade.glsl"
 #include "lib/mis.glsl"
+#include "lib/accumulate.glsl"
 
 // OURS: the largest survival probability of Russian roulette (see the header).
 const float kRrMaxSurvival = 0.95;
@@ -71,6 +72,7 @@ bool nonFinite(vec3 v) {
 float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
 void main() {
+  gSceneScale = pc.camera.right.w;
   uvec2 size = pc.frame.xy;
   uvec2 p = gl_GlobalInvocationID.xy;
   if (p.x >= size.x || p.y >= size.y) return;
@@ -183,10 +185,8 @@ void main() {
     rays++;
   }
 
-  vec4 sum = radiance[pixel];
-  if (nonFinite(L)) sum.w += 1.0; // dropped and counted (see the header)
-  else sum.rgb += L;
-  radiance[pixel] = sum;
+  // A non-finite sample is dropped and counted in .w (see the header).
+  OBS_ACCUMULATE(radiance, pixel, nonFinite(L) ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(L, 0.0))
   atomicAdd(status[kStatusPathRays], rays);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

@@ -10,6 +10,7 @@
 #include "lib/material.glsl"
 #include "lib/rng.glsl"
 #include "lib/camera.glsl"
+#include "lib/accumulate.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 layout(push_constant) uniform Push { PrimaryPush pc; };
@@ -18,7 +19,7 @@ layout(std430, set = 0, binding = kBindingPassFirst + 1) buffer AovBuffer { vec4
 
 void accumulate(uint pixel, uint slot, vec4 value, bool first) {
   uint i = pixel * kAovSlots + slot;
-  aov[i] = first ? value : aov[i] + value;
+  if (first) OBS_ACCUMULATE_FIRST(aov, i, value) else OBS_ACCUMULATE(aov, i, value)
 }
 
 void main() {
@@ -67,5 +68,5 @@ void main() {
   accumulate(pixel, kAovPosition, vec4(g.position.xyz, 0.0), first);
   accumulate(pixel, kAovEmission, g.emission, first);
   accumulate(pixel, kAovPreview, vec4(preview, 0.0), first);
-  if (first) aov[pixel * kAovSlots + kAovIds] = vec4(g.geometricNormal.w, g.shadingNormal.w, 0.0, 0.0);
+  if (first) OBS_ACCUMULATE_FIRST(aov, pixel * kAovSlots + kAovIds, vec4(g.geometricNormal.w, g.shadingNormal.w, 0.0, 0.0))
 }

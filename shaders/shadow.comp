@@ -15,10 +15,12 @@
 #include "lib/bsdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/shade.glsl"
+#include "lib/accumulate.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
 void main() {
+  gSceneScale = pc.eye.w;
   uvec2 size = pc.frame.xy;
   uvec2 p = gl_GlobalInvocationID.xy;
   if (p.x >= size.x || p.y >= size.y) return;
@@ -37,7 +39,7 @@ void main() {
     vec3 contribution;
     uint light;
     directLightSample(sp, u, pc.counts.x, budget, contribution, light);
-    basis[light * pixelCount + pixel] += vec4(contribution * invCount, 0.0);
+    OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(contribution * invCount, 0.0))
   }
   atomicAdd(status[kStatusShadowRays], count);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);

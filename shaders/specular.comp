@@ -23,6 +23,7 @@
 #include "lib/lights.glsl"
 #include "lib/shade.glsl"
 #include "lib/obscurance.glsl"
+#include "lib/accumulate.glsl"
 
 layout(local_size_x = kWorkgroupSize1D) in;
 
@@ -43,6 +44,7 @@ bool sampleSpecularLobe(ShadingPoint sp, vec3 wo, vec2 u, out vec3 wi, out vec3 
 }
 
 void main() {
+  gSceneScale = pc.eye.w;
   uint entry = gl_GlobalInvocationID.x;
   if (entry >= queue[kQueueCount]) return;
   uint pixel = queue[kQueueHeader + entry];
@@ -80,7 +82,7 @@ void main() {
       // Seen emission in unit-emission terms: divided by the group's E_s (1 where E_s is 0).
       vec3 scale = lightScales[s.lightGroup].rgb;
       vec3 unit = materialEmission(m, s.uv, s.frontFacing) / mix(scale, vec3(1.0), equal(scale, vec3(0.0)));
-      specularBasis[s.lightGroup * pixelCount + pixel] += vec4(throughput * unit, 0.0);
+      OBS_ACCUMULATE(specularBasis, s.lightGroup * pixelCount + pixel, vec4(throughput * unit, 0.0))
     }
     sp = shadingPoint(s.position, s.geometricNormal, s.shadingNormal, -wi, baseColor, s.material);
     // Gather as at P [RTO §4.1 step 4]: direct light, then obscurance.
@@ -89,10 +91,10 @@ void main() {
       vec3 contribution;
       uint light;
       directLightSample(sp, u, lightCount, budget, contribution, light);
-      specularBasis[light * pixelCount + pixel] += vec4(throughput * contribution / float(shadowRays), 0.0);
+      OBS_ACCUMULATE(specularBasis, light * pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
     }
     vec4 aw = gatherObscurance(sp, rng, budget);
-    specularAmbient[pixel] += vec4(throughput * aw.rgb, 0.0);
+    OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
     rays += shadowRays + pc.counts.z;
   }
   atomicAdd(status[kStatusSpecularRays], rays);

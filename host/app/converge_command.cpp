@@ -161,9 +161,11 @@ private:
 };
 
 void runConverge(const ConvergeOptions& o) {
-  fs::create_directories(o.outputDir);
-  if (!fs::is_directory(o.outputDir)) throw InputError(fmt::format("{}: cannot create the output folder", o.outputDir));
-  LoadedScene loaded = loadScene(o.scenePath);
+  LoadedScene loaded = loadScene(o.scenePath); // first: a bad scene leaves no folder behind
+  std::error_code ec;
+  fs::create_directories(o.outputDir, ec);
+  if (ec || !fs::is_directory(o.outputDir))
+    throw InputError(fmt::format("{}: cannot create the output folder{}", o.outputDir, ec ? ": " + ec.message() : ""));
   gpu::Context context(o.device.contextOptions());
   fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
   Study study(o, loaded, context);

@@ -32,6 +32,9 @@ int main(int argc, char** argv) {
   } catch (const obscura::DeviceError& e) {
     fmt::print(stderr, "obscura: device error: {}\n", e.what());
     return 3;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "obscura: out of host memory (a smaller --width/--height or scene needs less)\n");
+    return 3;
   } catch (const vk::SystemError& e) {
     fmt::print(stderr, "obscura: Vulkan error: {}\n", e.what());
     return 3;

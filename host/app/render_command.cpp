@@ -1,6 +1,7 @@
 // obscura render SCENE -o out.{exr,png} [--width --height --spp --aov NAME... --metrics m.json]
 #include <algorithm>
 #include <cmath>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <unistd.h>
@@ -90,6 +91,17 @@ void printProgress(std::uint32_t done, std::uint32_t total, double seconds, std:
   std::fflush(stderr);
 }
 
+// Fails now, before any work, when `path` cannot be written (its folder is missing, is a file,
+// or refuses a new file): a late failure would leave a finished image and no metrics.
+void checkWritable(const std::string& path) {
+  std::string probe = path + ".probe.tmp";
+  {
+    std::ofstream out(probe);
+    if (!out) throw InputError(fmt::format("{}: cannot write metrics here", path));
+  }
+  std::remove(probe.c_str());
+}
+
 void writeMetrics(const std::string& path, const nlohmann::json& json) {
   std::string temp = path + ".tmp";
   {
@@ -161,8 +173,9 @@ void runRender(RenderOptions& o) {
   for (const auto& aov : o.aovs)
     if (std::find(known.begin(), known.end(), aov) == known.end())
       throw InputError(fmt::format("--aov {}: unknown AOV (known: {})", aov, fmt::join(known, ", ")));
-  if (o.dMax < 0.0f || (o.dMax == 0.0f && o.dMaxGiven))
-    throw InputError(fmt::format("--dmax {}: must be a positive distance in scene units", o.dMax));
+  if (o.dMaxGiven && !(std::isfinite(o.dMax) && o.dMax > 0.0f))
+    throw InputError(fmt::format("--dmax {}: must be a finite positive distance in scene units", o.dMax));
+  if (!o.metrics.empty()) checkWritable(o.metrics);
 
   LoadedScene loaded = loadScene(o.scenePath);
   scene::Camera camera = chooseCamera(loaded.scene, o.camera);
@@ -170,12 +183,16 @@ void runRender(RenderOptions& o) {
   fmt::print(stderr, "{}\n", sceneSummary(loaded));
 
   gpu::Context context(o.device.contextOptions());
-  std::uint64_t need = render::obscuranceBytesNeeded(o.width, o.height, loaded.scene.lightGroups.size() +
-                                                                          loaded.scene.punctualLights.size());
-  if (need > context.info().deviceLocalBytes || need / 6 > context.info().maxStorageBufferRange)
-    throw InputError(fmt::format("{}x{}: the frame buffers would need {:.1f} MiB, more than the device "
-                                 "'{}' offers", o.width, o.height, static_cast<double>(need) / 1048576.0,
-                                 context.info().name));
+  const std::size_t lightCount = loaded.scene.lightGroups.size() + loaded.scene.punctualLights.size();
+  std::uint64_t need = render::obscuranceBytesNeeded(o.width, o.height, lightCount);
+  std::uint64_t largest = render::obscuranceLargestBuffer(o.width, o.height, lightCount);
+  if (need > context.info().deviceLocalBytes || largest > context.info().maxStorageBufferRange)
+    throw InputError(fmt::format("{}x{}: the frame buffers would need {:.1f} MiB (the largest one {:.1f} MiB), more "
+                                 "than the device '{}' offers ({:.0f} MiB, {:.0f} MiB per buffer)",
+                                 o.width, o.height, static_cast<double>(need) / 1048576.0,
+                                 static_cast<double>(largest) / 1048576.0, context.info().name,
+                                 static_cast<double>(context.info().deviceLocalBytes) / 1048576.0,
+                                 static_cast<double>(context.info().maxStorageBufferRange) / 1048576.0));
   fmt::print(stderr, "device: {} ({})\n", context.info().name, context.info().driver);
 
   render::ObscuranceSettings settings = o.obscurance;

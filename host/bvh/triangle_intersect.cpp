@@ -64,14 +64,17 @@ inline float gammaBound(float n) {
 // while a 2000-unit floor under a ray's origin (spread ~1e3) still gets the bound it needs.
 // The GLSL twin computes the same expression in the same order.
 float triangleTError(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy, float cz,
-                     float e0, float e1, float e2, float det) {
+                     float e0, float e1, float e2, float det, float zScale) {
   const float maxZ = std::max(std::max(std::abs(az), std::abs(bz)), std::abs(cz));
   const float spreadZ = std::max(std::max(az, bz), cz) - std::min(std::min(az, bz), cz);
   const float deltaZ = gammaBound(3.0f) * maxZ;
   const float maxX = std::max(std::max(std::abs(ax), std::abs(bx)), std::abs(cx));
   const float maxY = std::max(std::max(std::abs(ay), std::abs(by)), std::abs(cy));
-  const float deltaX = gammaBound(5.0f) * (maxX + maxZ);
-  const float deltaY = gammaBound(5.0f) * (maxY + maxZ);
+  // x' = x - Sx z uses the UNSCALED z (|Sx|, |Sy| <= 1): PBR3 adds the scaled max|z| here, which
+  // assumes |d| ~ 1 and inflates the bound by 1/|d| for short directions (OURS: fixed).
+  const float maxZUnscaled = maxZ / zScale;
+  const float deltaX = gammaBound(5.0f) * (maxX + maxZUnscaled);
+  const float deltaY = gammaBound(5.0f) * (maxY + maxZUnscaled);
   const float deltaE = 2.0f * ((gammaBound(2.0f) * maxX * maxY + deltaY * maxX) + deltaX * maxY);
   const float maxE = std::max(std::max(std::abs(e0), std::abs(e1)), std::abs(e2));
   // When every vertex lies in front of the origin (beyond its own rounding error), t is a convex
@@ -162,7 +165,7 @@ bool intersectTriangle(const WatertightRay& ray, const glm::vec3& v0, const glm:
   //    ("Ensuring that t is positive"). For a huge triangle the error of t grows with the
   //    vertices' distance from the origin, not with the hit point, so offsetting a secondary
   //    ray's origin (which scales with the hit point) cannot prevent a self-hit alone.
-  const float tError = triangleTError(ax, ay, az, bx, by, bz, cx, cy, cz, uu, vv, ww, det);
+  const float tError = triangleTError(ax, ay, az, bx, by, bz, cx, cy, cz, uu, vv, ww, det, std::abs(ray.sz));
 
   // 9. Range test, open at tmin, closed at tmax so the caller can pass its best t and break ties
   //    by primitive id. A NaN t (zero direction) compares false and is rejected.

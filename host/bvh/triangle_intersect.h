@@ -26,7 +26,8 @@ bool intersectTriangle(const WatertightRay& ray, const glm::vec3& v0, const glm:
 
 // Conservative bound on the absolute error of the t computed from these sheared coordinates
 // (a*, b*, c*), edge functions e0..e2 and det [PBR3 §3.9.5]; hits with t <= it are rejected.
+// zScale = |Sz|, the shear's z scale (to recover unscaled z for the x/y error terms).
 float triangleTError(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy, float cz,
-                     float e0, float e1, float e2, float det);
+                     float e0, float e1, float e2, float det, float zScale);
 
 } // namespace obscura::bvh

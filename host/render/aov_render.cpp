@@ -1,9 +1,11 @@
 #include "render/aov_render.h"
 
 #include <bit>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
+#include "gpu/kernel.h"
 #include "gpu/timestamps.h"
 #include "render/primary_pass.h"
 #include "render/scene_buffers.h"
@@ -41,7 +43,9 @@ io::Image resolvePrimaryAovs(const std::vector<glm::vec4>& aov, std::uint32_t wi
   const float inv = 1.0f / static_cast<float>(spp);
   std::size_t k = 0;
   for (std::size_t p = 0; p < std::size_t(width) * height; ++p) {
-    const glm::vec4* slot = &aov[p * gpu::kAovSlots];
+    // Each accumulator is (sum, compensation): the sum of slot k is at k * kAccumulatorVec4s.
+    auto sum = [&](std::uint32_t k) { return aov[(p * gpu::kAovSlots + k) * gpu::kAccumulatorVec4s]; };
+    const glm::vec4 slot[gpu::kAovSlots] = {sum(0), sum(1), sum(2), sum(3), sum(4), sum(5)};
     glm::vec4 albedo = slot[gpu::kAovAlbedo] * inv;
     glm::vec4 normalDepth = slot[gpu::kAovNormal] * inv;
     glm::vec3 position = glm::vec3(slot[gpu::kAovPosition]) * inv;
@@ -74,18 +78,24 @@ io::Image renderAovs(const gpu::Context& context, const scene::Scene& scene, con
   gpu::Timestamps timestamps(context);
   const gpu::GpuCamera camera = gpuCamera(settings.camera, settings.width, settings.height);
 
-  // One submission per sample: keeps each dispatch short (no device timeouts on slow devices)
-  // and lets the progress line move.
-  for (std::uint32_t s = 0; s < settings.spp; ++s) {
+  // Several samples per submission (each dispatch is short, so no device timeout), with a
+  // barrier between samples, which read and write the same accumulators. The progress line moves
+  // once per submission.
+  constexpr std::uint32_t kSamplesPerSubmission = 64; // <= the timestamp pool's 256 pairs
+  for (std::uint32_t first = 0; first < settings.spp; first += kSamplesPerSubmission) {
+    const std::uint32_t last = std::min(settings.spp, first + kSamplesPerSubmission);
     context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
       timestamps.reset(cmd);
-      timestamps.begin(cmd, "primary");
-      primary.record(cmd, camera, s, settings.seed);
-      timestamps.end(cmd, "primary");
+      for (std::uint32_t s = first; s < last; ++s) {
+        if (s > first) gpu::computeBarrier(cmd);
+        timestamps.begin(cmd, "primary");
+        primary.record(cmd, camera, s, settings.seed);
+        timestamps.end(cmd, "primary");
+      }
     });
     timestamps.collect();
     if (progress)
-      progress(s + 1, settings.spp,
+      progress(last, settings.spp,
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
 

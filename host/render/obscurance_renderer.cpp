@@ -58,9 +58,18 @@ const std::vector<std::string>& obscuranceAovNames() {
   return names;
 }
 
+std::uint64_t obscuranceLargestBuffer(std::uint32_t width, std::uint32_t height, std::size_t lights) {
+  const std::uint64_t pixels = std::uint64_t(width) * height, vec4 = 16;
+  const std::uint64_t aovs = pixels * gpu::kAovSlots * gpu::kAccumulatorVec4s * vec4;
+  const std::uint64_t basis = pixels * std::max<std::uint64_t>(lights, 1) * gpu::kAccumulatorVec4s * vec4;
+  const std::uint64_t composed = pixels * gpu::kComposeSlots * vec4;
+  return std::max({aovs, basis, composed, pixels * sizeof(gpu::GBufferTexel)});
+}
+
 std::uint64_t obscuranceBytesNeeded(std::uint32_t width, std::uint32_t height, std::size_t lights) {
   std::uint64_t pixels = std::uint64_t(width) * height;
-  return PrimaryPass::bytesNeeded(width, height) + pixels * 16 * (lights + 1 + gpu::kComposeSlots);
+  return PrimaryPass::bytesNeeded(width, height) +
+         pixels * 16 * (gpu::kAccumulatorVec4s * (lights + 1) + gpu::kComposeSlots);
 }
 
 ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
@@ -83,8 +92,10 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
 
   gpu::Buffer lightBuffer = gpu::uploadArray(context, lights.lights, "shadow.lights");
   gpu::Buffer emitterBuffer = gpu::uploadArray(context, lights.emitters, "shadow.emitters");
-  gpu::Buffer basis(context, std::max<std::uint64_t>(lightCount, 1) * pixels * 16, Usage::eStorageBuffer, "shadow.basis");
-  gpu::Buffer ambient(context, pixels * 16, Usage::eStorageBuffer, "obscurance.ambient");
+  constexpr std::uint64_t kAccumulator = gpu::kAccumulatorVec4s * sizeof(glm::vec4);
+  gpu::Buffer basis(context, std::max<std::uint64_t>(lightCount, 1) * pixels * kAccumulator, Usage::eStorageBuffer,
+                    "shadow.basis");
+  gpu::Buffer ambient(context, pixels * kAccumulator, Usage::eStorageBuffer, "obscurance.ambient");
   std::vector<glm::vec4> scales;
   for (const auto& e : lights.emission) scales.emplace_back(e, 0.0f);
   gpu::Buffer scaleBuffer = gpu::uploadArray(context, scales, "compose.emission");
@@ -93,9 +104,9 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
   // not need is not dispatched, and needs no memory).
   const bool runSpecular = hasGlossy(scene) && settings.maxDepth > 1;
   const std::uint64_t specularPixels = runSpecular ? pixels : 1;
-  gpu::Buffer specularBasis(context, std::max<std::uint64_t>(lightCount, 1) * specularPixels * 16,
+  gpu::Buffer specularBasis(context, std::max<std::uint64_t>(lightCount, 1) * specularPixels * kAccumulator,
                             Usage::eStorageBuffer, "specular.basis");
-  gpu::Buffer specularAmbient(context, specularPixels * 16, Usage::eStorageBuffer, "specular.ambient");
+  gpu::Buffer specularAmbient(context, specularPixels * kAccumulator, Usage::eStorageBuffer, "specular.ambient");
   gpu::Buffer queue(context, (gpu::kQueueHeader + specularPixels) * 4,
                     Usage::eStorageBuffer | Usage::eIndirectBuffer, "specular.queue");
 
@@ -133,7 +144,7 @@ ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Sce
                       .params = glm::vec4(result.dMax, settings.tau, static_cast<float>(settings.rho),
                                           static_cast<float>(settings.maxDepth)),
                       .rAve = glm::vec4(result.ambient.averageReflectance, 0.0f),
-                      .eye = glm::vec4(settings.camera.position, 0.0f)};
+                      .eye = glm::vec4(settings.camera.position, sceneScale(scene.bounds))};
   const std::uint32_t groupsX = gpu::groupsFor(settings.width, gpu::kWorkgroupSizeX);
   const std::uint32_t groupsY = gpu::groupsFor(settings.height, gpu::kWorkgroupSizeY);
 

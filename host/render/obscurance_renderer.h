@@ -59,6 +59,9 @@ struct ObscuranceResult {
 ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
                                    const ObscuranceSettings& settings, const ProgressFn& progress = nullptr);
 
+// The largest single frame buffer (it must fit the device's maxStorageBufferRange).
+std::uint64_t obscuranceLargestBuffer(std::uint32_t width, std::uint32_t height, std::size_t lights);
+
 // Device memory the frame buffers need (beyond the scene) for `lights` lights.
 std::uint64_t obscuranceBytesNeeded(std::uint32_t width, std::uint32_t height, std::size_t lights);
 

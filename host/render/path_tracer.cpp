@@ -32,7 +32,7 @@ gpu::KernelDesc pathKernelDesc() {
 } // namespace
 
 std::uint64_t pathTraceBytesNeeded(std::uint32_t width, std::uint32_t height) {
-  return std::uint64_t(width) * height * sizeof(glm::vec4);
+  return std::uint64_t(width) * height * gpu::kAccumulatorVec4s * sizeof(glm::vec4);
 }
 
 PathTraceResult renderPathTraced(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
@@ -49,7 +49,8 @@ PathTraceResult renderPathTraced(const gpu::Context& context, const scene::Scene
   result.stats.notes = buffers.notes();
   const std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
 
-  gpu::Buffer radiance(context, pixels * sizeof(glm::vec4), Usage::eStorageBuffer, "pathtrace.radiance");
+  gpu::Buffer radiance(context, pixels * gpu::kAccumulatorVec4s * sizeof(glm::vec4), Usage::eStorageBuffer,
+                       "pathtrace.radiance");
   gpu::Buffer lightBuffer = gpu::uploadArray(context, lights.lights, "pathtrace.lights");
   gpu::Buffer emitterBuffer = gpu::uploadArray(context, lights.emitters, "pathtrace.emitters");
   std::vector<glm::vec4> scales;
@@ -70,6 +71,7 @@ PathTraceResult renderPathTraced(const gpu::Context& context, const scene::Scene
                 .frame = glm::uvec4(settings.width, settings.height, 0u, settings.seed),
                 .params = glm::uvec4(lightCount, settings.maxDepth, settings.rrDepth,
                                      static_cast<std::uint32_t>(settings.strategy))};
+  push.camera.right.w = sceneScale(scene.bounds); // the ray-origin offset's scale (ray.glsl)
   const std::uint32_t groupsX = gpu::groupsFor(settings.width, gpu::kWorkgroupSizeX);
   const std::uint32_t groupsY = gpu::groupsFor(settings.height, gpu::kWorkgroupSizeY);
 
@@ -105,8 +107,9 @@ PathTraceResult renderPathTraced(const gpu::Context& context, const scene::Scene
   image.pixels.resize(pixels * 3);
   const float inv = 1.0f / static_cast<float>(settings.spp);
   for (std::uint64_t p = 0; p < pixels; ++p) {
-    for (int c = 0; c < 3; ++c) image.pixels[p * 3 + c] = sums[p][c] * inv;
-    result.nonFiniteSamples += static_cast<std::uint64_t>(sums[p].w);
+    const glm::vec4 sum = sums[p * gpu::kAccumulatorVec4s]; // (sum, compensation) pairs
+    for (int c = 0; c < 3; ++c) image.pixels[p * 3 + c] = sum[c] * inv;
+    result.nonFiniteSamples += static_cast<std::uint64_t>(sum.w);
   }
   if (result.nonFiniteSamples > 0)
     st.notes.push_back(fmt::format("path tracing dropped {} non-finite samples (NaN or inf radiance)",

@@ -28,7 +28,7 @@ gpu::KernelDesc primaryKernelDesc() {
 
 std::uint64_t PrimaryPass::bytesNeeded(std::uint32_t width, std::uint32_t height) {
   std::uint64_t pixels = std::uint64_t(width) * height;
-  return pixels * (sizeof(gpu::GBufferTexel) + gpu::kAovSlots * sizeof(glm::vec4));
+  return pixels * (sizeof(gpu::GBufferTexel) + gpu::kAovSlots * gpu::kAccumulatorVec4s * sizeof(glm::vec4));
 }
 
 PrimaryPass::PrimaryPass(const gpu::Context& context, const SceneBuffers& scene, std::uint32_t width,
@@ -36,7 +36,7 @@ PrimaryPass::PrimaryPass(const gpu::Context& context, const SceneBuffers& scene,
     : width_(width), height_(height), kernel_(context, primaryKernelDesc()),
       gbuffer_(context, std::uint64_t(width) * height * sizeof(gpu::GBufferTexel),
                vk::BufferUsageFlagBits::eStorageBuffer, "primary.gbuffer"),
-      aovs_(context, std::uint64_t(width) * height * gpu::kAovSlots * sizeof(glm::vec4),
+      aovs_(context, std::uint64_t(width) * height * gpu::kAovSlots * gpu::kAccumulatorVec4s * sizeof(glm::vec4),
             vk::BufferUsageFlagBits::eStorageBuffer, "primary.aovs") {
   scene.bindTo(kernel_);
   kernel_.bind(gpu::kBindingPassFirst, gbuffer_);

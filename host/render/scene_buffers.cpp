@@ -34,6 +34,14 @@ std::vector<gpu::BindingKind> sceneBindingKinds() {
           K::StorageBuffer,      K::StorageBuffer, K::StorageBuffer};
 }
 
+float sceneScale(const scene::Bounds& bounds) {
+  glm::vec3 e = bounds.extent();
+  float largest = std::max(e.x, std::max(e.y, e.z));
+  // Never above 1: for a large scene the paper's absolute step (1/65536 near the origin) is already
+  // negligible, and growing it would lift rays off fine detail (a 1 m object on a 2 km floor).
+  return largest > 0.0f && std::isfinite(largest) ? std::min(largest, 1.0f) : 1.0f;
+}
+
 void widenBox(glm::vec4& lo, glm::vec4& hi) {
   for (int k = 0; k < 3; ++k) {
     if (lo[k] > hi[k]) continue; // an empty child: left as it is (its ref is kInvalidIndex)

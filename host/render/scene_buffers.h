@@ -14,6 +14,10 @@ namespace obscura::render {
 // The BVH input for a scene: its triangles' world-space vertices in scene order.
 bvh::TriangleSoup triangleSoup(const scene::Scene& scene);
 
+// The scale of the ray-origin offset (shaders/lib/ray.glsl): the scene's largest bounding-box
+// extent, capped at 1 (the paper's constants are for unit scenes and only shrink for tiny ones).
+float sceneScale(const scene::Bounds& bounds);
+
 // a-bar of a material with its base colour factor [SPEC §1.2] (render/bsdf.h meanAlbedo).
 glm::vec3 materialMeanAlbedo(const scene::Material& material);
 

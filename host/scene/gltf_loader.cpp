@@ -168,6 +168,35 @@ bool keepEncodedImage(tinygltf::Image* image, const int imageIndex, std::string*
   return true;
 }
 
+// The GLB container, checked before tinygltf sees it: tinygltf 2.7's LoadBinaryFromMemory checks
+// the BIN chunk's length against the file without its 8-byte chunk header, so a chunk that claims
+// up to 8 bytes more than the file holds is read past the end of the buffer (found by
+// tests/fuzz, regression tests/fuzz/regressions/glb_bin_chunk_header_not_counted.glb).
+void checkGlbChunks(const std::string& path, const std::vector<unsigned char>& bytes) {
+  auto word = [&](std::size_t at) {
+    std::uint32_t v;
+    std::memcpy(&v, bytes.data() + at, 4);
+    return v; // GLB is little-endian, like every platform we build for
+  };
+  const auto fail = [&](const std::string& problem) { throw InputError(path + ": GLB: " + problem); };
+  if (bytes.size() < 20) fail("the file is shorter than the 20-byte GLB header and JSON chunk header");
+  const std::uint64_t length = word(8); // the header's total length
+  if (length > bytes.size()) {
+    fail("the header's length " + std::to_string(length) + " exceeds the file (" + std::to_string(bytes.size()) + " bytes)");
+  }
+  const std::uint64_t jsonEnd = 20ull + word(12);
+  if (jsonEnd > length) {
+    fail("the JSON chunk (" + std::to_string(word(12)) + " bytes) runs past the end (length " + std::to_string(length) + ")");
+  }
+  if (jsonEnd == length) return; // no BIN chunk
+  if (jsonEnd + 8 > length) fail("truncated chunk header after the JSON chunk");
+  const std::uint64_t binEnd = jsonEnd + 8 + word(static_cast<std::size_t>(jsonEnd));
+  if (binEnd > length) {
+    fail("the BIN chunk (" + std::to_string(word(static_cast<std::size_t>(jsonEnd))) + " bytes at offset " +
+         std::to_string(jsonEnd + 8) + ") runs past the end (length " + std::to_string(length) + ")");
+  }
+}
+
 tinygltf::Model parseModel(const std::string& path, std::vector<std::string>& warnings) {
   std::vector<unsigned char> bytes;
   if (!readFile(path, bytes)) {
@@ -186,6 +215,7 @@ tinygltf::Model parseModel(const std::string& path, std::vector<std::string>& wa
   std::string err, warn;
   bool ok = false;
   const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  if (binary) checkGlbChunks(path, bytes);
   try {
     const auto size = static_cast<unsigned int>(bytes.size());
     ok = binary ? parser.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), size, baseDir)

@@ -67,14 +67,15 @@ float gammaBound(float n) {
 // instead of max|z|: see triangleTError() in host/bvh/triangle_intersect.cpp for why). A hit
 // with t <= this bound may really lie behind the origin. Same expression, same order as there.
 float triangleTError(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy, float cz,
-                     float e0, float e1, float e2, float det) {
+                     float e0, float e1, float e2, float det, float zScale) {
   precise float maxZ = max(max(abs(az), abs(bz)), abs(cz));
   precise float spreadZ = max(max(az, bz), cz) - min(min(az, bz), cz);
   precise float deltaZ = gammaBound(3.0) * maxZ;
   precise float maxX = max(max(abs(ax), abs(bx)), abs(cx));
   precise float maxY = max(max(abs(ay), abs(by)), abs(cy));
-  precise float deltaX = gammaBound(5.0) * (maxX + maxZ);
-  precise float deltaY = gammaBound(5.0) * (maxY + maxZ);
+  precise float maxZUnscaled = maxZ / zScale; // x' = x - Sx z uses the unscaled z
+  precise float deltaX = gammaBound(5.0) * (maxX + maxZUnscaled);
+  precise float deltaY = gammaBound(5.0) * (maxY + maxZUnscaled);
   precise float deltaE = 2.0 * ((gammaBound(2.0) * maxX * maxY + deltaY * maxX) + deltaX * maxY);
   precise float maxE = max(max(abs(e0), abs(e1)), abs(e2));
   precise float bound = (3.0 * (gammaBound(3.0) * maxE * maxZ + deltaZ * maxE) + 6.0 * deltaE * spreadZ) * abs(1.0 / det);
@@ -114,7 +115,9 @@ bool intersectTriangle(WatertightRay r, vec3 p0, vec3 p1, vec3 p2, float tmin, f
   v = W / det;
   // A t that rounding could have made positive is no hit [PBR3 §3.9.5]: for a huge triangle the
   // error of t grows with its vertices, so the origin offset of a secondary ray cannot cover it.
-  float tError = triangleTError(Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz, U, V, W, det);
+  // |Sz|: rowZ holds Sz in one component and exact zeros elsewhere.
+  float zScale = max(max(abs(r.rowZ.x), abs(r.rowZ.y)), abs(r.rowZ.z));
+  float tError = triangleTError(Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz, U, V, W, det, zScale);
   return t > tmin && t > tError && t <= tmax;
 }
 

@@ -54,8 +54,10 @@ vec3 obscuranceReflectance(ShadingPoint sp) {
 }
 
 // One shadow ray: contribution (unit emission, before E_s) and the light it belongs to.
-// Light arriving below the geometric surface is dropped, so interpolated normals never leak
-// light through a surface.
+// Light arriving below the GEOMETRIC surface is dropped, so interpolated normals never leak light
+// through a surface; light above it but below the interpolated shading normal (the terminator of
+// a smooth low-poly mesh) uses |cos| with the shading normal, as pbrt does, so no facet turns
+// black while its geometry faces the light.
 void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, inout StepBudget budget,
                        out vec3 contribution, out uint light) {
   contribution = vec3(0.0);
@@ -63,7 +65,8 @@ void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, inout StepBudge
   light = ls.light;
   float cosG = dot(sp.ng, ls.wi);
   float cosS = dot(sp.ns, ls.wi);
-  if (cosG <= 0.0 || cosS <= 0.0 || all(equal(ls.weight, vec3(0.0)))) return;
+  if (cosG <= 0.0 || all(equal(ls.weight, vec3(0.0)))) return;
+  cosS = abs(cosS);
   vec3 origin = offsetRayOrigin(sp.position, sp.ng);
   vec3 direction = ls.wi;
   float tmax = 1.0 / 0.0;
@@ -77,7 +80,9 @@ void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, inout StepBudge
   }
   RayHit h = traceWithBudget(budget, origin, direction, 0.0, tmax, true);
   if (h.primitive != kInvalidIndex) return; // occluded (or truncated, reported by the caller)
-  contribution = shadingBsdf(sp, ls.wi) * ls.weight * cosS;
+  // The BSDF sees the light mirrored above the shading normal when it lies below it.
+  vec3 wiShading = dot(sp.ns, ls.wi) < 0.0 ? reflect(ls.wi, sp.ns) : ls.wi;
+  contribution = shadingBsdf(sp, wiShading) * ls.weight * cosS;
 }
 
 #endif

@@ -195,7 +195,8 @@ struct ShadePush {
   uvec4 counts; // 16: light count, shadow rays per hit, obscurance rays per hit, flags
   vec4 params;  // 32: dMax, tau, rho kind (as float), maximum path depth (as float)
   vec4 rAve;    // 48: R_ave rgb (the reflectance of a miss within dmax, SPEC §1.2), w = unused
-  vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = unused
+  vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = scene size
+                //     (largest bounding-box extent: scales the ray-origin offset, ray.glsl)
 };              // 80 bytes
 
 // ---- Bindings of the shading passes (after the scene's 0..5).
@@ -217,7 +218,7 @@ OBS_CONST uint kQueueHeader = 4;
 
 // ---- pathtrace.comp: push constants and its own bindings after the scene's (0..5).
 struct PathPush {
-  GpuCamera camera; // 0
+  GpuCamera camera; // 0: camera.right.w = scene size (scales the ray-origin offset, ray.glsl)
   uvec4 frame;      // 64: width, height, sample index, seed
   uvec4 params;     // 80: light count (0 = no light with power), max depth d, RR depth, strategy
 };                  // 96 bytes
@@ -243,8 +244,12 @@ struct ComposePush {
   vec4 ambient;    // 16: I_a(E) rgb, w = 1 when the specular buffers hold data
 };                 // 32 bytes
 
-// ---- Per-pixel AOV accumulation of primary.comp: kAovSlots vec4 per pixel, summed over samples
-// (slot kAovIds is written by sample 0 only).
+// ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,
+// then its Kahan compensation), so accumulation buffers hold kAccumulatorVec4s vec4 per entry.
+OBS_CONST uint kAccumulatorVec4s = 2;
+
+// ---- Per-pixel AOV accumulation of primary.comp: kAovSlots accumulators per pixel, summed over
+// samples (slot kAovIds is written by sample 0 only).
 OBS_CONST uint kAovAlbedo = 0;   // rgb albedo, a = coverage (1 on hit)
 OBS_CONST uint kAovNormal = 1;   // xyz shading normal, w = depth (distance from the camera)
 OBS_CONST uint kAovPosition = 2; // xyz world position, w = unused
