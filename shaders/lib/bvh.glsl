@@ -117,7 +117,10 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     }
   }
 
-  // The second loop. lavapipe's loop limiter counts the passes of both loops of the 8-lane group,
+  // The second loop repeats the first one's pass with an array stack. Factoring the common pass
+  // into a function (with an early return for any hit) measured 15 % slower on lavapipe (Sponza
+  // closest hit, ratio to Embree 0.330 -> 0.284), so the body is written twice on purpose.
+  // lavapipe's loop limiter counts the passes of both loops of the 8-lane group,
   // which ran the first loop for as many passes as its longest ray: an overflowed ray continues
   // counting from there, so the group stays within kMaxTraversalSteps passes in total.
   uint groupSteps = subgroupMax(hit.steps);
