@@ -18,6 +18,7 @@
 
 #include "bvh/bvh.h"
 #include "gpu_test.h"
+#include "render/test_scenes.h"
 #include "render/ray_tracer.h"
 #include "render/scene_buffers.h"
 #include "scene/gltf_loader.h"
@@ -27,41 +28,12 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// A scene made of a triangle soup, with one default material.
-scene::Scene soupScene(const bvh::TriangleSoup& soup) {
-  scene::Scene s;
-  for (std::size_t i = 0; i < soup.size(); ++i) {
-    auto base = static_cast<std::uint32_t>(s.positions.size());
-    for (glm::vec3 p : {soup.v0[i], soup.v1[i], soup.v2[i]}) {
-      s.positions.push_back(p);
-      s.normals.push_back(glm::vec3(0, 0, 1));
-      s.uvs.push_back(glm::vec2(0));
-      s.bounds.grow(p);
-    }
-    s.triangles.push_back(glm::uvec3(base, base + 1, base + 2));
-    s.triangleMaterial.push_back(0);
-    s.triangleLightGroup.push_back(gpu::kInvalidIndex);
-  }
-  s.materials.push_back({});
-  return s;
-}
 
 bvh::Ray cpuRay(const gpu::GpuRay& r) {
   return {glm::vec3(r.origin), glm::vec3(r.direction), r.origin.w, r.direction.w};
 }
 
 // Brute force on all cores: the oracle.
-std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vector<gpu::GpuRay>& rays) {
-  std::vector<bvh::Hit> out(rays.size());
-  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-  std::vector<std::thread> pool;
-  for (unsigned k = 0; k < threads; ++k)
-    pool.emplace_back([&, k] {
-      for (std::size_t i = k; i < rays.size(); i += threads) out[i] = bvh::closestHitBruteForce(soup, cpuRay(rays[i]));
-    });
-  for (auto& t : pool) t.join();
-  return out;
-}
 
 std::vector<bvh::Hit> cpuReference(const bvh::Bvh& tree, const std::vector<gpu::GpuRay>& rays) {
   std::vector<bvh::Hit> out(rays.size());

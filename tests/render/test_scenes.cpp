@@ -1,5 +1,8 @@
 #include "render/test_scenes.h"
 
+#include <algorithm>
+#include <thread>
+
 #include "shared/host_device.h"
 
 namespace obscura::test {
@@ -76,6 +79,39 @@ void SceneBuilder::directionalLight(glm::vec3 direction, glm::vec3 color, float 
 scene::Scene SceneBuilder::build() {
   if (scene_.materials.empty()) lambertian(glm::vec3(0.5f));
   return scene_;
+}
+
+scene::Scene soupScene(const bvh::TriangleSoup& soup) {
+  scene::Scene s;
+  for (std::size_t i = 0; i < soup.size(); ++i) {
+    auto base = static_cast<std::uint32_t>(s.positions.size());
+    for (glm::vec3 p : {soup.v0[i], soup.v1[i], soup.v2[i]}) {
+      s.positions.push_back(p);
+      s.normals.push_back(glm::vec3(0, 0, 1));
+      s.uvs.push_back(glm::vec2(0));
+      s.bounds.grow(p);
+    }
+    s.triangles.push_back(glm::uvec3(base, base + 1, base + 2));
+    s.triangleMaterial.push_back(0);
+    s.triangleLightGroup.push_back(gpu::kInvalidIndex);
+  }
+  s.materials.push_back({});
+  return s;
+}
+
+std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vector<gpu::GpuRay>& rays) {
+  std::vector<bvh::Hit> out(rays.size());
+  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  std::vector<std::thread> pool;
+  for (unsigned k = 0; k < threads; ++k)
+    pool.emplace_back([&, k] {
+      for (std::size_t i = k; i < rays.size(); i += threads) {
+        const auto& r = rays[i];
+        out[i] = bvh::closestHitBruteForce(soup, {glm::vec3(r.origin), glm::vec3(r.direction), r.origin.w, r.direction.w});
+      }
+    });
+  for (auto& t : pool) t.join();
+  return out;
 }
 
 scene::Camera lookCamera(glm::vec3 position, glm::vec3 forward, glm::vec3 up, float yfov) {

@@ -2,10 +2,13 @@
 // emissive quads (light groups), punctual lights.
 #pragma once
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
+#include "bvh/bvh.h"
 #include "scene/scene.h"
+#include "shared/host_device.h"
 
 namespace obscura::test {
 
@@ -23,6 +26,12 @@ public:
 private:
   scene::Scene scene_;
 };
+
+// A scene made of a triangle soup, with one default material.
+scene::Scene soupScene(const bvh::TriangleSoup& soup);
+
+// The oracle of the traversal tests: brute force over every triangle, on all cores.
+std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vector<gpu::GpuRay>& rays);
 
 // A camera at `position` looking along `forward` with the given vertical field of view.
 scene::Camera lookCamera(glm::vec3 position, glm::vec3 forward, glm::vec3 up, float yfov);
