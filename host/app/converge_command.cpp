@@ -258,8 +258,11 @@ void addConvergeCommand(CLI::App& app) {
   addDeviceOptions(*cmd, o->device);
   cmd->callback([o, cmd] {
     o->commandLine = "obscura converge";
-    for (const auto* opt : cmd->get_options())
-      if (opt->count() > 0 && !opt->get_name().empty()) o->commandLine += " " + opt->get_name() + " " + opt->as<std::string>();
+    for (const auto* opt : cmd->get_options()) {
+      if (opt->count() == 0 || opt->get_name().empty()) continue;
+      const bool positional = opt->get_lnames().empty() && opt->get_snames().empty();
+      o->commandLine += (positional ? " " : " " + opt->get_name() + " ") + opt->as<std::string>();
+    }
     runConverge(*o);
   });
 }
