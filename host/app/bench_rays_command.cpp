@@ -1,5 +1,5 @@
 // obscura bench-rays SCENE --rays N [--seed S] [--json] [--baseline embree] — traversal speed on
-// the GPU path with reproducible rays (see render/bench_rays.h), so other ray tracers can shoot the
+// the GPU path with reproducible rays (see bench/bench_rays.h), so other ray tracers can shoot the
 // same ones. --baseline embree traces the same rays with Embree 3 in the same process (when built
 // with it) and reports the ratio, which machine load affects on both sides alike.
 #include <cmath>
@@ -14,12 +14,12 @@
 #include "app/commands.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
-#include "render/bench_rays.h"
+#include "bench/bench_rays.h"
 #ifdef OBSCURA_HAVE_EMBREE
-#include "render/embree_baseline.h"
+#include "bench/embree_baseline.h"
 #endif
-#include "render/ray_tracer.h"
-#include "render/scene_buffers.h"
+#include "bench/ray_tracer.h"
+#include "render/scene/scene_buffers.h"
 
 namespace obscura::app {
 namespace {

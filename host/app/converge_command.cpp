@@ -16,8 +16,8 @@
 #include "app/scene_setup.h"
 #include "core/error.h"
 #include "io/image_io.h"
-#include "render/convergence.h"
-#include "render/image_error.h"
+#include "analysis/convergence.h"
+#include "analysis/image_error.h"
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
 

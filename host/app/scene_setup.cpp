@@ -4,7 +4,7 @@
 
 #include <fmt/core.h>
 
-#include "render/scene_buffers.h"
+#include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
 namespace obscura::app {

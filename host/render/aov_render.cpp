@@ -7,8 +7,8 @@
 
 #include "gpu/kernel.h"
 #include "gpu/timestamps.h"
-#include "render/primary_pass.h"
-#include "render/scene_buffers.h"
+#include "render/passes/primary_pass.h"
+#include "render/scene/scene_buffers.h"
 
 namespace obscura::render {
 

@@ -17,9 +17,9 @@
 #include "bvh/bvh.h"
 #include "gpu/context.h"
 #include "io/image_io.h"
-#include "render/ambient.h"
+#include "render/scene/ambient.h"
 #include "render/aov_render.h"
-#include "render/light_set.h"
+#include "render/scene/light_set.h"
 #include "scene/scene.h"
 
 namespace obscura::render {

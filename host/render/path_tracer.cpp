@@ -12,9 +12,9 @@
 #include "gpu/kernel.h"
 #include "gpu/timestamps.h"
 #include "pathtrace.spv.h"
-#include "render/light_set.h"
-#include "render/primary_pass.h"
-#include "render/scene_buffers.h"
+#include "render/scene/light_set.h"
+#include "render/passes/primary_pass.h"
+#include "render/scene/scene_buffers.h"
 
 namespace obscura::render {
 namespace {

@@ -19,8 +19,8 @@
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "render/test_scenes.h"
-#include "render/ray_tracer.h"
-#include "render/scene_buffers.h"
+#include "bench/ray_tracer.h"
+#include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
 namespace obscura::test {

@@ -8,7 +8,7 @@
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "render/aov_render.h"
-#include "render/scene_buffers.h"
+#include "render/scene/scene_buffers.h"
 #include "render/test_scenes.h"
 
 namespace obscura::test {

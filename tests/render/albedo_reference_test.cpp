@@ -9,7 +9,7 @@
 #include "gpu_test.h"
 #include "io/image_io.h"
 #include "render/aov_render.h"
-#include "render/scene_buffers.h"
+#include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
 namespace obscura::test {

@@ -13,9 +13,9 @@
 #include "gpu_test.h"
 #include "render/test_scenes.h"
 #include "loop_limit_test.spv.h"
-#include "render/bench_rays.h"
-#include "render/ray_tracer.h"
-#include "render/scene_buffers.h"
+#include "bench/bench_rays.h"
+#include "bench/ray_tracer.h"
+#include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
 namespace obscura::test {

@@ -1,6 +1,6 @@
 #version 460
 // Runs the production bsdf.glsl (and the GGX part of sampling.glsl) so tests/shaders/bsdf_test.cpp
-// can compare it with the C++ twins (host/render/bsdf.h) and check sampleBsdf's distribution.
+// can compare it with the C++ twins (host/shading/bsdf.h) and check sampleBsdf's distribution.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/rng.glsl"

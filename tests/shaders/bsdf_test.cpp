@@ -1,4 +1,4 @@
-// The production bsdf.glsl on lavapipe against its C++ twin (host/render/bsdf.h): eval, pdf and
+// The production bsdf.glsl on lavapipe against its C++ twin (host/shading/bsdf.h): eval, pdf and
 // sample agree on random inputs; a sample's weight is eval cos / pdf; sampleBsdf's directions follow
 // bsdfPdf (chi-square), with the mass that falls below the horizon reported as "no sample".
 #include <algorithm>
@@ -10,7 +10,7 @@
 
 #include "bsdf_test.spv.h"
 #include "gpu_test.h"
-#include "render/bsdf.h"
+#include "shading/bsdf.h"
 #include "shaders/shader_runner.h"
 
 #include "chi_square.h"

@@ -1,6 +1,6 @@
 // The production sampling.glsl on lavapipe: its warps follow their pdfs (chi-square), systematic
 // sampling puts one ray in each cell [RTO §4.2, SPEC §1.4], the warps invert, and the GPU agrees
-// with the C++ twins (host/render/bsdf.h).
+// with the C++ twins (host/shading/bsdf.h).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "gpu_test.h"
-#include "render/bsdf.h"
+#include "shading/bsdf.h"
 #include "sampling_test.spv.h"
 #include "chi_square.h"
 #include "shaders/shader_runner.h"

@@ -1,4 +1,4 @@
-#include "render/ambient.h"
+#include "render/scene/ambient.h"
 
 #include <cmath>
 #include <numbers>

@@ -6,7 +6,7 @@
 
 #include "gpu/kernel.h"
 #include "gpu/timestamps.h"
-#include "render/scene_buffers.h"
+#include "render/scene/scene_buffers.h"
 
 namespace obscura::render {
 

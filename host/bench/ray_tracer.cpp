@@ -1,4 +1,4 @@
-#include "render/ray_tracer.h"
+#include "bench/ray_tracer.h"
 
 #include <algorithm>
 

@@ -12,7 +12,7 @@
 
 #include <glm/glm.hpp>
 
-#include "render/light_set.h"
+#include "render/scene/light_set.h"
 #include "scene/scene.h"
 
 namespace obscura::render {

@@ -1,4 +1,4 @@
-#include "render/image_error.h"
+#include "analysis/image_error.h"
 
 #include <gtest/gtest.h>
 

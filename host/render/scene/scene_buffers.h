@@ -18,7 +18,7 @@ bvh::TriangleSoup triangleSoup(const scene::Scene& scene);
 // extent, capped at 1 (the paper's constants are for unit scenes and only shrink for tiny ones).
 float sceneScale(const scene::Bounds& bounds);
 
-// a-bar of a material with its base colour factor [SPEC §1.2] (render/bsdf.h meanAlbedo).
+// a-bar of a material with its base colour factor [SPEC §1.2] (shading/bsdf.h meanAlbedo).
 glm::vec3 materialMeanAlbedo(const scene::Material& material);
 
 // Widens a box outward by one ulp on every face (conservative: never loses a hit). The GPU slab

@@ -1,4 +1,4 @@
-#include "render/scene_buffers.h"
+#include "render/scene/scene_buffers.h"
 
 #include <bit>
 #include <cmath>
@@ -8,8 +8,8 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
-#include "render/bsdf.h"
-#include "render/texture_fit.h"
+#include "shading/bsdf.h"
+#include "render/scene/texture_fit.h"
 
 namespace obscura::render {
 

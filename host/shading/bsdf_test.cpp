@@ -1,7 +1,7 @@
-// The C++ BSDF twin (render/bsdf.h) against analytic answers and brute-force integrals: the
+// The C++ BSDF twin (shading/bsdf.h) against analytic answers and brute-force integrals: the
 // Lambertian case, reciprocity, the pdf's normalisation, white furnaces and the mean albedo ā
 // [SPEC §1.2, §5]. tests/shaders/bsdf_test.cpp checks that the GLSL agrees with this twin.
-#include "render/bsdf.h"
+#include "shading/bsdf.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "render/texture_fit.h"
+#include "render/scene/texture_fit.h"
 
 #include <gtest/gtest.h>
 

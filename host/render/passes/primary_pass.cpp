@@ -1,4 +1,4 @@
-#include "render/primary_pass.h"
+#include "render/passes/primary_pass.h"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "render/convergence.h"
+#include "analysis/convergence.h"
 
 #include <cmath>
 

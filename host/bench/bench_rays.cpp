@@ -1,4 +1,4 @@
-#include "render/bench_rays.h"
+#include "bench/bench_rays.h"
 
 #include <cmath>
 #include <fstream>

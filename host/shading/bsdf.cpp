@@ -1,4 +1,4 @@
-#include "render/bsdf.h"
+#include "shading/bsdf.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 #ifdef OBSCURA_HAVE_EMBREE
-#include "render/embree_baseline.h"
+#include "bench/embree_baseline.h"
 
 #include <algorithm>
 #include <atomic>
