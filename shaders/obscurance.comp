@@ -17,15 +17,16 @@
 #include "lib/shade.glsl"
 #include "lib/obscurance.glsl"
 #include "lib/accumulate.glsl"
+#include "lib/band.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
 void main() {
   gSceneScale = pc.eye.w;
-  uvec2 size = pc.frame.xy;
-  uvec2 p = gl_GlobalInvocationID.xy;
-  if (p.x >= size.x || p.y >= size.y) return;
-  uint pixel = p.y * size.x + p.x;
+  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, pc.frame.xy, pc.band.xy);
+  if (!bp.inside) return;
+  uvec2 p = bp.frame;
+  uint pixel = bp.index;
   GBufferTexel g = gbuffer[pixel];
   if (g.albedo.a == 0.0) return;
 

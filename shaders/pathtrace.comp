@@ -59,6 +59,7 @@ layout(std430, set = 0, binding = kBindingPathScales) readonly buffer ScaleBuffe
 #include "lib/shade.glsl"
 #include "lib/mis.glsl"
 #include "lib/accumulate.glsl"
+#include "lib/band.glsl"
 
 // OURS: the largest survival probability of Russian roulette (see the header).
 const float kRrMaxSurvival = 0.95;
@@ -74,9 +75,10 @@ float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
 void main() {
   gSceneScale = pc.camera.right.w;
   uvec2 size = pc.frame.xy;
-  uvec2 p = gl_GlobalInvocationID.xy;
-  if (p.x >= size.x || p.y >= size.y) return;
-  uint pixel = p.y * size.x + p.x;
+  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, size, pc.band.xy);
+  if (!bp.inside) return;
+  uvec2 p = bp.frame;
+  uint pixel = bp.index;
   const uint lightCount = pc.params.x;
   const uint maxDepth = pc.params.y;
   const uint rrDepth = pc.params.z;

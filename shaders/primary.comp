@@ -11,11 +11,14 @@
 #include "lib/rng.glsl"
 #include "lib/camera.glsl"
 #include "lib/accumulate.glsl"
+#include "lib/band.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 layout(push_constant) uniform Push { PrimaryPush pc; };
-layout(std430, set = 0, binding = kBindingPassFirst) writeonly buffer GBuffer { GBufferTexel gbuffer[]; };
-layout(std430, set = 0, binding = kBindingPassFirst + 1) buffer AovBuffer { vec4 aov[]; };
+layout(std430, set = 0, binding = kBindingPrimaryGBuffer) writeonly buffer GBuffer { GBufferTexel gbuffer[]; };
+layout(std430, set = 0, binding = kBindingPrimaryAovs) buffer AovBuffer { vec4 aov[]; };
+layout(std430, set = 0, binding = kBindingPrimaryLightScales) readonly buffer LightScales { vec4 lightScales[]; };
+layout(std430, set = 0, binding = kBindingPrimaryEmissionBasis) buffer EmissionBasis { vec4 emissionBasis[]; };
 
 void accumulate(uint pixel, uint slot, vec4 value, bool first) {
   uint i = pixel * kAovSlots + slot;
@@ -24,11 +27,15 @@ void accumulate(uint pixel, uint slot, vec4 value, bool first) {
 
 void main() {
   uvec2 size = pc.frame.xy;
-  uvec2 p = gl_GlobalInvocationID.xy;
-  if (p.x >= size.x || p.y >= size.y) return;
-  uint pixel = p.y * size.x + p.x;
+  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, size, pc.band.xy);
+  if (!bp.inside) return;
+  uvec2 p = bp.frame;
+  uint pixel = bp.index;
   uint sampleIndex = pc.frame.z;
   bool first = sampleIndex == 0u;
+  const uint lightCount = pc.band.z;
+  const bool accumulateSums = (pc.band.w & kPrimaryFlagGBufferOnly) == 0u;
+  const bool accumulateAovs = accumulateSums && (pc.band.w & kPrimaryFlagNoAovs) == 0u;
 
   uint rng = rngSeed(p, 0u, pc.frame.w); // the shift is per pixel, fixed over samples
   vec2 shift = vec2(rngNext(rng), rngNext(rng));
@@ -41,6 +48,8 @@ void main() {
 
   GBufferTexel g;
   vec3 preview = vec3(0.0);
+  uint lightGroup = kInvalidIndex;
+  vec3 unitSeen = vec3(0.0);
   if (rayHitValid(hit) && hit.primitive != kInvalidIndex) {
     Surface s = surfaceAt(hit, origin, direction);
     GpuMaterial m = materials[s.material];
@@ -52,6 +61,8 @@ void main() {
     g.shadingNormal = vec4(s.shadingNormal, uintBitsToFloat(s.material));
     g.albedo = vec4(albedo, 1.0);
     g.emission = vec4(emission, 0.0);
+    lightGroup = s.lightGroup;
+    if (lightGroup != kInvalidIndex) unitSeen = unitEmission(emission, lightScales[lightGroup].rgb);
     // A light at the eye: enough to see shapes before any lighting pass runs.
     preview = albedo * abs(dot(s.shadingNormal, direction)) + emission;
   } else {
@@ -62,7 +73,17 @@ void main() {
     g.emission = vec4(0.0);
   }
   gbuffer[pixel] = g;
+  if (!accumulateSums) return;
 
+  // M_s: the emission the camera sees, per light at unit emission, so that relighting scales a
+  // lamp the camera looks at with its light [SPEC §3]. Sample 0 starts every light's sum.
+  for (uint s = 0u; s < lightCount; ++s) {
+    vec4 seen = vec4(s == lightGroup ? unitSeen : vec3(0.0), 0.0);
+    if (first) OBS_ACCUMULATE_FIRST(emissionBasis, s * bp.count + pixel, seen)
+    else if (s == lightGroup) OBS_ACCUMULATE(emissionBasis, s * bp.count + pixel, seen)
+  }
+
+  if (!accumulateAovs) return;
   accumulate(pixel, kAovAlbedo, g.albedo, first);
   accumulate(pixel, kAovNormal, vec4(g.shadingNormal.xyz, g.position.w), first);
   accumulate(pixel, kAovPosition, vec4(g.position.xyz, 0.0), first);

@@ -24,6 +24,7 @@
 #include "lib/shade.glsl"
 #include "lib/obscurance.glsl"
 #include "lib/accumulate.glsl"
+#include "lib/band.glsl"
 
 layout(local_size_x = kWorkgroupSize1D) in;
 
@@ -49,8 +50,9 @@ void main() {
   if (entry >= queue[kQueueCount]) return;
   uint pixel = queue[kQueueHeader + entry];
   uvec2 size = pc.frame.xy;
-  uvec2 p = uvec2(pixel % size.x, pixel / size.x);
-  uint pixelCount = size.x * size.y;
+  BandPixel bp = bandPixelFromIndex(pixel, size, pc.band.xy);
+  uvec2 p = bp.frame;
+  uint pixelCount = bp.count;
   const uint lightCount = pc.counts.x;
   const uint shadowRays = lightCount > 0u ? pc.counts.y : 0u;
   const uint maxDepth = uint(pc.params.w);
@@ -80,8 +82,7 @@ void main() {
     vec3 baseColor = materialBaseColor(m, s.uv).rgb;
     if (delta && s.lightGroup != kInvalidIndex) {
       // Seen emission in unit-emission terms: divided by the group's E_s (1 where E_s is 0).
-      vec3 scale = lightScales[s.lightGroup].rgb;
-      vec3 unit = materialEmission(m, s.uv, s.frontFacing) / mix(scale, vec3(1.0), equal(scale, vec3(0.0)));
+      vec3 unit = unitEmission(materialEmission(m, s.uv, s.frontFacing), lightScales[s.lightGroup].rgb);
       OBS_ACCUMULATE(specularBasis, s.lightGroup * pixelCount + pixel, vec4(throughput * unit, 0.0))
     }
     sp = shadingPoint(s.position, s.geometricNormal, s.shadingNormal, -wi, baseColor, s.material);

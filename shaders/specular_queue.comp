@@ -6,14 +6,15 @@
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
 #include "lib/shading_bindings.glsl"
+#include "lib/band.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
 void main() {
-  uvec2 size = pc.frame.xy;
-  uvec2 p = gl_GlobalInvocationID.xy;
-  if (p.x >= size.x || p.y >= size.y) return;
-  uint pixel = p.y * size.x + p.x;
+  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, pc.frame.xy, pc.band.xy);
+  if (!bp.inside) return;
+  uvec2 p = bp.frame;
+  uint pixel = bp.index;
   GBufferTexel g = gbuffer[pixel];
   if (g.albedo.a == 0.0 || materials[floatBitsToUint(g.shadingNormal.w)].params.w == 0.0) return;
   uint slot = atomicAdd(queue[kQueueCount], 1u);

@@ -18,5 +18,6 @@ void addRenderCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addBenchRaysCommand(CLI::App& app);
 void addConvergeCommand(CLI::App& app);
+void addRelightCommand(CLI::App& app);
 
 } // namespace obscura::app

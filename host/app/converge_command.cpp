@@ -6,6 +6,7 @@
 // tracing at the paper's budget, the obscurance bias floor, and when path tracing beats it.
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <sstream>
 
@@ -73,14 +74,18 @@ public:
     stem_ = fs::path(o.scenePath).stem().string();
   }
 
-  Rendered render(const Method& m, std::uint32_t spp, std::uint32_t seed) const {
+  // Renders with the study's persistent renderers: the scene is uploaded and the pipelines are
+  // made once per method family, not once per render.
+  Rendered render(const Method& m, std::uint32_t spp, std::uint32_t seed) {
     Rendered r;
     const render::RenderStats* stats = nullptr;
     if (m.pathTrace) {
       render::PathTraceSettings s{.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_};
-      auto result = render::renderPathTraced(context_, loaded_.scene, loaded_.bvh, s);
-      r.image = std::move(result.image);
-      statsCopy_ = result.stats;
+      if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, loaded_.scene, loaded_.bvh, s);
+      pathTracer_->configure(s);
+      pathTracer_->render();
+      r.image = pathTracer_->image();
+      statsCopy_ = pathTracer_->stats();
     } else {
       render::ObscuranceSettings s;
       s.width = width_;
@@ -92,9 +97,12 @@ public:
       s.obscuranceRays = kPaperRays;
       s.rho = m.rho;
       s.systematic = m.systematic;
-      auto result = render::renderObscurances(context_, loaded_.scene, loaded_.bvh, s);
-      r.image = std::move(result.image);
-      statsCopy_ = result.stats;
+      if (!obscurance_)
+        obscurance_ = std::make_unique<render::ObscuranceRenderer>(context_, loaded_.scene, loaded_.bvh, s);
+      obscurance_->configure(s);
+      obscurance_->render();
+      r.image = obscurance_->image();
+      statsCopy_ = obscurance_->stats();
     }
     stats = &statsCopy_;
     if (stats->truncatedTraversals) throw DeviceError("traversals were truncated; the study would be wrong");
@@ -107,7 +115,7 @@ public:
   }
 
   // The converged image of a method, from the cache when the same settings made it.
-  io::Image reference(const Method& m) const {
+  io::Image reference(const Method& m) {
     std::uint32_t spp = m.pathTrace ? (o_.pathReferenceSpp ? o_.pathReferenceSpp : o_.referenceFactor * o_.pathMaxSpp)
                                     : o_.referenceFactor * o_.obscuranceMaxSpp;
     fs::path exr = fs::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
@@ -154,6 +162,8 @@ private:
   const ConvergeOptions& o_;
   const LoadedScene& loaded_;
   const gpu::Context& context_;
+  std::unique_ptr<render::ObscuranceRenderer> obscurance_;
+  std::unique_ptr<render::PathTracer> pathTracer_;
   scene::Camera camera_;
   std::uint32_t width_ = 0, height_ = 0;
   std::string stem_;

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   obscura::app::addInfoCommand(app);
   obscura::app::addBenchRaysCommand(app);
   obscura::app::addConvergeCommand(app);
+  obscura::app::addRelightCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -10,58 +10,18 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/render_options.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
 #include "gpu/buffer.h"
 #include "io/image_io.h"
-#include "render/aov_render.h"
+#include "render/aovs.h"
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
+#include "relight/relight_state.h"
 
 namespace obscura::app {
 namespace {
-
-struct RenderOptions {
-  std::string scenePath;
-  std::string output;
-  std::uint32_t width = 0, height = 0; // 0 = from the camera's aspect, 512 on the long side
-  std::uint32_t spp = 4;
-  std::uint32_t seed = 1;
-  int camera = -1;
-  std::vector<std::string> aovs;
-  std::string metrics;
-  float exposure = 0.0f;
-  std::string method = "obscurance";
-  render::ObscuranceSettings obscurance;
-  std::string rho = "sqrt";
-  std::string sampling = "systematic";
-  bool noBleed = false;
-  float dMax = 0.0f;
-  bool dMaxGiven = false;
-  DeviceOptions device;
-};
-
-scene::Camera chooseCamera(const scene::Scene& scene, int index) {
-  if (index >= 0) {
-    if (index >= static_cast<int>(scene.cameras.size()))
-      throw InputError(fmt::format("--camera {}: the scene {} has {} cameras", index, scene.sourcePath,
-                                   scene.cameras.size()));
-    return scene.cameras[index];
-  }
-  return scene.cameras.empty() ? scene::defaultCamera(scene.bounds) : scene.cameras.front();
-}
-
-void chooseSize(RenderOptions& o, const scene::Camera& camera) {
-  float aspect = camera.aspectRatio > 0.0f ? camera.aspectRatio : 1.0f;
-  if (o.width == 0 && o.height == 0) {
-    o.width = aspect >= 1.0f ? 512u : static_cast<std::uint32_t>(std::lround(512.0f * aspect));
-    o.height = aspect >= 1.0f ? static_cast<std::uint32_t>(std::lround(512.0f / aspect)) : 512u;
-  } else if (o.height == 0) {
-    o.height = std::max(1u, static_cast<std::uint32_t>(std::lround(static_cast<float>(o.width) / aspect)));
-  } else if (o.width == 0) {
-    o.width = std::max(1u, static_cast<std::uint32_t>(std::lround(static_cast<float>(o.height) * aspect)));
-  }
-}
 
 // Keeps only the requested AOVs' channels (all when none requested).
 io::Image selectAovs(const io::Image& all, const std::vector<std::string>& aovs) {
@@ -117,8 +77,10 @@ void writeMetrics(const std::string& path, const nlohmann::json& json) {
 }
 
 // Writes the image (EXR layers or PNG of one AOV) and the metrics; fails on truncated traversals.
+// `display`, when given, is the GPU-tonemapped combined image, written as the PNG of `combined`.
 void writeOutputs(const RenderOptions& o, const io::Image& image, const render::RenderStats& stats,
-                  const gpu::Context& context, const LoadedScene& loaded, const nlohmann::json& method) {
+                  const gpu::Context& context, const LoadedScene& loaded, const nlohmann::json& method,
+                  const std::vector<std::uint32_t>* display = nullptr) {
   for (const auto& note : stats.notes) fmt::print(stderr, "note: {}\n", note);
   if (stats.truncatedTraversals > 0)
     throw DeviceError(fmt::format("{} traversals ran out of steps (kMaxTraversalSteps); the image would be wrong",
@@ -127,6 +89,8 @@ void writeOutputs(const RenderOptions& o, const io::Image& image, const render::
   io::Image selected = selectAovs(image, o.aovs);
   if (io::extensionOf(o.output) == "exr") {
     io::writeExr(o.output, selected);
+  } else if (display && (o.aovs.empty() || o.aovs.front() == "combined")) {
+    io::writePngRgba8(o.output, image.width, image.height, *display);
   } else {
     std::string first = o.aovs.empty() ? "combined" : o.aovs.front();
     const auto channels = render::aovChannels(first);
@@ -173,8 +137,7 @@ void runRender(RenderOptions& o) {
   for (const auto& aov : o.aovs)
     if (std::find(known.begin(), known.end(), aov) == known.end())
       throw InputError(fmt::format("--aov {}: unknown AOV (known: {})", aov, fmt::join(known, ", ")));
-  if (o.dMaxGiven && !(std::isfinite(o.dMax) && o.dMax > 0.0f))
-    throw InputError(fmt::format("--dmax {}: must be a finite positive distance in scene units", o.dMax));
+  checkRenderOptions(o);
   if (!o.metrics.empty()) checkWritable(o.metrics);
 
   LoadedScene loaded = loadScene(o.scenePath);
@@ -183,28 +146,9 @@ void runRender(RenderOptions& o) {
   fmt::print(stderr, "{}\n", sceneSummary(loaded));
 
   gpu::Context context(o.device.contextOptions());
-  const std::size_t lightCount = loaded.scene.lightGroups.size() + loaded.scene.punctualLights.size();
-  std::uint64_t need = render::obscuranceBytesNeeded(o.width, o.height, lightCount);
-  std::uint64_t largest = render::obscuranceLargestBuffer(o.width, o.height, lightCount);
-  if (need > context.info().deviceLocalBytes || largest > context.info().maxStorageBufferRange)
-    throw InputError(fmt::format("{}x{}: the frame buffers would need {:.1f} MiB (the largest one {:.1f} MiB), more "
-                                 "than the device '{}' offers ({:.0f} MiB, {:.0f} MiB per buffer)",
-                                 o.width, o.height, static_cast<double>(need) / 1048576.0,
-                                 static_cast<double>(largest) / 1048576.0, context.info().name,
-                                 static_cast<double>(context.info().deviceLocalBytes) / 1048576.0,
-                                 static_cast<double>(context.info().maxStorageBufferRange) / 1048576.0));
   fmt::print(stderr, "device: {} ({})\n", context.info().name, context.info().driver);
 
-  render::ObscuranceSettings settings = o.obscurance;
-  settings.width = o.width;
-  settings.height = o.height;
-  settings.spp = o.spp;
-  settings.seed = o.seed;
-  settings.camera = camera;
-  settings.dMax = o.dMax;
-  settings.rho = o.rho == "exp" ? render::RhoKind::Exp : o.rho == "ao" ? render::RhoKind::Ao : render::RhoKind::Sqrt;
-  settings.systematic = o.sampling == "systematic";
-  settings.colourBleeding = !o.noBleed;
+  render::ObscuranceSettings settings = obscuranceSettings(o, camera);
   const bool tty = ::isatty(STDERR_FILENO);
   const std::uint64_t raysPerSample = std::uint64_t(o.width) * o.height *
                                       (1 + settings.shadowRays + settings.obscuranceRays);
@@ -212,28 +156,50 @@ void runRender(RenderOptions& o) {
       tty ? render::ProgressFn([&](auto d, auto t, auto s) { printProgress(d, t, s, raysPerSample); })
           : render::ProgressFn();
   if (o.method == "pathtrace") {
+    if (!o.saveState.empty())
+      throw InputError("--save-state: only the obscurance method keeps per-light transport (--method obscurance)");
     render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
                                  .camera = camera, .maxDepth = settings.maxDepth};
-    render::PathTraceResult traced = render::renderPathTraced(context, loaded.scene, loaded.bvh, pt, progress);
-    writeOutputs(o, traced.image, traced.stats, context, loaded, {{"method", "pathtrace"}, {"max_depth", pt.maxDepth}});
+    render::PathTracer tracer(context, loaded.scene, loaded.bvh, pt);
+    tracer.render(progress);
+    writeOutputs(o, tracer.image(), tracer.stats(), context, loaded, {{"method", "pathtrace"}, {"max_depth", pt.maxDepth}});
     return;
   }
-  render::ObscuranceResult result = render::renderObscurances(context, loaded.scene, loaded.bvh, settings, progress);
-  render::RenderStats& stats = result.stats;
-  io::Image& image = result.image;
-  const glm::vec3 ia = result.ambientIntensity, rAve = result.ambient.averageReflectance;
+  // Only what the output shows is kept: a PNG of combined needs neither the primary AOVs nor the
+  // other composed ones (a 4K frame then fits lavapipe's 2 GiB).
+  const bool exr = io::extensionOf(o.output) == "exr";
+  const std::vector<std::string> wanted = o.aovs.empty() ? (exr ? render::obscuranceAovNames()
+                                                                : std::vector<std::string>{"combined"})
+                                                         : o.aovs;
+  const auto& primaryNames = render::aovNames();
+  settings.primaryAovs = std::any_of(wanted.begin(), wanted.end(), [&](const std::string& a) {
+    return a != "emission" && std::find(primaryNames.begin(), primaryNames.end(), a) != primaryNames.end();
+  });
+  settings.composedAovs = std::any_of(wanted.begin(), wanted.end(), [](const std::string& a) { return a != "combined"; });
+  render::ObscuranceRenderer renderer(context, loaded.scene, loaded.bvh, settings);
+  renderer.reset();
+  renderer.iterate(settings.spp, progress);
+  renderer.compose(o.exposure);
+  const render::RenderStats stats = renderer.stats();
+  io::Image image = renderer.image();
+  // The EXR carries one layer per light group (light.<name>), so that a compositor can relight it.
+  if (io::extensionOf(o.output) == "exr" && o.aovs.empty()) appendChannels(image, renderer.lightLayers());
+  const std::vector<std::uint32_t> display = renderer.display();
+  const glm::vec3 ia = renderer.ambientIntensity(), rAve = renderer.ambient().averageReflectance;
   fmt::print(stderr, "obscurance: dmax {:.4g}, rho {}, {} sampling, {}; R_ave ({:.4f}, {:.4f}, {:.4f}), "
-                     "I_a ({:.4g}, {:.4g}, {:.4g}); {} lights\n",
-             result.dMax, o.rho, o.sampling, o.noBleed ? "grey" : "colour bleeding", rAve.x, rAve.y, rAve.z,
-             ia.x, ia.y, ia.z, result.lights.size());
-  if (result.ambient.reflectanceClamped)
+                     "I_a ({:.4g}, {:.4g}, {:.4g}); {} lights; frame in {} band(s)\n",
+             renderer.dMax(), o.rho, o.sampling, o.noBleed ? "grey" : "colour bleeding", rAve.x, rAve.y, rAve.z,
+             ia.x, ia.y, ia.z, renderer.lights().size(), renderer.layout().bandCount());
+  if (renderer.ambient().reflectanceClamped)
     fmt::print(stderr, "note: the average reflectance reaches 1; it was clamped to 0.999 (I_a would be infinite)\n");
+  if (!o.saveState.empty()) relight::saveState(o.saveState, renderer, o.scenePath);
   writeOutputs(o, image, stats, context, loaded,
-               {{"method", o.method}, {"dmax", result.dMax}, {"rho", o.rho}, {"tau", settings.tau},
+               {{"method", o.method}, {"dmax", renderer.dMax()}, {"rho", o.rho}, {"tau", settings.tau},
                 {"sampling", o.sampling}, {"colour_bleeding", !o.noBleed}, {"max_depth", settings.maxDepth},
                 {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
                 {"r_ave", {rAve.x, rAve.y, rAve.z}}, {"ambient_intensity", {ia.x, ia.y, ia.z}},
-                {"lights", result.lights.names}});
+                {"lights", renderer.lights().names}, {"bands", renderer.layout().bandCount()}},
+               &display);
 }
 
 } // namespace
@@ -243,32 +209,13 @@ void addRenderCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render", "Render a glTF scene headless to EXR (all AOVs) or PNG");
   cmd->add_option("scene", options->scenePath, "glTF 2.0 scene (.gltf or .glb)")->required();
   cmd->add_option("-o,--output", options->output, "output image, .exr (AOV layers) or .png (tonemapped)")->required();
-  cmd->add_option("--width", options->width, "image width in pixels (default: 512 on the long side)")
-      ->check(CLI::Range(1u, 16384u));
-  cmd->add_option("--height", options->height, "image height in pixels")->check(CLI::Range(1u, 16384u));
-  cmd->add_option("--spp", options->spp, "primary samples per pixel")->check(CLI::Range(1u, 1u << 20));
-  cmd->add_option("--seed", options->seed, "random seed (same seed, same image)");
-  cmd->add_option("--camera", options->camera, "index of the glTF camera to use (default: the first)")
-      ->check(CLI::NonNegativeNumber);
+  addRenderOptions(*cmd, *options);
   cmd->add_option("--aov", options->aovs, "AOV(s) to write; the first goes to PNG (default: all / preview)");
   cmd->add_option("--exposure", options->exposure, "PNG exposure in stops");
   cmd->add_option("--metrics", options->metrics, "write device, scene, BVH and per-pass figures as JSON");
-  cmd->add_option("--method", options->method, "obscurance (ray-traced obscurances) or pathtrace (the reference)")
-      ->check(CLI::IsMember({"obscurance", "pathtrace"}));
-  cmd->add_option("--max-depth", options->obscurance.maxDepth,
-                  "path depth in scattering vertices (specular paths; path tracing), default 6")
-      ->check(CLI::Range(1u, 1024u));
-  cmd->add_option("--shadow-rays", options->obscurance.shadowRays, "shadow rays per hit (N_s)")
-      ->check(CLI::Range(0u, 1024u));
-  cmd->add_option("--obs-rays", options->obscurance.obscuranceRays, "obscurance rays per hit (N_obs)")
-      ->check(CLI::Range(0u, 1024u));
-  cmd->add_option("--rho", options->rho, "rho(d): sqrt (the paper's), exp, ao")->check(CLI::IsMember({"sqrt", "exp", "ao"}));
-  cmd->add_option("--tau", options->obscurance.tau, "tau of --rho exp")->check(CLI::PositiveNumber);
-  cmd->add_option("--dmax", options->dMax, "dmax in scene units (default: 1/4 of the largest bounding-box extent)")
-      ->each([options](const std::string&) { options->dMaxGiven = true; });
-  cmd->add_option("--sampling", options->sampling, "obscurance rays: systematic (default) or random")
-      ->check(CLI::IsMember({"systematic", "random"}));
-  cmd->add_flag("--no-bleed", options->noBleed, "grey obscurance W instead of colour bleeding W_c");
+  cmd->add_option("--save-state", options->saveState,
+                  "write the relighting state to this folder (per-light transport as EXR layers + JSON), for "
+                  "'obscura relight DIR'");
   addDeviceOptions(*cmd, options->device);
   cmd->callback([options] { runRender(*options); });
 }

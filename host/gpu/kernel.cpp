@@ -1,5 +1,6 @@
 #include "gpu/kernel.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include <fmt/core.h>
@@ -56,23 +57,32 @@ Kernel::Kernel(const Context& context, const KernelDesc& desc)
 
   std::uint32_t storage = 0, texel = 0;
   for (auto kind : bindings_) (kind == BindingKind::StorageBuffer ? storage : texel)++;
+  const std::uint32_t setCount = std::max(desc.setCount, 1u);
   std::vector<vk::DescriptorPoolSize> sizes;
-  if (storage) sizes.push_back({.type = vk::DescriptorType::eStorageBuffer, .descriptorCount = storage});
-  if (texel) sizes.push_back({.type = vk::DescriptorType::eUniformTexelBuffer, .descriptorCount = texel});
+  if (storage) sizes.push_back({.type = vk::DescriptorType::eStorageBuffer, .descriptorCount = storage * setCount});
+  if (texel) sizes.push_back({.type = vk::DescriptorType::eUniformTexelBuffer, .descriptorCount = texel * setCount});
   pool_ = device.createDescriptorPool({.flags = vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
-                                       .maxSets = 1,
+                                       .maxSets = setCount,
                                        .poolSizeCount = static_cast<std::uint32_t>(sizes.size()),
                                        .pPoolSizes = sizes.data()});
-  vk::raii::DescriptorSets sets(device, {.descriptorPool = *pool_, .descriptorSetCount = 1, .pSetLayouts = &rawLayout});
-  set_ = std::move(sets.front());
+  std::vector<vk::DescriptorSetLayout> layouts(setCount, rawLayout);
+  vk::raii::DescriptorSets sets(device, {.descriptorPool = *pool_, .descriptorSetCount = setCount,
+                                         .pSetLayouts = layouts.data()});
+  for (auto& set : sets) sets_.push_back(std::move(set));
 }
 
-void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
+const vk::raii::DescriptorSet& Kernel::descriptorSet(std::uint32_t set) const {
+  if (set >= sets_.size())
+    throw std::logic_error(fmt::format("{}: descriptor set {} of {}", name_, set, sets_.size()));
+  return sets_[set];
+}
+
+void Kernel::bind(std::uint32_t binding, const Buffer& buffer, std::uint32_t set) {
   if (binding >= bindings_.size() || bindings_[binding] != BindingKind::StorageBuffer)
     throw std::logic_error(fmt::format("{}: binding {} is not a storage buffer", name_, binding));
   vk::DescriptorBufferInfo info{.buffer = buffer.handle(), .offset = 0, .range = VK_WHOLE_SIZE};
   context_->device().updateDescriptorSets(
-      vk::WriteDescriptorSet{.dstSet = *set_,
+      vk::WriteDescriptorSet{.dstSet = *descriptorSet(set),
                              .dstBinding = binding,
                              .descriptorCount = 1,
                              .descriptorType = vk::DescriptorType::eStorageBuffer,
@@ -80,12 +90,12 @@ void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
       nullptr);
 }
 
-void Kernel::bind(std::uint32_t binding, const TexelBuffer& buffer) {
+void Kernel::bind(std::uint32_t binding, const TexelBuffer& buffer, std::uint32_t set) {
   if (binding >= bindings_.size() || bindings_[binding] != BindingKind::UniformTexelBuffer)
     throw std::logic_error(fmt::format("{}: binding {} is not a texel buffer", name_, binding));
   vk::BufferView view = buffer.view();
   context_->device().updateDescriptorSets(
-      vk::WriteDescriptorSet{.dstSet = *set_,
+      vk::WriteDescriptorSet{.dstSet = *descriptorSet(set),
                              .dstBinding = binding,
                              .descriptorCount = 1,
                              .descriptorType = vk::DescriptorType::eUniformTexelBuffer,
@@ -93,9 +103,9 @@ void Kernel::bind(std::uint32_t binding, const TexelBuffer& buffer) {
       nullptr);
 }
 
-void Kernel::bindCommon(const vk::raii::CommandBuffer& cmd, const void* push) const {
+void Kernel::bindCommon(const vk::raii::CommandBuffer& cmd, const void* push, std::uint32_t set) const {
   cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_);
-  cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipelineLayout_, 0, {*set_}, {});
+  cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipelineLayout_, 0, {*descriptorSet(set)}, {});
   if (pushBytes_) {
     if (!push) throw std::logic_error(fmt::format("{}: push constants missing", name_));
     cmd.pushConstants<std::uint8_t>(*pipelineLayout_, vk::ShaderStageFlagBits::eCompute, 0,
@@ -104,14 +114,14 @@ void Kernel::bindCommon(const vk::raii::CommandBuffer& cmd, const void* push) co
 }
 
 void Kernel::dispatch(const vk::raii::CommandBuffer& cmd, std::uint32_t groupsX, std::uint32_t groupsY,
-                      std::uint32_t groupsZ, const void* push) const {
-  bindCommon(cmd, push);
+                      std::uint32_t groupsZ, const void* push, std::uint32_t set) const {
+  bindCommon(cmd, push, set);
   cmd.dispatch(groupsX, groupsY, groupsZ);
 }
 
 void Kernel::dispatchIndirect(const vk::raii::CommandBuffer& cmd, const Buffer& args,
-                              vk::DeviceSize offset, const void* push) const {
-  bindCommon(cmd, push);
+                              vk::DeviceSize offset, const void* push, std::uint32_t set) const {
+  bindCommon(cmd, push, set);
   cmd.dispatchIndirect(args.handle(), offset);
 }
 

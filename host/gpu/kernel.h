@@ -26,26 +26,31 @@ struct KernelDesc {
   std::vector<BindingKind> bindings;       // binding i of set 0
   std::uint32_t pushConstantBytes = 0;
   std::vector<SpecConstant> specConstants;
+  // Descriptor sets: one per frame band (render/frame/frame_layout.h), each bound to that band's
+  // buffers once; a dispatch names the set it uses.
+  std::uint32_t setCount = 1;
 };
 
 class Kernel {
 public:
   Kernel(const Context& context, const KernelDesc& desc);
 
-  void bind(std::uint32_t binding, const Buffer& buffer);
-  void bind(std::uint32_t binding, const TexelBuffer& buffer);
+  void bind(std::uint32_t binding, const Buffer& buffer, std::uint32_t set = 0);
+  void bind(std::uint32_t binding, const TexelBuffer& buffer, std::uint32_t set = 0);
 
   // Records push constants + dispatch of groups. `push` must be pushConstantBytes long.
   void dispatch(const vk::raii::CommandBuffer& cmd, std::uint32_t groupsX, std::uint32_t groupsY,
-                std::uint32_t groupsZ, const void* push = nullptr) const;
+                std::uint32_t groupsZ, const void* push = nullptr, std::uint32_t set = 0) const;
   // Records an indirect dispatch whose group counts come from `args` at `offset`.
   void dispatchIndirect(const vk::raii::CommandBuffer& cmd, const Buffer& args, vk::DeviceSize offset,
-                        const void* push = nullptr) const;
+                        const void* push = nullptr, std::uint32_t set = 0) const;
 
   const std::string& name() const { return name_; }
+  std::uint32_t setCount() const { return static_cast<std::uint32_t>(sets_.size()); }
 
 private:
-  void bindCommon(const vk::raii::CommandBuffer& cmd, const void* push) const;
+  void bindCommon(const vk::raii::CommandBuffer& cmd, const void* push, std::uint32_t set) const;
+  const vk::raii::DescriptorSet& descriptorSet(std::uint32_t set) const;
 
   const Context* context_;
   std::string name_;
@@ -55,7 +60,7 @@ private:
   vk::raii::PipelineLayout pipelineLayout_ = nullptr;
   vk::raii::Pipeline pipeline_ = nullptr;
   vk::raii::DescriptorPool pool_ = nullptr;
-  vk::raii::DescriptorSet set_ = nullptr;
+  std::vector<vk::raii::DescriptorSet> sets_;
 };
 
 // A compute-to-compute (and compute-to-transfer) memory barrier between dispatches.

@@ -59,12 +59,36 @@ void writeWithOiio(const std::string& path, const std::string& shownPath, const 
     throw InputError(fmt::format("{}: cannot write: {}", shownPath, out->geterror()));
 }
 
+} // namespace
+
 float linearToSrgb(float v) {
   v = std::clamp(v, 0.0f, 1.0f);
   return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
-} // namespace
+void appendChannels(Image& to, const Image& from) {
+  if (to.width != from.width || to.height != from.height)
+    throw InputError(fmt::format("cannot add {}x{} channels to a {}x{} image", from.width, from.height, to.width,
+                                 to.height));
+  const std::size_t a = to.channels.size(), b = from.channels.size(), n = std::size_t(to.width) * to.height;
+  std::vector<float> pixels(n * (a + b));
+  for (std::size_t p = 0; p < n; ++p) {
+    std::copy_n(&to.pixels[p * a], a, &pixels[p * (a + b)]);
+    std::copy_n(&from.pixels[p * b], b, &pixels[p * (a + b) + a]);
+  }
+  to.pixels = std::move(pixels);
+  to.channels.insert(to.channels.end(), from.channels.begin(), from.channels.end());
+}
+
+void writePngRgba8(const std::string& path, int width, int height, const std::vector<std::uint32_t>& rgba) {
+  std::vector<unsigned char> rgb(std::size_t(width) * height * 3);
+  for (std::size_t i = 0; i < rgb.size() / 3; ++i)
+    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = static_cast<unsigned char>((rgba[i] >> (8 * c)) & 0xFFu);
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  writeAtomically(path, [&](const std::string& temp) {
+    writeWithOiio(temp, path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+  });
+}
 
 void writeExr(const std::string& path, const Image& image) {
   OIIO::ImageSpec spec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT);

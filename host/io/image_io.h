@@ -4,6 +4,7 @@
 // for viewing only: exposure, then the sRGB curve, 8 bits [SPEC §5]. Files are written to a
 // temporary name in the same folder and renamed, so a failed run leaves no partial file.
 #pragma once
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,15 @@ void writePng(const std::string& path, const Image& image, int firstChannel = 0,
               int count = 3);
 // Reads any image OpenImageIO reads (linear floats as stored; PNG values / 255, no decoding).
 Image readImage(const std::string& path);
+
+// Appends `from`'s channels to `to` (same size; InputError otherwise).
+void appendChannels(Image& to, const Image& from);
+// Writes an 8-bit PNG of packed RGBA8 pixels (R in the low byte; alpha dropped), as the GPU's
+// tonemap pass makes them.
+void writePngRgba8(const std::string& path, int width, int height, const std::vector<std::uint32_t>& rgba);
+// The sRGB transfer curve (IEC 61966-2-1) of a linear value clamped to [0, 1]: the C++ twin of
+// srgbEncode in shaders/tonemap.comp.
+float linearToSrgb(float linear);
 
 // The extension, lower case, without the dot ("exr", "png").
 std::string extensionOf(const std::string& path);

@@ -1,45 +1,31 @@
 #include "render/obscurance_renderer.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 
-#include "compose.spv.h"
-#include "gpu/kernel.h"
-#include "gpu/timestamps.h"
-#include "obscurance.spv.h"
-#include "render/passes/primary_pass.h"
-#include "render/scene/scene_buffers.h"
+#include <fmt/format.h>
+
+#include "core/error.h"
 #include "shading/bsdf.h"
-#include "shadow.spv.h"
-#include "specular.spv.h"
-#include "specular_queue.spv.h"
 
 namespace obscura::render {
 namespace {
 
-using Usage = vk::BufferUsageFlagBits;
+using Clock = std::chrono::steady_clock;
 
-gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv) {
-  auto bindings = sceneBindingKinds();
-  bindings.insert(bindings.end(), gpu::kShadingBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
-  return {.name = name, .spirv = spirv, .bindings = bindings, .pushConstantBytes = sizeof(gpu::ShadePush)};
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-gpu::KernelDesc composeKernelDesc() {
-  return {.name = "compose", .spirv = kSpirv_compose,
-          .bindings = std::vector<gpu::BindingKind>(7, gpu::BindingKind::StorageBuffer),
-          .pushConstantBytes = sizeof(gpu::ComposePush)};
+std::vector<glm::vec4> asVec4(const std::vector<glm::vec3>& v) {
+  std::vector<glm::vec4> out;
+  for (const auto& e : v) out.emplace_back(e, 0.0f);
+  return out;
 }
 
-// Whether any triangle has a glossy material: only then does the specular pass run.
-bool hasGlossy(const scene::Scene& scene) {
-  std::vector<bool> glossy;
-  for (const auto& m : scene.materials) glossy.push_back(isGlossy(m.metallic, m.roughness));
-  for (std::uint32_t m : scene.triangleMaterial)
-    if (glossy[m]) return true;
-  return false;
-}
+// Samples recorded into one submission: each pass of a sample takes one timestamp pair, and the
+// pool holds 256 pairs; fewer per submission keep the progress line moving.
+constexpr std::uint32_t kSamplesPerSubmission = 16;
 
 const std::vector<std::string> kComposeAovs = {"combined", "direct", "indirect", "specular", "obscurance"};
 
@@ -58,184 +44,381 @@ const std::vector<std::string>& obscuranceAovNames() {
   return names;
 }
 
-std::uint64_t obscuranceLargestBuffer(std::uint32_t width, std::uint32_t height, std::size_t lights) {
-  const std::uint64_t pixels = std::uint64_t(width) * height, vec4 = 16;
-  const std::uint64_t aovs = pixels * gpu::kAovSlots * gpu::kAccumulatorVec4s * vec4;
-  const std::uint64_t basis = pixels * std::max<std::uint64_t>(lights, 1) * gpu::kAccumulatorVec4s * vec4;
-  const std::uint64_t composed = pixels * gpu::kComposeSlots * vec4;
-  return std::max({aovs, basis, composed, pixels * sizeof(gpu::GBufferTexel)});
+bool sceneHasGlossy(const scene::Scene& scene) {
+  std::vector<bool> glossy;
+  for (const auto& m : scene.materials) glossy.push_back(isGlossy(m.metallic, m.roughness));
+  for (std::uint32_t m : scene.triangleMaterial)
+    if (glossy[m]) return true;
+  return false;
 }
 
-std::uint64_t obscuranceBytesNeeded(std::uint32_t width, std::uint32_t height, std::size_t lights) {
-  std::uint64_t pixels = std::uint64_t(width) * height;
-  return PrimaryPass::bytesNeeded(width, height) +
-         pixels * 16 * (gpu::kAccumulatorVec4s * (lights + 1) + gpu::kComposeSlots);
+ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+                                       const ObscuranceSettings& settings)
+    : context_(&context), scene_(&scene), settings_(settings),
+      runSpecular_(sceneHasGlossy(scene) && settings.maxDepth > 1),
+      sceneBuffers_(context, scene, bvh), lights_(buildLightSet(scene)),
+      frame_(context, settings.width, settings.height, static_cast<std::uint32_t>(lights_.size()),
+             FrameContents{.specular = runSpecular_, .primaryAovs = settings.primaryAovs,
+                           .composedSlots = settings.composedAovs ? gpu::kComposeSlots : 1u},
+             settings.maxBufferBytes),
+      primary_(context, frame_.layout().bandCount()), shadow_(context, frame_.layout().bandCount()),
+      obscurance_(context, frame_.layout().bandCount()), specularPass_(context, frame_.layout().bandCount()),
+      compose_(context, frame_.layout().bandCount()), tonemap_(context, frame_.layout().bandCount()),
+      stream_(context), timestamps_(context) {
+  for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
+  ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
+  emissions_ = lights_.emission;
+  configure(settings);
+  uploadLights();
 }
 
-ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
-                                   const ObscuranceSettings& settings, const ProgressFn& progress) {
-  auto start = std::chrono::steady_clock::now();
-  ObscuranceResult result;
-  result.dMax = settings.dMax > 0.0f ? settings.dMax : defaultDMax(scene.bounds);
-  result.lights = buildLightSet(scene);
-  const LightSet& lights = result.lights;
-  std::vector<glm::vec3> meanAlbedo;
-  for (const auto& m : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(m));
-  result.ambient = computeAmbient(scene, lights, meanAlbedo, settings.colourBleeding);
-  result.ambientIntensity = result.ambient.intensity(lights.emission);
+void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
+  if (settings.width != frame_.layout().width || settings.height != frame_.layout().height ||
+      settings.primaryAovs != frame_.contents().primaryAovs ||
+      (settings.composedAovs ? gpu::kComposeSlots : 1u) != frame_.contents().composedSlots)
+    throw std::logic_error("ObscuranceRenderer::configure: resolution and AOVs are the frame's; make a new renderer");
+  const bool bleedChanged = settings.colourBleeding != settings_.colourBleeding;
+  settings_ = settings;
+  dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax(scene_->bounds);
+  if (bleedChanged) ambient_ = computeAmbient(*scene_, lights_, meanAlbedo_, settings.colourBleeding);
+  reset();
+}
 
-  SceneBuffers buffers(context, scene, bvh);
-  result.stats.notes = buffers.notes();
-  PrimaryPass primary(context, buffers, settings.width, settings.height);
-  const std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
-  const auto lightCount = static_cast<std::uint32_t>(lights.size());
-
-  gpu::Buffer lightBuffer = gpu::uploadArray(context, lights.lights, "shadow.lights");
-  gpu::Buffer emitterBuffer = gpu::uploadArray(context, lights.emitters, "shadow.emitters");
-  constexpr std::uint64_t kAccumulator = gpu::kAccumulatorVec4s * sizeof(glm::vec4);
-  gpu::Buffer basis(context, std::max<std::uint64_t>(lightCount, 1) * pixels * kAccumulator, Usage::eStorageBuffer,
-                    "shadow.basis");
-  gpu::Buffer ambient(context, pixels * kAccumulator, Usage::eStorageBuffer, "obscurance.ambient");
-  std::vector<glm::vec4> scales;
-  for (const auto& e : lights.emission) scales.emplace_back(e, 0.0f);
-  gpu::Buffer scaleBuffer = gpu::uploadArray(context, scales, "compose.emission");
-  gpu::Buffer composed(context, pixels * gpu::kComposeSlots * 16, Usage::eStorageBuffer, "compose.output");
-  // The specular buffers exist in full only when a glossy material does (a pass the scene does
-  // not need is not dispatched, and needs no memory).
-  const bool runSpecular = hasGlossy(scene) && settings.maxDepth > 1;
-  const std::uint64_t specularPixels = runSpecular ? pixels : 1;
-  gpu::Buffer specularBasis(context, std::max<std::uint64_t>(lightCount, 1) * specularPixels * kAccumulator,
-                            Usage::eStorageBuffer, "specular.basis");
-  gpu::Buffer specularAmbient(context, specularPixels * kAccumulator, Usage::eStorageBuffer, "specular.ambient");
-  gpu::Buffer queue(context, (gpu::kQueueHeader + specularPixels) * 4,
-                    Usage::eStorageBuffer | Usage::eIndirectBuffer, "specular.queue");
-
-  gpu::Kernel shadow(context, shadingKernelDesc("shadow", kSpirv_shadow));
-  gpu::Kernel obscurance(context, shadingKernelDesc("obscurance", kSpirv_obscurance));
-  gpu::Kernel specularQueue(context, shadingKernelDesc("specular.queue", kSpirv_specular_queue));
-  gpu::Kernel specular(context, shadingKernelDesc("specular", kSpirv_specular));
-  for (gpu::Kernel* k : {&shadow, &obscurance, &specularQueue, &specular}) {
-    buffers.bindTo(*k);
-    k->bind(gpu::kBindingGBuffer, primary.gbuffer());
-    k->bind(gpu::kBindingLights, lightBuffer);
-    k->bind(gpu::kBindingEmitters, emitterBuffer);
-    k->bind(gpu::kBindingBasis, basis);
-    k->bind(gpu::kBindingAmbient, ambient);
-    k->bind(gpu::kBindingSpecularBasis, specularBasis);
-    k->bind(gpu::kBindingSpecularAmbient, specularAmbient);
-    k->bind(gpu::kBindingSpecularQueue, queue);
-    k->bind(gpu::kBindingLightScales, scaleBuffer);
-  }
-  gpu::Kernel compose(context, composeKernelDesc());
-  compose.bind(0, basis);
-  compose.bind(1, ambient);
-  compose.bind(2, primary.aovs());
-  compose.bind(3, scaleBuffer);
-  compose.bind(4, composed);
-  compose.bind(5, specularBasis);
-  compose.bind(6, specularAmbient);
-
-  const bool runShadow = lights.anySampled() && settings.shadowRays > 0;
-  const bool runObscurance = settings.obscuranceRays > 0;
-  const gpu::GpuCamera camera = gpuCamera(settings.camera, settings.width, settings.height);
-  std::uint32_t flags = (settings.systematic ? gpu::kFlagSystematic : 0u) | (settings.colourBleeding ? gpu::kFlagBleed : 0u);
-  gpu::ShadePush push{.frame = glm::uvec4(settings.width, settings.height, 0u, settings.seed),
-                      .counts = glm::uvec4(lightCount, settings.shadowRays, settings.obscuranceRays, flags),
-                      .params = glm::vec4(result.dMax, settings.tau, static_cast<float>(settings.rho),
-                                          static_cast<float>(settings.maxDepth)),
-                      .rAve = glm::vec4(result.ambient.averageReflectance, 0.0f),
-                      .eye = glm::vec4(settings.camera.position, sceneScale(scene.bounds))};
-  const std::uint32_t groupsX = gpu::groupsFor(settings.width, gpu::kWorkgroupSizeX);
-  const std::uint32_t groupsY = gpu::groupsFor(settings.height, gpu::kWorkgroupSizeY);
-
-  gpu::Timestamps timestamps(context);
-  context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
-    cmd.fillBuffer(basis.handle(), 0, VK_WHOLE_SIZE, 0u);
-    cmd.fillBuffer(ambient.handle(), 0, VK_WHOLE_SIZE, 0u);
-    cmd.fillBuffer(specularBasis.handle(), 0, VK_WHOLE_SIZE, 0u);
-    cmd.fillBuffer(specularAmbient.handle(), 0, VK_WHOLE_SIZE, 0u);
+void ObscuranceRenderer::reset() {
+  samples_ = 0;
+  primaryRays_ = 0;
+  wallSeconds_ = 0.0;
+  frame_.resetStatus();
+  timestamps_ = gpu::Timestamps(*context_);
+  // Sample 0 of the primary pass starts the AOV and M_s accumulators; the shading passes add to
+  // theirs, so those start at zero.
+  stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+    for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) {
+      const auto& band = frame_.band(b);
+      for (const gpu::Buffer* buffer : {&band.basis, &band.ambient, &band.specularBasis, &band.specularAmbient,
+                                        &band.emissionBasis, &band.aovs})
+        cmd.fillBuffer(buffer->handle(), 0, VK_WHOLE_SIZE, 0u);
+    }
   });
-  const std::array<std::uint32_t, gpu::kQueueHeader> emptyQueue = {0u, 1u, 1u, 0u};
-  for (std::uint32_t s = 0; s < settings.spp; ++s) {
-    push.frame.z = s;
-    context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
-      timestamps.reset(cmd);
-      timestamps.begin(cmd, "primary");
-      primary.record(cmd, camera, s, settings.seed);
-      timestamps.end(cmd, "primary");
-      gpu::computeBarrier(cmd);
-      if (runShadow) {
-        timestamps.begin(cmd, "shadow");
-        shadow.dispatch(cmd, groupsX, groupsY, 1, &push);
-        timestamps.end(cmd, "shadow");
-      }
-      if (runObscurance) {
-        timestamps.begin(cmd, "obscurance");
-        obscurance.dispatch(cmd, groupsX, groupsY, 1, &push);
-        timestamps.end(cmd, "obscurance");
-      }
-      if (runSpecular) {
-        timestamps.begin(cmd, "specular");
-        cmd.updateBuffer<std::uint32_t>(queue.handle(), 0, emptyQueue);
+}
+
+void ObscuranceRenderer::uploadLights() {
+  lightBuffers_.lights = gpu::uploadArray(*context_, lights_.lights, "lights.lights");
+  lightBuffers_.emitters = gpu::uploadArray(*context_, lights_.emitters, "lights.emitters");
+  lightBuffers_.scales = gpu::uploadArray(*context_, asVec4(lights_.emission), "lights.render_scales");
+  emissionBuffer_ = gpu::uploadArray(*context_, asVec4(emissions_), "compose.emissions");
+  bindAll();
+}
+
+void ObscuranceRenderer::bindAll() {
+  const ShadingInputs inputs{.scene = sceneBuffers_, .lights = lightBuffers_, .frame = frame_};
+  for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) {
+    primary_.bind(b, sceneBuffers_, frame_, lightBuffers_.scales);
+    shadow_.bind(b, inputs);
+    obscurance_.bind(b, inputs);
+    specularPass_.bind(b, inputs);
+    compose_.bind(b, frame_, emissionBuffer_);
+    tonemap_.bind(b, frame_);
+  }
+}
+
+gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
+  const std::uint32_t flags = (settings_.systematic ? gpu::kFlagSystematic : 0u) |
+                              (settings_.colourBleeding ? gpu::kFlagBleed : 0u);
+  return {.frame = glm::uvec4(settings_.width, settings_.height, sample, settings_.seed),
+          .counts = glm::uvec4(static_cast<std::uint32_t>(lights_.size()), settings_.shadowRays,
+                               settings_.obscuranceRays, flags),
+          .params = glm::vec4(dMax_, settings_.tau, static_cast<float>(settings_.rho),
+                              static_cast<float>(settings_.maxDepth)),
+          .rAve = glm::vec4(ambient_.averageReflectance, 0.0f),
+          .eye = glm::vec4(settings_.camera.position, sceneScale(scene_->bounds)),
+          .band = glm::uvec4(0u)};
+}
+
+void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progress) {
+  const auto start = Clock::now();
+  const double wallBefore = wallSeconds_;
+  const FrameLayout& layout = frame_.layout();
+  const std::uint32_t bands = layout.bandCount();
+  const auto lightCount = static_cast<std::uint32_t>(lights_.size());
+  const bool runShadow = lights_.anySampled() && settings_.shadowRays > 0;
+  const bool runObscurance = settings_.obscuranceRays > 0;
+  const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
+  const std::uint32_t end = samples_ + samples;
+  while (samples_ < end) {
+    const std::uint32_t last = std::min(end, samples_ + kSamplesPerSubmission);
+    stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+      timestamps_.reset(cmd);
+      for (std::uint32_t s = samples_; s < last; ++s) {
+        if (s > samples_) gpu::computeBarrier(cmd);
+        const gpu::ShadePush push = shadePush(s);
+        timestamps_.begin(cmd, "primary");
+        for (std::uint32_t b = 0; b < bands; ++b)
+          primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount,
+                          settings_.primaryAovs ? 0u : gpu::kPrimaryFlagNoAovs);
+        timestamps_.end(cmd, "primary");
         gpu::computeBarrier(cmd);
-        specularQueue.dispatch(cmd, groupsX, groupsY, 1, &push);
-        gpu::computeBarrier(cmd);
-        specular.dispatchIndirect(cmd, queue, 0, &push);
-        timestamps.end(cmd, "specular");
+        if (runShadow) {
+          timestamps_.begin(cmd, "shadow");
+          for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push);
+          timestamps_.end(cmd, "shadow");
+        }
+        if (runObscurance) {
+          timestamps_.begin(cmd, "obscurance");
+          for (std::uint32_t b = 0; b < bands; ++b) obscurance_.record(cmd, b, layout, push);
+          timestamps_.end(cmd, "obscurance");
+        }
+        if (runSpecular_) {
+          timestamps_.begin(cmd, "specular");
+          for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, push);
+          timestamps_.end(cmd, "specular");
+        }
       }
     });
-    timestamps.collect();
-    if (progress)
-      progress(s + 1, settings.spp, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    timestamps_.collect();
+    primaryRays_ += layout.pixels() * (last - samples_);
+    samples_ = last;
+    wallSeconds_ = wallBefore + secondsSince(start);
+    if (progress) progress(samples_ - (end - samples), samples, secondsSince(start));
   }
-  gpu::ComposePush composePush{.frame = glm::uvec4(settings.width, settings.height, settings.spp, lightCount),
-                               .ambient = glm::vec4(result.ambientIntensity, runSpecular ? 1.0f : 0.0f)};
-  context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
-    timestamps.reset(cmd);
-    timestamps.begin(cmd, "compose");
-    compose.dispatch(cmd, gpu::groupsFor(pixels, gpu::kWorkgroupSize1D), 1, 1, &composePush);
-    timestamps.end(cmd, "compose");
-  });
-  timestamps.collect();
+}
 
-  auto status = buffers.statusWords();
-  auto& st = result.stats;
+void ObscuranceRenderer::render(const ProgressFn& progress) {
+  reset();
+  iterate(settings_.spp, progress);
+  compose();
+}
+
+void ObscuranceRenderer::setEmissions(const std::vector<glm::vec3>& emissions) {
+  if (emissions.size() != lights_.size())
+    throw std::logic_error(fmt::format("setEmissions: {} emissions for {} lights", emissions.size(), lights_.size()));
+  emissions_ = emissions;
+  emissionBuffer_.upload(*context_, asVec4(emissions_));
+}
+
+void ObscuranceRenderer::compose(float exposureStops) {
+  const auto start = Clock::now();
+  const FrameLayout& layout = frame_.layout();
+  const glm::vec3 ia = ambientIntensity();
+  const auto lightCount = static_cast<std::uint32_t>(lights_.size());
+  stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+    timestamps_.reset(cmd);
+    timestamps_.begin(cmd, "compose");
+    for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+      compose_.record(cmd, b, layout, samples_, lightCount, ia, runSpecular_, frame_.contents().composedSlots);
+    timestamps_.end(cmd, "compose");
+    gpu::computeBarrier(cmd);
+    timestamps_.begin(cmd, "tonemap");
+    for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+      tonemap_.record(cmd, b, layout, gpu::kComposeCombined, 3, exposureStops, frame_.contents().composedSlots);
+    timestamps_.end(cmd, "tonemap");
+  });
+  timestamps_.collect();
+  wallSeconds_ += secondsSince(start);
+}
+
+std::vector<glm::vec4> ObscuranceRenderer::downloadBand(const gpu::Buffer& buffer) const {
+  return buffer.download<glm::vec4>(*context_);
+}
+
+io::Image ObscuranceRenderer::image() const {
+  const FrameLayout& layout = frame_.layout();
+  const std::uint32_t slots = frame_.contents().composedSlots;
+  const bool primaryAovs = frame_.contents().primaryAovs;
+  io::Image image;
+  image.width = static_cast<int>(layout.width);
+  image.height = static_cast<int>(layout.height);
+  // Composed slots in order (emission after obscurance), then the primary pass's AOVs, whose
+  // emission is replaced by the composed one (it follows the current E_s).
+  std::vector<std::uint32_t> shown;
+  for (std::uint32_t slot = 0; slot < slots; ++slot)
+    if (slot != gpu::kComposeEmission || !primaryAovs) shown.push_back(slot);
+  const char* slotNames[gpu::kComposeSlots] = {"combined", "direct", "indirect", "specular", "obscurance", "emission"};
+  for (std::uint32_t slot : shown)
+    for (const auto& c : aovChannels(slotNames[slot])) image.channels.push_back(c);
+  if (primaryAovs)
+    for (const auto& name : aovNames())
+      for (const auto& c : aovChannels(name)) image.channels.push_back(c);
+  const std::size_t nc = image.channels.size();
+  image.pixels.resize(layout.pixels() * nc);
+  const int emissionChannel = image.channelIndex("emission.R");
+  for (std::uint32_t b = 0; b < layout.bandCount(); ++b) {
+    const auto composed = downloadBand(frame_.band(b).composed);
+    io::Image primary;
+    if (primaryAovs)
+      primary = resolvePrimaryAovs(downloadBand(frame_.band(b).aovs), layout.width, layout.bands[b].rows,
+                                   std::max(samples_, 1u));
+    const std::size_t pc = primary.channels.size();
+    const std::uint64_t first = std::uint64_t(layout.bands[b].firstRow) * layout.width;
+    for (std::uint64_t p = 0; p < layout.bandPixels(b); ++p) {
+      float* out = &image.pixels[(first + p) * nc];
+      std::size_t k = 0;
+      for (std::uint32_t slot : shown) {
+        const glm::vec4 v = composed[p * slots + slot];
+        const std::size_t n = slot == gpu::kComposeObscurance ? 1 : 3;
+        for (std::size_t c = 0; c < n; ++c) out[k++] = v[static_cast<int>(c)];
+      }
+      if (!primaryAovs) continue;
+      std::copy_n(&primary.pixels[p * pc], pc, out + k);
+      const glm::vec4 seen = composed[p * slots + gpu::kComposeEmission];
+      for (int c = 0; c < 3; ++c) out[emissionChannel + c] = seen[c];
+    }
+  }
+  return image;
+}
+
+Transport ObscuranceRenderer::transport() const {
+  const FrameLayout& layout = frame_.layout();
+  Transport t;
+  t.width = static_cast<int>(layout.width);
+  t.height = static_cast<int>(layout.height);
+  t.lights = lights_.names;
+  t.specular = runSpecular_;
+  const std::size_t lights = lights_.size();
+  t.direct.assign(lights, std::vector<glm::vec3>(layout.pixels()));
+  t.seen.assign(lights, std::vector<glm::vec3>(layout.pixels()));
+  if (runSpecular_) {
+    t.specularDirect.assign(lights, std::vector<glm::vec3>(layout.pixels()));
+    t.specularAmbient.resize(layout.pixels());
+  }
+  t.ambient.resize(layout.pixels());
+  const float inv = 1.0f / static_cast<float>(std::max(samples_, 1u));
+  // Accumulators are Kahan pairs: the sum of entry i is element i * kAccumulatorVec4s.
+  auto sum = [](const std::vector<glm::vec4>& v, std::uint64_t i) { return v[i * gpu::kAccumulatorVec4s]; };
+  for (std::uint32_t b = 0; b < layout.bandCount(); ++b) {
+    const auto& band = frame_.band(b);
+    const auto basis = downloadBand(band.basis), seen = downloadBand(band.emissionBasis);
+    const auto ambient = downloadBand(band.ambient);
+    const std::vector<glm::vec4> specularBasis = runSpecular_ ? downloadBand(band.specularBasis) : std::vector<glm::vec4>();
+    const std::vector<glm::vec4> specularAmbient = runSpecular_ ? downloadBand(band.specularAmbient) : std::vector<glm::vec4>();
+    const std::uint64_t px = layout.bandPixels(b);
+    const std::uint64_t first = std::uint64_t(layout.bands[b].firstRow) * layout.width;
+    for (std::uint64_t p = 0; p < px; ++p) {
+      t.ambient[first + p] = sum(ambient, p) * inv;
+      if (runSpecular_) t.specularAmbient[first + p] = glm::vec3(sum(specularAmbient, p)) * inv;
+      for (std::size_t s = 0; s < lights; ++s) {
+        t.direct[s][first + p] = glm::vec3(sum(basis, s * px + p)) * inv;
+        t.seen[s][first + p] = glm::vec3(sum(seen, s * px + p)) * inv;
+        if (runSpecular_) t.specularDirect[s][first + p] = glm::vec3(sum(specularBasis, s * px + p)) * inv;
+      }
+    }
+  }
+  return t;
+}
+
+std::vector<std::uint32_t> ObscuranceRenderer::display() const {
+  std::vector<std::uint32_t> out;
+  out.reserve(frame_.layout().pixels());
+  for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) {
+    auto band = frame_.band(b).display.download<std::uint32_t>(*context_);
+    out.insert(out.end(), band.begin(), band.begin() + static_cast<std::ptrdiff_t>(frame_.layout().bandPixels(b)));
+  }
+  return out;
+}
+
+std::size_t ObscuranceRenderer::lightIndex(const std::string& name) const {
+  auto it = std::find(lights_.names.begin(), lights_.names.end(), name);
+  if (it == lights_.names.end())
+    throw InputError(fmt::format("light '{}': no such light (lights: {})", name, fmt::join(lights_.names, ", ")));
+  return static_cast<std::size_t>(it - lights_.names.begin());
+}
+
+std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
+  if (std::find(lights_.names.begin(), lights_.names.end(), light.name) != lights_.names.end())
+    throw InputError(fmt::format("add light '{}': a light of that name exists", light.name));
+  const std::size_t index = lights_.size();
+  std::vector<int> source(index + 1, -1);
+  for (std::size_t i = 0; i < index; ++i) source[i] = static_cast<int>(i);
+  frame_.remapLights(stream_, source);
+  appendPunctual(lights_, light, scene_->bounds);
+  updateSelection(lights_);
+  emissions_.push_back(lights_.emission.back());
+  ambient_ = computeAmbient(*scene_, lights_, meanAlbedo_, settings_.colourBleeding);
+  uploadLights();
+
+  // The new light's shadow rays from the frame's own primary hits: the G-buffer of every sample
+  // so far is made again (same seed, same sub-pixel position, no accumulation) and the shadow
+  // pass samples the new light alone.
+  const auto start = Clock::now();
+  const double wallBefore = wallSeconds_;
+  const FrameLayout& layout = frame_.layout();
+  const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
+  // The shadow pass samples lights through the selection CDF; with every other light's
+  // probability 0 it picks the new one alone (an exact single-light estimator: pdf 1).
+  std::vector<gpu::GpuLight> only = lights_.lights;
+  for (std::size_t i = 0; i < only.size(); ++i) {
+    only[i].params.x = i + 1 < only.size() ? 0.0f : 1.0f;
+    only[i].params.y = i + 1 < only.size() ? 0.0f : 1.0f;
+  }
+  lightBuffers_.lights.upload(*context_, only);
+  const auto lightCount = static_cast<std::uint32_t>(lights_.size());
+  for (std::uint32_t first = 0; first < samples_; first += kSamplesPerSubmission) {
+    const std::uint32_t last = std::min(samples_, first + kSamplesPerSubmission);
+    stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+      timestamps_.reset(cmd);
+      for (std::uint32_t s = first; s < last; ++s) {
+        if (s > first) gpu::computeBarrier(cmd);
+        timestamps_.begin(cmd, "primary");
+        for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+          primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, gpu::kPrimaryFlagGBufferOnly);
+        timestamps_.end(cmd, "primary");
+        gpu::computeBarrier(cmd);
+        timestamps_.begin(cmd, "shadow");
+        const gpu::ShadePush push = shadePush(s);
+        for (std::uint32_t b = 0; b < layout.bandCount(); ++b) shadow_.record(cmd, b, layout, push);
+        timestamps_.end(cmd, "shadow");
+      }
+    });
+    timestamps_.collect();
+    primaryRays_ += layout.pixels() * (last - first);
+  }
+  lightBuffers_.lights.upload(*context_, lights_.lights);
+  wallSeconds_ = wallBefore + secondsSince(start);
+  return index;
+}
+
+void ObscuranceRenderer::removeLight(std::size_t index) {
+  if (index >= lights_.size()) throw std::logic_error("removeLight: no such light");
+  if (lights_.lights[index].info.x == gpu::kLightArea) {
+    // Area lights stay: their triangles name them by index. Off is a scale of 0, which is what
+    // a scene without that emission renders (D_s, M_s and I_a's share all vanish).
+    emissions_[index] = glm::vec3(0.0f);
+    emissionBuffer_.upload(*context_, asVec4(emissions_));
+    return;
+  }
+  std::vector<int> source;
+  for (std::size_t i = 0; i < lights_.size(); ++i)
+    if (i != index) source.push_back(static_cast<int>(i));
+  frame_.remapLights(stream_, source);
+  removePunctual(lights_, index);
+  emissions_.erase(emissions_.begin() + static_cast<std::ptrdiff_t>(index));
+  ambient_ = computeAmbient(*scene_, lights_, meanAlbedo_, settings_.colourBleeding);
+  uploadLights();
+}
+
+RenderStats ObscuranceRenderer::stats() const {
+  RenderStats st;
+  st.notes = sceneBuffers_.notes();
+  const auto status = frame_.statusWords();
   st.truncatedTraversals = status[gpu::kStatusTruncated];
   auto pass = [&](const char* name, std::uint64_t rays) {
-    if (!timestamps.totalsMs().contains(name)) return;
-    st.passes[name] = {.gpuMs = timestamps.totalsMs().at(name), .rays = rays};
+    if (!timestamps_.totalsMs().contains(name)) return;
+    st.passes[name] = {.gpuMs = timestamps_.totalsMs().at(name), .rays = rays};
   };
-  pass("primary", pixels * settings.spp);
+  pass("primary", primaryRays_);
   pass("shadow", status[gpu::kStatusShadowRays]);
   pass("obscurance", status[gpu::kStatusObscuranceRays]);
   pass("specular", status[gpu::kStatusSpecularRays]);
   pass("compose", 0);
-  st.deviceBytes = buffers.bytes() + obscuranceBytesNeeded(settings.width, settings.height, lights.size());
+  pass("tonemap", 0);
+  st.deviceBytes = deviceBytes();
+  st.wallSeconds = wallSeconds_;
+  return st;
+}
 
-  // Image: the composed AOVs, then the primary pass's.
-  auto composedData = composed.download<glm::vec4>(context);
-  io::Image primaryImage = resolvePrimaryAovs(primary.aovs().download<glm::vec4>(context), settings.width,
-                                              settings.height, settings.spp);
-  io::Image& image = result.image;
-  image.width = static_cast<int>(settings.width);
-  image.height = static_cast<int>(settings.height);
-  for (const auto& name : kComposeAovs)
-    for (const auto& c : aovChannels(name)) image.channels.push_back(c);
-  for (const auto& c : primaryImage.channels) image.channels.push_back(c);
-  const std::size_t nc = image.channels.size(), pc = primaryImage.channels.size();
-  image.pixels.resize(pixels * nc);
-  for (std::size_t p = 0; p < pixels; ++p) {
-    float* out = &image.pixels[p * nc];
-    std::size_t k = 0;
-    for (std::uint32_t slot = 0; slot < gpu::kComposeSlots; ++slot) {
-      glm::vec4 v = composedData[p * gpu::kComposeSlots + slot];
-      std::size_t n = slot == gpu::kComposeObscurance ? 1 : 3;
-      for (std::size_t c = 0; c < n; ++c) out[k++] = v[static_cast<int>(c)];
-    }
-    std::copy_n(&primaryImage.pixels[p * pc], pc, out + k);
-  }
-  st.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return result;
+std::uint64_t ObscuranceRenderer::deviceBytes() const {
+  return sceneBuffers_.bytes() + frame_.bytes() + lightBuffers_.lights.size() + lightBuffers_.emitters.size() +
+         lightBuffers_.scales.size() + emissionBuffer_.size();
 }
 
 } // namespace obscura::render

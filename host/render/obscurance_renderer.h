@@ -1,25 +1,42 @@
-// obscurance_renderer.h — ray-traced obscurances [RTO] as GPU passes, progressive:
-// each iteration adds one primary sample per pixel with its shadow and obscurance rays:
+// obscurance_renderer.h — ray-traced obscurances [RTO] as a renderer that lives across frames.
 //
-//   primary.comp -> G-buffer -> shadow.comp     -> D_s  (one basis buffer per light, unit E_s)
-//                            -> obscurance.comp -> A, W
-//                            -> specular_queue.comp -> glossy pixels -> specular.comp (indirect
-//                               dispatch): specular paths, D_s and A gathered at their vertices
-//   after the last iteration: compose.comp  C = sum_s E_s D_s + I_a(E) A + emission [SPEC §3]
+// Made once per scene and view; it holds resources by lifetime:
+//   scene  SceneBuffers (geometry, BVH, materials, textures), the light set and its GPU buffers
+//   frame  ObscuranceFrame (G-buffer, basis buffers D_s and M_s per light, ambient A, specular
+//          buffers, queue, composed AOVs, display bytes, ray counters), split into bands
+//   pass   one small class per pass owning its kernel: primary, shadow, obscurance, specular,
+//          compose, tonemap
+// and offers what a frame loop needs: reset(), iterate(n), compose(), image(), plus edits.
 //
-// A pass the scene does not need is not dispatched (no light with power: no shadow pass).
+//   iterate: primary.comp -> G-buffer -> shadow.comp     -> D_s (per light, unit E_s)
+//                                     -> obscurance.comp -> A, W
+//                                     -> specular passes -> D_s, A along specular paths
+//   compose: C = sum_s E_s (D_s + M_s) + I_a(E) A  [SPEC §3] — a light edit reruns this alone.
 #pragma once
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "bvh/bvh.h"
+#include "gpu/command_stream.h"
 #include "gpu/context.h"
+#include "gpu/timestamps.h"
 #include "io/image_io.h"
+#include "render/aovs.h"
+#include "render/frame/obscurance_frame.h"
+#include "render/passes/compose_pass.h"
+#include "render/passes/obscurance_pass.h"
+#include "render/passes/primary_pass.h"
+#include "render/passes/shading_inputs.h"
+#include "render/passes/shadow_pass.h"
+#include "render/passes/specular_pass.h"
+#include "render/passes/tonemap_pass.h"
 #include "render/scene/ambient.h"
-#include "render/aov_render.h"
 #include "render/scene/light_set.h"
+#include "render/scene/scene_buffers.h"
+#include "render/transport.h"
 #include "scene/scene.h"
 
 namespace obscura::render {
@@ -39,6 +56,11 @@ struct ObscuranceSettings {
   bool systematic = true;            // [RTO §4.2]
   bool colourBleeding = true;        // W_c [RTO eq. 6]; false: grey W [RTO eq. 2]
   std::uint32_t maxDepth = 6;        // specular paths: scattering vertices, the primary hit is 1
+  std::uint64_t maxBufferBytes = 0;  // per-buffer limit for frame bands; 0 = the device's
+  // What the frame keeps (only what is asked for is allocated): the primary pass's AOVs (albedo,
+  // normal, depth, ...), and all composed AOVs or `combined` alone.
+  bool primaryAovs = true;
+  bool composedAovs = true;
 };
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.
@@ -47,22 +69,100 @@ float defaultDMax(const scene::Bounds& bounds);
 // The AOVs of an obscurance render, in EXR layer order [RTO fig. 5].
 const std::vector<std::string>& obscuranceAovNames();
 
-struct ObscuranceResult {
-  io::Image image;            // every AOV (obscuranceAovNames() + the primary AOVs)
-  RenderStats stats;          // per-pass GPU ms and rays
-  AmbientTerm ambient;        // R_ave, I_a weights per light
-  glm::vec3 ambientIntensity; // I_a(E) with the scene's emissions
-  LightSet lights;
-  float dMax = 0.0f;
+// Whether any triangle has a glossy material: only then does the specular pass run.
+bool sceneHasGlossy(const scene::Scene& scene);
+
+class ObscuranceRenderer {
+public:
+  ObscuranceRenderer(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+                     const ObscuranceSettings& settings);
+
+  // New per-sample parameters (rays, rho, dmax, sampling, seed, camera, spp); the resolution
+  // must stay. Restarts the accumulation.
+  void configure(const ObscuranceSettings& settings);
+  // Forgets every sample (the next iterate starts at sample 0) and the ray counters.
+  void reset();
+  // Adds `samples` progressive samples: one primary sample per pixel with its shadow, obscurance
+  // and specular rays each. Several samples share one submission.
+  void iterate(std::uint32_t samples, const ProgressFn& progress = nullptr);
+  // reset() + iterate(settings.spp) + compose(): one finished frame.
+  void render(const ProgressFn& progress = nullptr);
+
+  // The emission scales E_s compose uses (default: the scene's own). I_a follows them [SPEC §3].
+  void setEmissions(const std::vector<glm::vec3>& emissions);
+  const std::vector<glm::vec3>& emissions() const { return emissions_; }
+  // Composes the AOVs on the GPU with the current emissions, then tonemaps `combined` to the
+  // display bytes with `exposureStops`.
+  void compose(float exposureStops = 0.0f);
+
+  // The AOVs the frame keeps (all of obscuranceAovNames() by default) as image channels, from the
+  // last compose().
+  io::Image image() const;
+  // The per-light transport so far, resolved on the host (what relighting keeps).
+  Transport transport() const;
+  // One RGB layer per light with the current E_s (render/transport.h lightLayers).
+  io::Image lightLayers() const { return render::lightLayers(transport(), emissions_, ambient_.weight); }
+  // The tonemapped combined image of the last compose(), RGBA8 per pixel (R in the low byte).
+  std::vector<std::uint32_t> display() const;
+
+  // Light edits that trace rays. addLight traces only the new light's shadow rays, from the same
+  // primary hits as the frame's samples (the G-buffer is made again per sample), into a new basis
+  // buffer; removeLight drops one. Both update I_a. Indices shift like a vector's.
+  std::size_t addLight(const scene::PunctualLight& light);
+  void removeLight(std::size_t index);
+  // The index of the light named `name`; InputError listing the names when there is none.
+  std::size_t lightIndex(const std::string& name) const;
+
+  const LightSet& lights() const { return lights_; }
+  const AmbientTerm& ambient() const { return ambient_; }
+  glm::vec3 ambientIntensity() const { return ambient_.intensity(emissions_); }
+  float dMax() const { return dMax_; }
+  std::uint32_t samples() const { return samples_; }
+  const ObscuranceSettings& settings() const { return settings_; }
+  const FrameLayout& layout() const { return frame_.layout(); }
+  bool specular() const { return runSpecular_; }
+  // Per-pass GPU ms and rays since the last reset, wall time, memory, truncations, notes.
+  RenderStats stats() const;
+  // Bytes of device memory held: scene, lights and frame (the real allocations).
+  std::uint64_t deviceBytes() const;
+
+private:
+  void uploadLights();
+  void bindAll();
+  gpu::ShadePush shadePush(std::uint32_t sample) const;
+  std::vector<glm::vec4> downloadBand(const gpu::Buffer& buffer) const;
+
+  const gpu::Context* context_;
+  const scene::Scene* scene_;
+  ObscuranceSettings settings_;
+  float dMax_ = 0.0f;
+  bool runSpecular_ = false;
+  std::vector<glm::vec3> meanAlbedo_;
+
+  // Scene lifetime.
+  SceneBuffers sceneBuffers_;
+  LightSet lights_;
+  AmbientTerm ambient_;
+  LightBuffers lightBuffers_;
+  std::vector<glm::vec3> emissions_; // what compose uses
+  gpu::Buffer emissionBuffer_;
+
+  // Frame lifetime.
+  ObscuranceFrame frame_;
+  std::uint32_t samples_ = 0;
+  std::uint64_t primaryRays_ = 0;
+
+  // Passes.
+  PrimaryPass primary_;
+  ShadowPass shadow_;
+  ObscurancePass obscurance_;
+  SpecularPass specularPass_;
+  ComposePass compose_;
+  TonemapPass tonemap_;
+
+  gpu::CommandStream stream_;
+  gpu::Timestamps timestamps_;
+  double wallSeconds_ = 0.0;
 };
-
-ObscuranceResult renderObscurances(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
-                                   const ObscuranceSettings& settings, const ProgressFn& progress = nullptr);
-
-// The largest single frame buffer (it must fit the device's maxStorageBufferRange).
-std::uint64_t obscuranceLargestBuffer(std::uint32_t width, std::uint32_t height, std::size_t lights);
-
-// Device memory the frame buffers need (beyond the scene) for `lights` lights.
-std::uint64_t obscuranceBytesNeeded(std::uint32_t width, std::uint32_t height, std::size_t lights);
 
 } // namespace obscura::render

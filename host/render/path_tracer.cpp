@@ -9,113 +9,176 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "gpu/kernel.h"
-#include "gpu/timestamps.h"
 #include "pathtrace.spv.h"
-#include "render/scene/light_set.h"
 #include "render/passes/primary_pass.h"
-#include "render/scene/scene_buffers.h"
 
 namespace obscura::render {
 namespace {
 
-
 using Usage = vk::BufferUsageFlagBits;
+using Clock = std::chrono::steady_clock;
+constexpr std::uint64_t kAccumulator = gpu::kAccumulatorVec4s * sizeof(glm::vec4);
+constexpr std::uint32_t kSamplesPerSubmission = 16;
 
-gpu::KernelDesc pathKernelDesc() {
+gpu::KernelDesc pathKernelDesc(std::uint32_t bands) {
   auto bindings = sceneBindingKinds();
   bindings.insert(bindings.end(), gpu::kPathBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
   return {.name = "pathtrace", .spirv = kSpirv_pathtrace, .bindings = bindings,
-          .pushConstantBytes = sizeof(gpu::PathPush)};
+          .pushConstantBytes = sizeof(gpu::PathPush), .setCount = bands};
+}
+
+const PathTraceSettings& checked(const PathTraceSettings& settings) {
+  if (settings.width == 0 || settings.height == 0) throw InputError("path tracing: the image has no pixels");
+  if (settings.spp == 0) throw InputError("path tracing: --spp must be at least 1");
+  if (settings.maxDepth > kMaxPathDepth)
+    throw InputError(fmt::format("path tracing: depth {} is above the limit of {}", settings.maxDepth, kMaxPathDepth));
+  return settings;
+}
+
+std::vector<glm::vec4> asVec4(const std::vector<glm::vec3>& v) {
+  std::vector<glm::vec4> out;
+  for (const auto& e : v) out.emplace_back(e, 0.0f);
+  return out;
 }
 
 } // namespace
 
 std::uint64_t pathTraceBytesNeeded(std::uint32_t width, std::uint32_t height) {
-  return std::uint64_t(width) * height * gpu::kAccumulatorVec4s * sizeof(glm::vec4);
+  return std::uint64_t(width) * height * kAccumulator;
 }
 
-PathTraceResult renderPathTraced(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
-                                 const PathTraceSettings& settings, const ProgressFn& progress) {
-  if (settings.width == 0 || settings.height == 0) throw InputError("path tracing: the image has no pixels");
-  if (settings.spp == 0) throw InputError("path tracing: --spp must be at least 1");
-  if (settings.maxDepth > kMaxPathDepth)
-    throw InputError(fmt::format("path tracing: depth {} is above the limit of {}", settings.maxDepth, kMaxPathDepth));
+PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+                       const PathTraceSettings& settings, std::uint64_t maxBufferBytes)
+    : context_(&context), scene_(&scene), settings_(checked(settings)), sceneBuffers_(context, scene, bvh),
+      lights_(buildLightSet(scene)),
+      layout_(FrameLayout::split(settings.width, settings.height, kAccumulator,
+                                 maxBufferBytes ? maxBufferBytes : context.info().maxStorageBufferRange,
+                                 "the radiance accumulator")),
+      kernel_(context, pathKernelDesc(layout_.bandCount())), stream_(context), timestamps_(context) {
+  if (pathTraceBytesNeeded(settings.width, settings.height) > context.info().deviceLocalBytes)
+    throw InputError(fmt::format("{}x{}: path tracing needs {:.1f} MiB, more than the device offers", settings.width,
+                                 settings.height,
+                                 static_cast<double>(pathTraceBytesNeeded(settings.width, settings.height)) / 1048576.0));
+  lightBuffer_ = gpu::uploadArray(context, lights_.lights, "pathtrace.lights");
+  emitterBuffer_ = gpu::uploadArray(context, lights_.emitters, "pathtrace.emitters");
+  scaleBuffer_ = gpu::uploadArray(context, asVec4(lights_.emission), "pathtrace.emission");
+  status_ = gpu::Buffer(context, gpu::kStatusWords * 4, Usage::eStorageBuffer, "pathtrace.status");
+  for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
+    radiance_.emplace_back(context, layout_.bandPixels(b) * kAccumulator,
+                           Usage::eStorageBuffer | Usage::eTransferDst, fmt::format("pathtrace.radiance[{}]", b));
+    sceneBuffers_.bindTo(kernel_, b, &status_);
+    kernel_.bind(gpu::kBindingPathRadiance, radiance_.back(), b);
+    kernel_.bind(gpu::kBindingPathLights, lightBuffer_, b);
+    kernel_.bind(gpu::kBindingPathEmitters, emitterBuffer_, b);
+    kernel_.bind(gpu::kBindingPathScales, scaleBuffer_, b);
+  }
+  reset();
+}
 
-  auto start = std::chrono::steady_clock::now();
-  PathTraceResult result;
-  const LightSet lights = buildLightSet(scene);
-  SceneBuffers buffers(context, scene, bvh);
-  result.stats.notes = buffers.notes();
-  const std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
+void PathTracer::configure(const PathTraceSettings& settings) {
+  checked(settings);
+  if (settings.width != settings_.width || settings.height != settings_.height)
+    throw std::logic_error("PathTracer::configure: the resolution is the frame's; make a new path tracer");
+  settings_ = settings;
+  reset();
+}
 
-  gpu::Buffer radiance(context, pixels * gpu::kAccumulatorVec4s * sizeof(glm::vec4), Usage::eStorageBuffer,
-                       "pathtrace.radiance");
-  gpu::Buffer lightBuffer = gpu::uploadArray(context, lights.lights, "pathtrace.lights");
-  gpu::Buffer emitterBuffer = gpu::uploadArray(context, lights.emitters, "pathtrace.emitters");
-  std::vector<glm::vec4> scales;
-  for (const auto& e : lights.emission) scales.emplace_back(e, 0.0f);
-  gpu::Buffer scaleBuffer = gpu::uploadArray(context, scales, "pathtrace.emission");
+void PathTracer::reset() {
+  samples_ = 0;
+  wallSeconds_ = 0.0;
+  timestamps_ = gpu::Timestamps(*context_);
+  std::uint32_t zeros[gpu::kStatusWords] = {};
+  status_.upload(*context_, zeros, sizeof(zeros));
+  stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+    for (const auto& r : radiance_) cmd.fillBuffer(r.handle(), 0, VK_WHOLE_SIZE, 0u);
+  });
+}
 
-  gpu::Kernel kernel(context, pathKernelDesc());
-  buffers.bindTo(kernel);
-  kernel.bind(gpu::kBindingPathRadiance, radiance);
-  kernel.bind(gpu::kBindingPathLights, lightBuffer);
-  kernel.bind(gpu::kBindingPathEmitters, emitterBuffer);
-  kernel.bind(gpu::kBindingPathScales, scaleBuffer);
-
+void PathTracer::iterate(std::uint32_t samples, const ProgressFn& progress) {
+  const auto start = Clock::now();
+  const double wallBefore = wallSeconds_;
   // No light with power: no light sampling at all (sampleLight needs a light it can pick), so the
   // shader traces no shadow ray; emitters of zero power still show where a ray sees them.
-  const auto lightCount = lights.anySampled() ? static_cast<std::uint32_t>(lights.size()) : 0u;
-  gpu::PathPush push{.camera = gpuCamera(settings.camera, settings.width, settings.height),
-                .frame = glm::uvec4(settings.width, settings.height, 0u, settings.seed),
-                .params = glm::uvec4(lightCount, settings.maxDepth, settings.rrDepth,
-                                     static_cast<std::uint32_t>(settings.strategy))};
-  push.camera.right.w = sceneScale(scene.bounds); // the ray-origin offset's scale (ray.glsl)
-  const std::uint32_t groupsX = gpu::groupsFor(settings.width, gpu::kWorkgroupSizeX);
-  const std::uint32_t groupsY = gpu::groupsFor(settings.height, gpu::kWorkgroupSizeY);
-
-  gpu::Timestamps timestamps(context);
-  context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) { cmd.fillBuffer(radiance.handle(), 0, VK_WHOLE_SIZE, 0u); });
-  for (std::uint32_t s = 0; s < settings.spp; ++s) {
-    push.frame.z = s;
-    context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
-      timestamps.reset(cmd);
-      timestamps.begin(cmd, "pathtrace");
-      kernel.dispatch(cmd, groupsX, groupsY, 1, &push);
-      timestamps.end(cmd, "pathtrace");
+  const auto lightCount = lights_.anySampled() ? static_cast<std::uint32_t>(lights_.size()) : 0u;
+  gpu::PathPush push{.camera = gpuCamera(settings_.camera, settings_.width, settings_.height),
+                     .frame = glm::uvec4(settings_.width, settings_.height, 0u, settings_.seed),
+                     .params = glm::uvec4(lightCount, settings_.maxDepth, settings_.rrDepth,
+                                          static_cast<std::uint32_t>(settings_.strategy)),
+                     .band = glm::uvec4(0u)};
+  push.camera.right.w = sceneScale(scene_->bounds); // the ray-origin offset's scale (ray.glsl)
+  const std::uint32_t end = samples_ + samples;
+  while (samples_ < end) {
+    const std::uint32_t last = std::min(end, samples_ + kSamplesPerSubmission);
+    stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+      timestamps_.reset(cmd);
+      timestamps_.begin(cmd, "pathtrace");
+      for (std::uint32_t s = samples_; s < last; ++s) {
+        if (s > samples_) gpu::computeBarrier(cmd);
+        push.frame.z = s;
+        for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
+          push.band = glm::uvec4(layout_.bands[b].firstRow, layout_.bands[b].rows, 0u, 0u);
+          kernel_.dispatch(cmd, gpu::groupsFor(settings_.width, gpu::kWorkgroupSizeX),
+                           gpu::groupsFor(layout_.bands[b].rows, gpu::kWorkgroupSizeY), 1, &push, b);
+        }
+      }
+      timestamps_.end(cmd, "pathtrace");
     });
-    timestamps.collect();
+    timestamps_.collect();
+    samples_ = last;
+    wallSeconds_ = wallBefore + std::chrono::duration<double>(Clock::now() - start).count();
     if (progress)
-      progress(s + 1, settings.spp, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      progress(samples_ - (end - samples), samples, std::chrono::duration<double>(Clock::now() - start).count());
   }
+}
 
-  auto status = buffers.statusWords();
-  auto& st = result.stats;
-  st.truncatedTraversals = status[gpu::kStatusTruncated];
-  st.passes["pathtrace"] = {.gpuMs = timestamps.totalsMs().contains("pathtrace") ? timestamps.totalsMs().at("pathtrace") : 0.0,
-                            .rays = status[gpu::kStatusPathRays]};
-  st.deviceBytes = buffers.bytes() + pathTraceBytesNeeded(settings.width, settings.height) +
-                   (lightBuffer.size() + emitterBuffer.size() + scaleBuffer.size());
+void PathTracer::render(const ProgressFn& progress) {
+  reset();
+  iterate(settings_.spp, progress);
+}
 
-  // The image: sum / spp. The shader never adds a non-finite sample (it counts it in .w instead).
-  auto sums = radiance.download<glm::vec4>(context);
-  io::Image& image = result.image;
-  image.width = static_cast<int>(settings.width);
-  image.height = static_cast<int>(settings.height);
+io::Image PathTracer::image() const {
+  io::Image image;
+  image.width = static_cast<int>(settings_.width);
+  image.height = static_cast<int>(settings_.height);
   image.channels = aovChannels("combined");
-  image.pixels.resize(pixels * 3);
-  const float inv = 1.0f / static_cast<float>(settings.spp);
-  for (std::uint64_t p = 0; p < pixels; ++p) {
-    const glm::vec4 sum = sums[p * gpu::kAccumulatorVec4s]; // (sum, compensation) pairs
-    for (int c = 0; c < 3; ++c) image.pixels[p * 3 + c] = sum[c] * inv;
-    result.nonFiniteSamples += static_cast<std::uint64_t>(sum.w);
+  image.pixels.resize(layout_.pixels() * 3);
+  const float inv = 1.0f / static_cast<float>(std::max(samples_, 1u));
+  for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
+    // The shader never adds a non-finite sample (it counts it in .w instead).
+    const auto sums = radiance_[b].download<glm::vec4>(*context_);
+    const std::uint64_t first = std::uint64_t(layout_.bands[b].firstRow) * settings_.width;
+    for (std::uint64_t p = 0; p < layout_.bandPixels(b); ++p)
+      for (int c = 0; c < 3; ++c) image.pixels[(first + p) * 3 + c] = sums[p * gpu::kAccumulatorVec4s][c] * inv;
   }
-  if (result.nonFiniteSamples > 0)
-    st.notes.push_back(fmt::format("path tracing dropped {} non-finite samples (NaN or inf radiance)",
-                                   result.nonFiniteSamples));
-  st.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return result;
+  return image;
+}
+
+std::uint64_t PathTracer::nonFiniteSamples() const {
+  std::uint64_t n = 0;
+  for (const auto& r : radiance_) {
+    const auto sums = r.download<glm::vec4>(*context_);
+    for (std::size_t p = 0; p < sums.size(); p += gpu::kAccumulatorVec4s) n += static_cast<std::uint64_t>(sums[p].w);
+  }
+  return n;
+}
+
+RenderStats PathTracer::stats() const {
+  RenderStats st;
+  st.notes = sceneBuffers_.notes();
+  std::vector<std::uint32_t> status(gpu::kStatusWords);
+  status_.download(*context_, status.data(), status.size() * 4);
+  st.truncatedTraversals = status[gpu::kStatusTruncated];
+  st.passes["pathtrace"] = {.gpuMs = timestamps_.totalsMs().contains("pathtrace") ? timestamps_.totalsMs().at("pathtrace")
+                                                                                   : 0.0,
+                            .rays = status[gpu::kStatusPathRays]};
+  std::uint64_t bytes = sceneBuffers_.bytes() + lightBuffer_.size() + emitterBuffer_.size() + scaleBuffer_.size() +
+                        status_.size();
+  for (const auto& r : radiance_) bytes += r.size();
+  st.deviceBytes = bytes;
+  if (const auto n = nonFiniteSamples(); n > 0)
+    st.notes.push_back(fmt::format("path tracing dropped {} non-finite samples (NaN or inf radiance)", n));
+  st.wallSeconds = wallSeconds_;
+  return st;
 }
 
 } // namespace obscura::render

@@ -8,7 +8,13 @@
 #include "bvh/bvh.h"
 #include "gpu/context.h"
 #include "io/image_io.h"
-#include "render/aov_render.h"
+#include "gpu/command_stream.h"
+#include "gpu/kernel.h"
+#include "gpu/timestamps.h"
+#include "render/aovs.h"
+#include "render/frame/frame_layout.h"
+#include "render/scene/light_set.h"
+#include "render/scene/scene_buffers.h"
 #include "scene/scene.h"
 
 namespace obscura::render {
@@ -36,15 +42,45 @@ struct PathTraceSettings {
 // path is far past what Russian roulette lets through anyway).
 inline constexpr std::uint32_t kMaxPathDepth = 1024;
 
-struct PathTraceResult {
-  io::Image image;                      // combined.R/G/B: mean radiance per pixel
-  RenderStats stats;                    // pass "pathtrace": GPU ms and rays (camera, shadow, bounce)
-  std::uint64_t nonFiniteSamples = 0;   // samples dropped because they were NaN or inf (expect 0)
-};
+// The path tracer, shaped like ObscuranceRenderer: made once per scene and view, progressive.
+// Scene lifetime: SceneBuffers and the lights; frame lifetime: one radiance accumulator per band
+// and the ray counters; its one pass is pathtrace.comp.
+class PathTracer {
+public:
+  // Throws InputError for maxDepth > kMaxPathDepth, a zero-sized image or spp 0.
+  PathTracer(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+             const PathTraceSettings& settings, std::uint64_t maxBufferBytes = 0);
 
-// Throws InputError for maxDepth > kMaxPathDepth, a zero-sized image or spp 0.
-PathTraceResult renderPathTraced(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
-                                 const PathTraceSettings& settings, const ProgressFn& progress = nullptr);
+  // New settings of the same resolution (seed, spp, depth, strategy, camera); restarts.
+  void configure(const PathTraceSettings& settings);
+  void reset();
+  void iterate(std::uint32_t samples, const ProgressFn& progress = nullptr);
+  // reset() + iterate(settings.spp).
+  void render(const ProgressFn& progress = nullptr);
+
+  // combined.R/G/B: the mean radiance per pixel so far.
+  io::Image image() const;
+  // Samples dropped because they were NaN or inf (expect 0).
+  std::uint64_t nonFiniteSamples() const;
+  RenderStats stats() const;
+  std::uint32_t samples() const { return samples_; }
+
+private:
+  const gpu::Context* context_;
+  const scene::Scene* scene_;
+  PathTraceSettings settings_;
+  SceneBuffers sceneBuffers_;
+  LightSet lights_;
+  gpu::Buffer lightBuffer_, emitterBuffer_, scaleBuffer_;
+  FrameLayout layout_;
+  std::vector<gpu::Buffer> radiance_; // per band
+  gpu::Buffer status_;
+  gpu::Kernel kernel_;
+  gpu::CommandStream stream_;
+  gpu::Timestamps timestamps_;
+  std::uint32_t samples_ = 0;
+  double wallSeconds_ = 0.0;
+};
 
 // Device memory the frame buffers need (beyond the scene).
 std::uint64_t pathTraceBytesNeeded(std::uint32_t width, std::uint32_t height);

@@ -154,11 +154,24 @@ struct GBufferTexel {
   vec4 emission;        // 64: rgb emitted radiance toward the camera, w = unused
 };                      // 80 bytes
 
+// ---- Frame bands. Frame-lifetime storage is split into bands of whole rows so that no buffer
+// exceeds the device's per-buffer limit (lavapipe: 128 MiB): a band owns its own G-buffer, AOV,
+// basis and compose buffers, and every per-pixel pass is dispatched once per band. Pixels are
+// addressed band-locally (index = local row * width + x) but sampled with their FRAME coordinates,
+// so a frame rendered in bands is bit-identical to the same frame rendered whole.
+// band = (first row of the band, rows in the band, light count, unused).
+
 // ---- Push constants of primary.comp (<= 128 bytes, the guaranteed minimum).
 struct PrimaryPush {
   GpuCamera camera;   // 0
-  uvec4 frame;        // 64: width, height, sample index, seed
-};                    // 80 bytes
+  uvec4 frame;        // 64: width, height (of the whole frame), sample index, seed
+  uvec4 band;         // 80: first row, rows, light count, flags (kPrimaryFlag*)
+};                    // 96 bytes
+// The primary pass re-creates the G-buffer of a sample without adding to the AOV and emission
+// accumulators (an added light traces its shadow rays from the same primary hits).
+OBS_CONST uint kPrimaryFlagGBufferOnly = 1u;
+// The frame keeps no primary AOVs (only what compose needs was asked for): M_s is still summed.
+OBS_CONST uint kPrimaryFlagNoAovs = 2u;
 
 // ---- Push constants of the bench/trace kernel.
 struct TracePush {
@@ -197,7 +210,8 @@ struct ShadePush {
   vec4 rAve;    // 48: R_ave rgb (the reflectance of a miss within dmax, SPEC §1.2), w = unused
   vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = scene size
                 //     (largest bounding-box extent: scales the ray-origin offset, ray.glsl)
-};              // 80 bytes
+  uvec4 band;   // 80: first row, rows, unused, unused (see "Frame bands")
+};              // 96 bytes
 
 // ---- Bindings of the shading passes (after the scene's 0..5).
 OBS_CONST uint kBindingGBuffer = 6;   // GBufferTexel[pixels] of the current sample
@@ -211,6 +225,14 @@ OBS_CONST uint kBindingSpecularQueue = 13;   // uint[]: kQueueHeader words, then
 OBS_CONST uint kBindingLightScales = 14;     // vec4[lights]: E_s (to make seen emission unit)
 OBS_CONST uint kShadingBindingCount = 15;
 
+// ---- Bindings of primary.comp after the scene's (0..5).
+OBS_CONST uint kBindingPrimaryGBuffer = 6;       // GBufferTexel[pixel]
+OBS_CONST uint kBindingPrimaryAovs = 7;          // vec4 pairs [pixel * kAovSlots + slot]
+OBS_CONST uint kBindingPrimaryLightScales = 8;   // vec4[lights]: E_s at render time (normaliser)
+OBS_CONST uint kBindingPrimaryEmissionBasis = 9; // vec4 pairs [light][pixel]: M_s, the emission
+                                                 // the camera sees of light s at unit emission
+OBS_CONST uint kPrimaryBindingCount = 10;
+
 // Header of the specular queue: an indirect dispatch (groups x, y, z) and the entry count.
 OBS_CONST uint kQueueGroupsX = 0;
 OBS_CONST uint kQueueCount = 3;
@@ -221,7 +243,8 @@ struct PathPush {
   GpuCamera camera; // 0: camera.right.w = scene size (scales the ray-origin offset, ray.glsl)
   uvec4 frame;      // 64: width, height, sample index, seed
   uvec4 params;     // 80: light count (0 = no light with power), max depth d, RR depth, strategy
-};                  // 96 bytes
+  uvec4 band;       // 96: first row, rows, unused, unused (see "Frame bands")
+};                  // 112 bytes
 OBS_CONST uint kPathStrategyMis = 0u;       // MIS of light and BSDF sampling (the reference)
 OBS_CONST uint kPathStrategyLightOnly = 1u; // area lights by light sampling only (tests)
 OBS_CONST uint kPathStrategyBsdfOnly = 2u;  // area lights by BSDF sampling only (tests)
@@ -232,17 +255,39 @@ OBS_CONST uint kBindingPathScales = 9u;     // vec4[lights]: E_s, each light's e
 OBS_CONST uint kPathBindingCount = 10u;
 
 // ---- compose.comp: per pixel, AOV slots written (averaged over samples).
-OBS_CONST uint kComposeCombined = 0;   // C = sum_s E_s D_s + I_a A + emission (+ specular)
+OBS_CONST uint kComposeCombined = 0;   // C = sum_s E_s (D_s + M_s) + I_a A (+ specular)
 OBS_CONST uint kComposeDirect = 1;     // sum_s E_s D_s at the primary hit
 OBS_CONST uint kComposeIndirect = 2;   // I_a * A at the primary hit (albedo I_a W_c)
 OBS_CONST uint kComposeSpecular = 3;   // everything gathered along specular paths
 OBS_CONST uint kComposeObscurance = 4; // W (grey obscurance), in .x
-OBS_CONST uint kComposeSlots = 5;
+OBS_CONST uint kComposeEmission = 5;   // sum_s E_s M_s: emission the camera sees, per light scaled
+OBS_CONST uint kComposeSlots = 6;
 
 struct ComposePush {
-  uvec4 frame;     // 0:  width, height, samples accumulated, light count
+  uvec4 frame;     // 0:  width, rows (of the band), samples accumulated, light count
   vec4 ambient;    // 16: I_a(E) rgb, w = 1 when the specular buffers hold data
-};                 // 32 bytes
+  uvec4 slots;     // 32: x = slots per pixel in the output: kComposeSlots, or 1 (combined only)
+};                 // 48 bytes
+
+// Bindings of compose.comp (its own set; no scene bindings).
+OBS_CONST uint kBindingComposeBasis = 0;           // vec4 pairs [light][pixel]: D_s sums
+OBS_CONST uint kBindingComposeAmbient = 1;         // vec4 pairs [pixel]: A sums (rgb), W (w)
+OBS_CONST uint kBindingComposeEmissionBasis = 2;   // vec4 pairs [light][pixel]: M_s sums
+OBS_CONST uint kBindingComposeEmissions = 3;       // vec4[lights]: E_s to compose with
+OBS_CONST uint kBindingComposeOutput = 4;          // vec4[pixel * kComposeSlots]
+OBS_CONST uint kBindingComposeSpecularBasis = 5;   // vec4 pairs [light][pixel]
+OBS_CONST uint kBindingComposeSpecularAmbient = 6; // vec4 pairs [pixel]
+OBS_CONST uint kComposeBindingCount = 7;
+
+// ---- tonemap.comp: composed radiance -> display RGBA8 (exposure, then the sRGB curve).
+struct TonemapPush {
+  uvec4 frame;     // 0:  width, rows (of the band), compose slot to show, channels (1 or 3)
+  vec4 params;     // 16: exposure scale 2^stops, unused...
+  uvec4 slots;     // 32: x = slots per pixel in the composed buffer (ComposePush.slots.x)
+};                 // 48 bytes
+OBS_CONST uint kBindingTonemapInput = 0;  // vec4[pixel * kComposeSlots]
+OBS_CONST uint kBindingTonemapOutput = 1; // uint[pixel]: RGBA8, R in the low byte
+OBS_CONST uint kTonemapBindingCount = 2;
 
 // ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,
 // then its Kahan compensation), so accumulation buffers hold kAccumulatorVec4s vec4 per entry.

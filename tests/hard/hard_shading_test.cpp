@@ -13,6 +13,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include "render/one_shot.h"
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "render/obscurance_renderer.h"
@@ -31,16 +32,16 @@ std::size_t nonFinite(const io::Image& image) {
 
 class HardRender : public GpuTest {
 protected:
-  render::ObscuranceResult render(const scene::Scene& s, const render::ObscuranceSettings& settings) {
+  test::ObscuranceResult render(const scene::Scene& s, const render::ObscuranceSettings& settings) {
     bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-    auto r = render::renderObscurances(context(), s, tree, settings);
+    auto r = test::renderObscurances(context(), s, tree, settings);
     EXPECT_EQ(r.stats.truncatedTraversals, 0u);
     EXPECT_EQ(nonFinite(r.image), 0u) << "NaN or inf in the obscurance render's AOVs";
     return r;
   }
-  render::PathTraceResult pathTrace(const scene::Scene& s, const render::PathTraceSettings& settings) {
+  test::PathTraceResult pathTrace(const scene::Scene& s, const render::PathTraceSettings& settings) {
     bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-    auto r = render::renderPathTraced(context(), s, tree, settings);
+    auto r = test::renderPathTraced(context(), s, tree, settings);
     EXPECT_EQ(r.stats.truncatedTraversals, 0u);
     EXPECT_EQ(r.nonFiniteSamples, 0u);
     EXPECT_EQ(nonFinite(r.image), 0u) << "NaN or inf in the path-traced image";
@@ -195,7 +196,7 @@ class HardScale : public HardRender {};
 // the samples are the same (same seed), so only rounding may differ. Returns RMSE / mean of the
 // combined AOV against the unscaled box and the pixels whose coverage changed.
 ImageDifference scaledCornellDifference(HardRender& test, float scale,
-                                        const std::function<render::ObscuranceResult(const scene::Scene&,
+                                        const std::function<test::ObscuranceResult(const scene::Scene&,
                                                                                      const render::ObscuranceSettings&)>& renderFn) {
   scene::Scene base = cornell();
   render::ObscuranceSettings settings;

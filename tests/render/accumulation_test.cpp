@@ -5,9 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include "render/one_shot.h"
 #include "bvh/bvh.h"
 #include "gpu_test.h"
-#include "render/aov_render.h"
+#include "render/aovs.h"
 #include "render/scene/scene_buffers.h"
 #include "render/test_scenes.h"
 
@@ -22,10 +23,11 @@ TEST_F(Accumulation, HundredThousandSamplesOfAConstantStayWithin1e6) {
   b.quad({-100, 0, -100}, {0, 0, 200}, {200, 0, 0}, m);
   scene::Scene s = b.build();
   bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-  render::RenderSettings settings{.width = 8, .height = 8, .spp = 100000, .seed = 3,
-                                  .camera = lookCamera({0, 1, 0}, {0, -1, 0}, {0, 0, -1}, 0.5f)};
-  render::RenderStats stats;
-  io::Image image = render::renderAovs(context(), s, tree, settings, stats);
+  // The primary pass alone (no shadow or obscurance rays): its AOV accumulators are under test.
+  render::ObscuranceSettings settings{.width = 8, .height = 8, .spp = 100000, .seed = 3,
+                                      .camera = lookCamera({0, 1, 0}, {0, -1, 0}, {0, 0, -1}, 0.5f),
+                                      .shadowRays = 0, .obscuranceRays = 0};
+  io::Image image = test::renderObscurances(context(), s, tree, settings).image;
   const int albedo = image.channelIndex("albedo.R");
   const float expected[3] = {0.3f, 0.7f, 0.1f};
   double worst = 0.0;

@@ -5,10 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include "render/one_shot.h"
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "io/image_io.h"
-#include "render/aov_render.h"
+#include "render/aovs.h"
 #include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
@@ -20,10 +21,11 @@ protected:
   io::Image render(std::uint32_t size, std::uint32_t spp, std::uint32_t seed = 1) {
     scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
     bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-    render::RenderSettings settings{.width = size, .height = size, .spp = spp, .seed = seed, .camera = s.cameras.at(0)};
-    render::RenderStats stats;
-    io::Image image = render::renderAovs(context(), s, tree, settings, stats);
-    EXPECT_EQ(stats.truncatedTraversals, 0u);
+    render::ObscuranceSettings settings{.width = size, .height = size, .spp = spp, .seed = seed,
+                                        .camera = s.cameras.at(0), .shadowRays = 0, .obscuranceRays = 0};
+    auto result = test::renderObscurances(context(), s, tree, settings);
+    io::Image image = std::move(result.image);
+    EXPECT_EQ(result.stats.truncatedTraversals, 0u);
     materials_ = s.materials;
     return image;
   }

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "render/one_shot.h"
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "render/obscurance_renderer.h"
@@ -22,9 +23,9 @@ constexpr float kHalfSize = 1000.0f; // "infinite" planes: far larger than dMax
 
 class Obscurance : public GpuTest {
 protected:
-  render::ObscuranceResult render(const scene::Scene& s, render::ObscuranceSettings settings) {
+  test::ObscuranceResult render(const scene::Scene& s, render::ObscuranceSettings settings) {
     bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-    auto result = render::renderObscurances(context(), s, tree, settings);
+    auto result = test::renderObscurances(context(), s, tree, settings);
     EXPECT_EQ(result.stats.truncatedTraversals, 0u);
     for (float v : result.image.pixels) EXPECT_TRUE(std::isfinite(v));
     return result;

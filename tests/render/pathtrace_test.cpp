@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "render/one_shot.h"
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "render/obscurance_renderer.h"
@@ -54,9 +55,9 @@ std::vector<double> channelValues(const io::Image& image, const std::string& pre
 
 class PathTrace : public GpuTest {
 protected:
-  render::PathTraceResult render(const scene::Scene& s, const render::PathTraceSettings& settings) {
+  test::PathTraceResult render(const scene::Scene& s, const render::PathTraceSettings& settings) {
     bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-    auto result = render::renderPathTraced(context(), s, tree, settings);
+    auto result = test::renderPathTraced(context(), s, tree, settings);
     EXPECT_EQ(result.stats.truncatedTraversals, 0u) << "the loop limiter must never cut a path";
     EXPECT_EQ(result.nonFiniteSamples, 0u);
     for (float v : result.image.pixels) EXPECT_TRUE(std::isfinite(v));
@@ -224,7 +225,7 @@ TEST_F(PathTrace, DirectLightOnTheCornellBoxMatchesTheObscuranceRenderersDirectA
   ob.shadowRays = 8;
   ob.obscuranceRays = 0;
   bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-  auto ref = render::renderObscurances(context(), s, tree, ob);
+  auto ref = test::renderObscurances(context(), s, tree, ob);
   ASSERT_EQ(ref.stats.truncatedTraversals, 0u);
 
   double sumSq = 0.0, sumRef = 0.0;

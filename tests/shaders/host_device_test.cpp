@@ -25,10 +25,11 @@ static_assert(sizeof(GpuRay) == 32);
 static_assert(sizeof(GpuHit) == 16 && offsetof(GpuHit, primitive) == 12);
 static_assert(sizeof(GpuCamera) == 64);
 static_assert(sizeof(GBufferTexel) == 80 && offsetof(GBufferTexel, emission) == 64);
-static_assert(sizeof(PrimaryPush) == 80 && sizeof(PrimaryPush) <= 128);
+static_assert(sizeof(PrimaryPush) == 96 && offsetof(PrimaryPush, band) == 80 && sizeof(PrimaryPush) <= 128);
 static_assert(sizeof(TracePush) == 16);
-static_assert(sizeof(PathPush) == 96 && offsetof(PathPush, params) == 80 && sizeof(PathPush) <= 128);
-static_assert(sizeof(ShadePush) == 80 && sizeof(ComposePush) == 32);
+static_assert(sizeof(PathPush) == 112 && offsetof(PathPush, band) == 96 && sizeof(PathPush) <= 128);
+static_assert(sizeof(ShadePush) == 96 && offsetof(ShadePush, band) == 80 && sizeof(ComposePush) == 48);
+static_assert(sizeof(TonemapPush) == 48);
 static_assert(kBvhStackSize >= kBvhMaxDepth, "the traversal stack must hold the deepest path");
 static_assert(kMaxTraversalSteps < 65535u, "must stop before lavapipe's loop limiter");
 } // namespace obscura::gpu
@@ -51,7 +52,7 @@ struct LayoutBlock {
   gpu::GpuLight light;
   gpu::GpuEmitter emitter;
 };
-static_assert(sizeof(LayoutBlock) == 176 * 4);
+static_assert(sizeof(LayoutBlock) == 180 * 4);
 
 class HostDeviceLayout : public GpuTest {};
 
@@ -66,8 +67,8 @@ TEST_F(HostDeviceLayout, GlslWritesEveryFieldWhereCppReadsIt) {
   out.download(context(), &block, sizeof(block));
   // Word i holds the value i (as float, int or uint as the field's type says).
   const auto* words = reinterpret_cast<const std::uint32_t*>(&block);
-  const std::size_t intWords[] = {60,  61,  62,  63,  68,  69,  70,  71,  83,  136, 137, 138,
-                                  139, 140, 141, 142, 143, 152, 153, 154, 155};
+  const std::size_t intWords[] = {60,  61,  62,  63,  68,  69,  70,  71,  83,  136, 137, 138, 139, 140,
+                                  141, 142, 143, 144, 145, 146, 147, 156, 157, 158, 159};
   for (std::size_t i = 0; i < sizeof(LayoutBlock) / 4; ++i) {
     bool isInt = std::find(std::begin(intWords), std::end(intWords), i) != std::end(intWords);
     if (isInt) {
@@ -83,8 +84,9 @@ TEST_F(HostDeviceLayout, GlslWritesEveryFieldWhereCppReadsIt) {
   EXPECT_EQ(block.material.meanAlbedo.x, 64.0f);
   EXPECT_EQ(block.primaryPush.frame.x, 136u);
   EXPECT_EQ(block.gtexel.emission.w, 119.0f);
-  EXPECT_EQ(block.light.info.x, 152u);
-  EXPECT_EQ(block.emitter.radiance.w, 175.0f);
+  EXPECT_EQ(block.primaryPush.band.w, 143u);
+  EXPECT_EQ(block.light.info.x, 156u);
+  EXPECT_EQ(block.emitter.radiance.w, 179.0f);
 }
 
 } // namespace

@@ -18,36 +18,37 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 }
 
 namespace {
-gpu::KernelDesc primaryKernelDesc() {
+gpu::KernelDesc primaryKernelDesc(std::uint32_t bands) {
   auto bindings = sceneBindingKinds();
-  bindings.insert(bindings.end(), 2, gpu::BindingKind::StorageBuffer); // gbuffer, aovs
+  bindings.insert(bindings.end(), gpu::kPrimaryBindingCount - gpu::kSceneBindingCount,
+                  gpu::BindingKind::StorageBuffer);
   return {.name = "primary", .spirv = kSpirv_primary, .bindings = bindings,
-          .pushConstantBytes = sizeof(gpu::PrimaryPush)};
+          .pushConstantBytes = sizeof(gpu::PrimaryPush), .setCount = bands};
 }
 } // namespace
 
-std::uint64_t PrimaryPass::bytesNeeded(std::uint32_t width, std::uint32_t height) {
-  std::uint64_t pixels = std::uint64_t(width) * height;
-  return pixels * (sizeof(gpu::GBufferTexel) + gpu::kAovSlots * gpu::kAccumulatorVec4s * sizeof(glm::vec4));
+PrimaryPass::PrimaryPass(const gpu::Context& context, std::uint32_t bands)
+    : kernel_(context, primaryKernelDesc(bands)) {}
+
+void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const ObscuranceFrame& frame,
+                       const gpu::Buffer& lightScales) {
+  scene.bindTo(kernel_, band, &frame.status());
+  const auto& b = frame.band(band);
+  kernel_.bind(gpu::kBindingPrimaryGBuffer, b.gbuffer, band);
+  kernel_.bind(gpu::kBindingPrimaryAovs, b.aovs, band);
+  kernel_.bind(gpu::kBindingPrimaryLightScales, lightScales, band);
+  kernel_.bind(gpu::kBindingPrimaryEmissionBasis, b.emissionBasis, band);
 }
 
-PrimaryPass::PrimaryPass(const gpu::Context& context, const SceneBuffers& scene, std::uint32_t width,
-                         std::uint32_t height)
-    : width_(width), height_(height), kernel_(context, primaryKernelDesc()),
-      gbuffer_(context, std::uint64_t(width) * height * sizeof(gpu::GBufferTexel),
-               vk::BufferUsageFlagBits::eStorageBuffer, "primary.gbuffer"),
-      aovs_(context, std::uint64_t(width) * height * gpu::kAovSlots * gpu::kAccumulatorVec4s * sizeof(glm::vec4),
-            vk::BufferUsageFlagBits::eStorageBuffer, "primary.aovs") {
-  scene.bindTo(kernel_);
-  kernel_.bind(gpu::kBindingPassFirst, gbuffer_);
-  kernel_.bind(gpu::kBindingPassFirst + 1, aovs_);
-}
-
-void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, const gpu::GpuCamera& camera,
-                         std::uint32_t sampleIndex, std::uint32_t seed) const {
-  gpu::PrimaryPush push{.camera = camera, .frame = glm::uvec4(width_, height_, sampleIndex, seed)};
-  kernel_.dispatch(cmd, gpu::groupsFor(width_, gpu::kWorkgroupSizeX), gpu::groupsFor(height_, gpu::kWorkgroupSizeY),
-                   1, &push);
+void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
+                         const gpu::GpuCamera& camera, std::uint32_t sampleIndex, std::uint32_t seed,
+                         std::uint32_t lights, std::uint32_t flags) const {
+  const FrameBand& rows = layout.bands[band];
+  gpu::PrimaryPush push{.camera = camera,
+                        .frame = glm::uvec4(layout.width, layout.height, sampleIndex, seed),
+                        .band = glm::uvec4(rows.firstRow, rows.rows, lights, flags)};
+  kernel_.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
+                   gpu::groupsFor(rows.rows, gpu::kWorkgroupSizeY), 1, &push, band);
 }
 
 } // namespace obscura::render

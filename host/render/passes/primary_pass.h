@@ -1,10 +1,10 @@
-// primary_pass.h — camera rays to the G-buffer and the AOV accumulation (primary.comp).
+// primary_pass.h — camera rays to the G-buffer, the AOV accumulators and the seen-emission basis
+// M_s (primary.comp) [RTO §4.1 step 1].
 #pragma once
 #include <cstdint>
-#include <functional>
 
 #include "gpu/kernel.h"
-#include "gpu/timestamps.h"
+#include "render/frame/obscurance_frame.h"
 #include "render/scene/scene_buffers.h"
 #include "scene/scene.h"
 
@@ -16,26 +16,22 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 
 class PrimaryPass {
 public:
-  PrimaryPass(const gpu::Context& context, const SceneBuffers& scene, std::uint32_t width,
-              std::uint32_t height);
+  PrimaryPass(const gpu::Context& context, std::uint32_t bands);
 
-  // Records the dispatch of sample `sampleIndex` (0 restarts the accumulation).
-  void record(const vk::raii::CommandBuffer& cmd, const gpu::GpuCamera& camera,
-              std::uint32_t sampleIndex, std::uint32_t seed) const;
+  // Binds band `band`'s descriptor set: the scene, the frame's status counters and band buffers,
+  // and the lights' render-time emission scales (which make M_s unit).
+  void bind(std::uint32_t band, const SceneBuffers& scene, const ObscuranceFrame& frame,
+            const gpu::Buffer& lightScales);
 
-  const gpu::Buffer& gbuffer() const { return gbuffer_; }
-  const gpu::Buffer& aovs() const { return aovs_; }
-  std::uint32_t width() const { return width_; }
-  std::uint32_t height() const { return height_; }
-
-  // Device memory that a pass of this size needs, to refuse absurd resolutions up front.
-  static std::uint64_t bytesNeeded(std::uint32_t width, std::uint32_t height);
+  // Records sample `sampleIndex` of band `band` (sample 0 restarts the accumulators). `flags`:
+  // kPrimaryFlagGBufferOnly makes the G-buffer again and accumulates nothing; kPrimaryFlagNoAovs
+  // skips the AOV accumulators the frame does not keep.
+  void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
+              const gpu::GpuCamera& camera, std::uint32_t sampleIndex, std::uint32_t seed, std::uint32_t lights,
+              std::uint32_t flags) const;
 
 private:
-  std::uint32_t width_, height_;
   gpu::Kernel kernel_;
-  gpu::Buffer gbuffer_;
-  gpu::Buffer aovs_;
 };
 
 } // namespace obscura::render

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 namespace obscura::render {
 namespace {
@@ -74,25 +75,43 @@ LightSet buildLightSet(const scene::Scene& scene) {
     set.power.push_back(static_cast<double>(luminanceWeight(flux * scale)));
   }
   // Punctual lights (KHR_lights_punctual): E_s = colour x intensity, unit transport per light.
-  for (const auto& p : scene.punctualLights) {
-    gpu::GpuLight light{};
-    std::uint32_t type = p.type == scene::PunctualType::Point ? gpu::kLightPoint
-                         : p.type == scene::PunctualType::Spot ? gpu::kLightSpot
-                                                               : gpu::kLightDirectional;
-    light.info = glm::uvec4(type, 0u, 0u, 0u);
-    light.position = glm::vec4(p.position, p.range);
-    light.direction = glm::vec4(glm::normalize(p.direction), 0.0f);
-    light.params = glm::vec4(0.0f, 0.0f, std::cos(p.innerConeAngle), std::cos(p.outerConeAngle));
-    glm::vec3 scale = p.color * p.intensity;
-    // Unit flux: 4 pi sr for point and spot (glTF's spot intensity is that of a point light
-    // masked by the cone; we count the full sphere, OURS); irradiance x cross-section for the sun.
-    float unit = type == gpu::kLightDirectional ? projectedBoxArea(scene.bounds, p.direction) : 4.0f * kPi;
-    set.lights.push_back(light);
-    set.names.push_back(p.name.empty() ? "punctual" : p.name);
-    set.emission.push_back(scale);
-    set.unitFlux.push_back(glm::vec3(unit));
-    set.power.push_back(static_cast<double>(unit * luminanceWeight(scale)));
-  }
+  for (const auto& p : scene.punctualLights) appendPunctual(set, p, scene.bounds);
+  updateSelection(set);
+  return set;
+}
+
+void appendPunctual(LightSet& set, const scene::PunctualLight& p, const scene::Bounds& bounds) {
+  gpu::GpuLight light{};
+  std::uint32_t type = p.type == scene::PunctualType::Point ? gpu::kLightPoint
+                       : p.type == scene::PunctualType::Spot ? gpu::kLightSpot
+                                                             : gpu::kLightDirectional;
+  light.info = glm::uvec4(type, 0u, 0u, 0u);
+  light.position = glm::vec4(p.position, p.range);
+  light.direction = glm::vec4(glm::normalize(p.direction), 0.0f);
+  light.params = glm::vec4(0.0f, 0.0f, std::cos(p.innerConeAngle), std::cos(p.outerConeAngle));
+  glm::vec3 scale = p.color * p.intensity;
+  // Unit flux: 4 pi sr for point and spot (glTF's spot intensity is that of a point light
+  // masked by the cone; we count the full sphere, OURS); irradiance x cross-section for the sun.
+  float unit = type == gpu::kLightDirectional ? projectedBoxArea(bounds, p.direction) : 4.0f * kPi;
+  set.lights.push_back(light);
+  set.names.push_back(p.name.empty() ? "punctual" : p.name);
+  set.emission.push_back(scale);
+  set.unitFlux.push_back(glm::vec3(unit));
+  set.power.push_back(static_cast<double>(unit * luminanceWeight(scale)));
+}
+
+void removePunctual(LightSet& set, std::size_t index) {
+  if (set.lights.at(index).info.x == gpu::kLightArea)
+    throw std::logic_error("removePunctual: light " + set.names[index] + " is an area light");
+  set.lights.erase(set.lights.begin() + static_cast<std::ptrdiff_t>(index));
+  set.names.erase(set.names.begin() + static_cast<std::ptrdiff_t>(index));
+  set.emission.erase(set.emission.begin() + static_cast<std::ptrdiff_t>(index));
+  set.unitFlux.erase(set.unitFlux.begin() + static_cast<std::ptrdiff_t>(index));
+  set.power.erase(set.power.begin() + static_cast<std::ptrdiff_t>(index));
+  updateSelection(set);
+}
+
+void updateSelection(LightSet& set) {
   // Selection CDF by power.
   double total = 0.0;
   for (double p : set.power) total += std::max(0.0, p);
@@ -109,7 +128,6 @@ LightSet buildLightSet(const scene::Scene& scene) {
     set.lights[i].params.x = static_cast<float>(closed ? 1.0 : running);
     set.lights[i].params.y = static_cast<float>(p);
   }
-  return set;
 }
 
 } // namespace obscura::render

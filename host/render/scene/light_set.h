@@ -31,6 +31,14 @@ struct LightSet {
 // buffer is simply 0) but are never sampled.
 LightSet buildLightSet(const scene::Scene& scene);
 
+// Appends a punctual light (glTF KHR_lights_punctual units); call updateSelection after.
+void appendPunctual(LightSet& set, const scene::PunctualLight& light, const scene::Bounds& bounds);
+// Removes punctual light `index` and updates the selection. Area lights are never removed from a
+// set: their triangles name them by index (TriangleShading), so they are switched off instead.
+void removePunctual(LightSet& set, std::size_t index);
+// The selection CDF and probabilities from the lights' powers.
+void updateSelection(LightSet& set);
+
 // Scalar "brightness" of an RGB value for selection weights: the channel mean.
 float luminanceWeight(const glm::vec3& rgb);
 

@@ -159,13 +159,13 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
            textures_.size() + texels_.size() + status_.size();
 }
 
-void SceneBuffers::bindTo(gpu::Kernel& kernel) const {
-  kernel.bind(gpu::kBindingBvhItems, items_);
-  kernel.bind(gpu::kBindingShading, shading_);
-  kernel.bind(gpu::kBindingMaterials, materials_);
-  kernel.bind(gpu::kBindingTextures, textures_);
-  kernel.bind(gpu::kBindingTexels, texels_);
-  kernel.bind(gpu::kBindingStatus, status_);
+void SceneBuffers::bindTo(gpu::Kernel& kernel, std::uint32_t set, const gpu::Buffer* status) const {
+  kernel.bind(gpu::kBindingBvhItems, items_, set);
+  kernel.bind(gpu::kBindingShading, shading_, set);
+  kernel.bind(gpu::kBindingMaterials, materials_, set);
+  kernel.bind(gpu::kBindingTextures, textures_, set);
+  kernel.bind(gpu::kBindingTexels, texels_, set);
+  kernel.bind(gpu::kBindingStatus, status ? *status : status_, set);
 }
 
 std::uint32_t SceneBuffers::truncatedTraversals() const { return statusWords()[gpu::kStatusTruncated]; }

@@ -35,8 +35,9 @@ class SceneBuffers {
 public:
   SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh);
 
-  // Binds bindings 0..5 of `kernel`.
-  void bindTo(gpu::Kernel& kernel) const;
+  // Binds bindings 0..5 of descriptor set `set` of `kernel`. Binding 5 (status counters) is the
+  // scene's own unless `status` is given: a renderer counts its frame's rays in its own buffer.
+  void bindTo(gpu::Kernel& kernel, std::uint32_t set = 0, const gpu::Buffer* status = nullptr) const;
 
   // Traversals cut off by kMaxTraversalSteps since the last reset (must stay 0).
   std::uint32_t truncatedTraversals() const;

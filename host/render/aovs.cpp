@@ -1,14 +1,8 @@
-#include "render/aov_render.h"
+#include "render/aovs.h"
 
 #include <bit>
-#include <algorithm>
-#include <chrono>
-#include <cmath>
 
-#include "gpu/kernel.h"
-#include "gpu/timestamps.h"
-#include "render/passes/primary_pass.h"
-#include "render/scene/scene_buffers.h"
+#include "shared/host_device.h"
 
 namespace obscura::render {
 
@@ -25,10 +19,6 @@ std::vector<std::string> aovChannels(const std::string& aov) {
   if (aov == "coverage") return {"coverage.A"};
   if (aov == "primitive" || aov == "material") return {aov + ".id"};
   return {aov + ".R", aov + ".G", aov + ".B"};
-}
-
-std::uint64_t renderBytesNeeded(std::uint32_t width, std::uint32_t height) {
-  return PrimaryPass::bytesNeeded(width, height);
 }
 
 // Converts the accumulated AOV slots into image channels.
@@ -66,47 +56,6 @@ io::Image resolvePrimaryAovs(const std::vector<glm::vec4>& aov, std::uint32_t wi
     image.pixels[k++] = primitive == gpu::kInvalidIndex ? -1.0f : static_cast<float>(primitive);
     image.pixels[k++] = material == gpu::kInvalidIndex ? -1.0f : static_cast<float>(material);
   }
-  return image;
-}
-
-io::Image renderAovs(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
-                     const RenderSettings& settings, RenderStats& stats, const ProgressFn& progress) {
-  auto start = std::chrono::steady_clock::now();
-  SceneBuffers buffers(context, scene, bvh);
-  stats.notes = buffers.notes();
-  PrimaryPass primary(context, buffers, settings.width, settings.height);
-  gpu::Timestamps timestamps(context);
-  const gpu::GpuCamera camera = gpuCamera(settings.camera, settings.width, settings.height);
-
-  // Several samples per submission (each dispatch is short, so no device timeout), with a
-  // barrier between samples, which read and write the same accumulators. The progress line moves
-  // once per submission.
-  constexpr std::uint32_t kSamplesPerSubmission = 64; // <= the timestamp pool's 256 pairs
-  for (std::uint32_t first = 0; first < settings.spp; first += kSamplesPerSubmission) {
-    const std::uint32_t last = std::min(settings.spp, first + kSamplesPerSubmission);
-    context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
-      timestamps.reset(cmd);
-      for (std::uint32_t s = first; s < last; ++s) {
-        if (s > first) gpu::computeBarrier(cmd);
-        timestamps.begin(cmd, "primary");
-        primary.record(cmd, camera, s, settings.seed);
-        timestamps.end(cmd, "primary");
-      }
-    });
-    timestamps.collect();
-    if (progress)
-      progress(last, settings.spp,
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-
-  stats.truncatedTraversals = buffers.truncatedTraversals();
-  auto& pass = stats.passes["primary"];
-  pass.rays = std::uint64_t(settings.width) * settings.height * settings.spp;
-  pass.gpuMs = timestamps.available() ? timestamps.totalsMs().at("primary") : 0.0;
-  stats.deviceBytes = buffers.bytes() + PrimaryPass::bytesNeeded(settings.width, settings.height);
-  auto aov = primary.aovs().download<glm::vec4>(context);
-  io::Image image = resolvePrimaryAovs(aov, settings.width, settings.height, settings.spp);
-  stats.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return image;
 }
 

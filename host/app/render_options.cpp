@@ -1,0 +1,78 @@
+#include "app/render_options.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+
+namespace obscura::app {
+
+scene::Camera chooseCamera(const scene::Scene& scene, int index) {
+  if (index >= 0) {
+    if (index >= static_cast<int>(scene.cameras.size()))
+      throw InputError(fmt::format("--camera {}: the scene {} has {} cameras", index, scene.sourcePath,
+                                   scene.cameras.size()));
+    return scene.cameras[index];
+  }
+  return scene.cameras.empty() ? scene::defaultCamera(scene.bounds) : scene.cameras.front();
+}
+
+void chooseSize(RenderOptions& o, const scene::Camera& camera) {
+  float aspect = camera.aspectRatio > 0.0f ? camera.aspectRatio : 1.0f;
+  if (o.width == 0 && o.height == 0) {
+    o.width = aspect >= 1.0f ? 512u : static_cast<std::uint32_t>(std::lround(512.0f * aspect));
+    o.height = aspect >= 1.0f ? static_cast<std::uint32_t>(std::lround(512.0f / aspect)) : 512u;
+  } else if (o.height == 0) {
+    o.height = std::max(1u, static_cast<std::uint32_t>(std::lround(static_cast<float>(o.width) / aspect)));
+  } else if (o.width == 0) {
+    o.width = std::max(1u, static_cast<std::uint32_t>(std::lround(static_cast<float>(o.height) * aspect)));
+  }
+}
+
+void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
+  cmd.add_option("--width", o.width, "image width in pixels (default: 512 on the long side)")
+      ->check(CLI::Range(1u, 16384u));
+  cmd.add_option("--height", o.height, "image height in pixels")->check(CLI::Range(1u, 16384u));
+  cmd.add_option("--spp", o.spp, "primary samples per pixel")->check(CLI::Range(1u, 1u << 20));
+  cmd.add_option("--seed", o.seed, "random seed (same seed, same image)");
+  cmd.add_option("--camera", o.camera, "index of the glTF camera to use (default: the first)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--method", o.method, "obscurance (ray-traced obscurances) or pathtrace (the reference)")
+      ->check(CLI::IsMember({"obscurance", "pathtrace"}));
+  cmd.add_option("--max-depth", o.obscurance.maxDepth,
+                  "path depth in scattering vertices (specular paths; path tracing), default 6")
+      ->check(CLI::Range(1u, 1024u));
+  cmd.add_option("--shadow-rays", o.obscurance.shadowRays, "shadow rays per hit (N_s)")
+      ->check(CLI::Range(0u, 1024u));
+  cmd.add_option("--obs-rays", o.obscurance.obscuranceRays, "obscurance rays per hit (N_obs)")
+      ->check(CLI::Range(0u, 1024u));
+  cmd.add_option("--rho", o.rho, "rho(d): sqrt (the paper's), exp, ao")->check(CLI::IsMember({"sqrt", "exp", "ao"}));
+  cmd.add_option("--tau", o.obscurance.tau, "tau of --rho exp")->check(CLI::PositiveNumber);
+  cmd.add_option("--dmax", o.dMax, "dmax in scene units (default: 1/4 of the largest bounding-box extent)")
+      ->each([&o](const std::string&) { o.dMaxGiven = true; });
+  cmd.add_option("--sampling", o.sampling, "obscurance rays: systematic (default) or random")
+      ->check(CLI::IsMember({"systematic", "random"}));
+  cmd.add_flag("--no-bleed", o.noBleed, "grey obscurance W instead of colour bleeding W_c");
+}
+
+void checkRenderOptions(const RenderOptions& o) {
+  if (o.dMaxGiven && !(std::isfinite(o.dMax) && o.dMax > 0.0f))
+    throw InputError(fmt::format("--dmax {}: must be a finite positive distance in scene units", o.dMax));
+}
+
+render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scene::Camera& camera) {
+  render::ObscuranceSettings settings = o.obscurance;
+  settings.width = o.width;
+  settings.height = o.height;
+  settings.spp = o.spp;
+  settings.seed = o.seed;
+  settings.camera = camera;
+  settings.dMax = o.dMax;
+  settings.rho = o.rho == "exp" ? render::RhoKind::Exp : o.rho == "ao" ? render::RhoKind::Ao : render::RhoKind::Sqrt;
+  settings.systematic = o.sampling == "systematic";
+  settings.colourBleeding = !o.noBleed;
+  return settings;
+}
+
+} // namespace obscura::app

@@ -1,0 +1,48 @@
+// render_options.h — the options of a render that `render` and `relight SCENE` share: image size,
+// samples, camera, method and the obscurance parameters, and the settings made from them.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "app/commands.h"
+#include "render/obscurance_renderer.h"
+#include "scene/scene.h"
+
+namespace obscura::app {
+
+struct RenderOptions {
+  std::string scenePath;
+  std::string output;
+  std::uint32_t width = 0, height = 0; // 0 = from the camera's aspect, 512 on the long side
+  std::uint32_t spp = 4;
+  std::uint32_t seed = 1;
+  int camera = -1;
+  std::vector<std::string> aovs;
+  std::string metrics;
+  float exposure = 0.0f;
+  std::string method = "obscurance";
+  std::string saveState;
+  render::ObscuranceSettings obscurance;
+  std::string rho = "sqrt";
+  std::string sampling = "systematic";
+  bool noBleed = false;
+  float dMax = 0.0f;
+  bool dMaxGiven = false;
+  DeviceOptions device;
+};
+
+// Registers the shared options on `cmd` (not the scene or the output, which each command names).
+void addRenderOptions(CLI::App& cmd, RenderOptions& o);
+// InputError for option values CLI11's checks cannot see (a non-finite --dmax).
+void checkRenderOptions(const RenderOptions& o);
+// The camera `index` of the scene (-1: the first, or the default camera when it has none).
+scene::Camera chooseCamera(const scene::Scene& scene, int index);
+// Fills a missing width or height from the camera's aspect (512 on the long side when both are).
+void chooseSize(RenderOptions& o, const scene::Camera& camera);
+// The obscurance renderer's settings from the options, for `camera` at the chosen size.
+render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scene::Camera& camera);
+
+} // namespace obscura::app

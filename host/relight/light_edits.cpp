@@ -1,0 +1,165 @@
+#include "relight/light_edits.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+
+namespace obscura::relight {
+namespace {
+
+using nlohmann::json;
+
+struct EntryContext {
+  const std::string& file;
+  std::size_t entry;
+  [[noreturn]] void fail(const std::string& what) const {
+    throw InputError(fmt::format("{}: entry {}: {}", file, entry, what));
+  }
+};
+
+float number(const json& j, const char* key, const EntryContext& at) {
+  if (!j.contains(key) || !j.at(key).is_number()) at.fail(fmt::format("'{}' must be a number", key));
+  const float v = j.at(key).get<float>();
+  if (!std::isfinite(v)) at.fail(fmt::format("'{}' must be finite", key));
+  return v;
+}
+
+glm::vec3 vec3(const json& j, const char* key, const EntryContext& at) {
+  if (!j.contains(key)) at.fail(fmt::format("'{}' is missing", key));
+  const json& v = j.at(key);
+  if (!v.is_array() || v.size() != 3 || !std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); }))
+    at.fail(fmt::format("'{}' must be an array of 3 numbers", key));
+  glm::vec3 out(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
+  if (!std::isfinite(out.x) || !std::isfinite(out.y) || !std::isfinite(out.z))
+    at.fail(fmt::format("'{}' must be finite", key));
+  return out;
+}
+
+std::string text(const json& j, const char* key, const EntryContext& at) {
+  if (!j.contains(key) || !j.at(key).is_string() || j.at(key).get<std::string>().empty())
+    at.fail(fmt::format("'{}' must be a non-empty string", key));
+  return j.at(key).get<std::string>();
+}
+
+void requireLight(const std::vector<std::string>& names, const std::string& name, const EntryContext& at) {
+  if (std::find(names.begin(), names.end(), name) == names.end())
+    at.fail(fmt::format("no light named '{}' at this point (lights: {})", name, fmt::join(names, ", ")));
+}
+
+scene::PunctualLight addedLight(const json& j, const EntryContext& at) {
+  if (!j.is_object()) at.fail("'add_light' must be an object");
+  const std::string type = text(j, "type", at);
+  scene::PunctualLight l;
+  l.name = text(j, "name", at);
+  if (type == "quad")
+    at.fail("an emissive quad needs scene geometry, which edits cannot insert yet; insert a glTF mesh instead");
+  if (type != "point" && type != "spot") at.fail(fmt::format("light type '{}' (known: point, spot)", type));
+  l.type = type == "point" ? scene::PunctualType::Point : scene::PunctualType::Spot;
+  l.position = vec3(j, "position", at);
+  l.color = j.contains("color") ? vec3(j, "color", at) : glm::vec3(1.0f);
+  l.intensity = number(j, "intensity", at);
+  if (l.intensity < 0.0f || glm::any(glm::lessThan(l.color, glm::vec3(0.0f))))
+    at.fail("intensity and color must not be negative");
+  if (l.type == scene::PunctualType::Spot) {
+    glm::vec3 d = vec3(j, "direction", at);
+    if (glm::length(d) == 0.0f) at.fail("'direction' must not be zero");
+    l.direction = glm::normalize(d);
+    l.innerConeAngle = j.contains("inner_cone") ? number(j, "inner_cone", at) : 0.0f;
+    l.outerConeAngle = j.contains("outer_cone") ? number(j, "outer_cone", at) : 0.7853982f;
+    if (!(0.0f <= l.innerConeAngle && l.innerConeAngle < l.outerConeAngle && l.outerConeAngle <= 1.5707964f))
+      at.fail("cones must satisfy 0 <= inner_cone < outer_cone <= pi/2 (radians, as glTF)");
+  }
+  return l;
+}
+
+} // namespace
+
+std::string Edit::kindName() const {
+  switch (kind) {
+    case Kind::Scale: return "scale";
+    case Kind::Color: return "color";
+    case Kind::AddLight: return "add_light";
+    case Kind::RemoveLight: return "remove_light";
+    case Kind::Move: return "move";
+    case Kind::Remove: return "remove";
+    case Kind::Insert: return "insert";
+  }
+  return "?";
+}
+
+std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> lightNames,
+                            std::vector<bool> areaLights) {
+  std::ifstream in(path);
+  if (!in) throw InputError(fmt::format("{}: cannot read the edits file", path));
+  json list;
+  try {
+    list = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
+  }
+  if (!list.is_array()) throw InputError(fmt::format("{}: the edits must be a JSON list", path));
+  std::vector<Edit> edits;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const EntryContext at{path, i};
+    const json& j = list[i];
+    if (!j.is_object()) at.fail("an edit must be an object");
+    Edit e;
+    e.entry = i;
+    if (j.contains("light")) {
+      e.name = text(j, "light", at);
+      requireLight(lightNames, e.name, at);
+      if (j.contains("scale")) {
+        e.kind = Edit::Kind::Scale;
+        e.scale = number(j, "scale", at);
+        if (e.scale < 0.0f) at.fail("'scale' must not be negative");
+      } else if (j.contains("color")) {
+        e.kind = Edit::Kind::Color;
+        e.color = vec3(j, "color", at);
+        if (glm::any(glm::lessThan(e.color, glm::vec3(0.0f)))) at.fail("'color' must not be negative");
+      } else {
+        at.fail("a light edit needs 'scale' or 'color'");
+      }
+    } else if (j.contains("add_light")) {
+      e.kind = Edit::Kind::AddLight;
+      e.light = addedLight(j.at("add_light"), at);
+      e.name = e.light.name;
+      if (std::find(lightNames.begin(), lightNames.end(), e.name) != lightNames.end())
+        at.fail(fmt::format("a light named '{}' exists already", e.name));
+      lightNames.push_back(e.name);
+      areaLights.push_back(false);
+    } else if (j.contains("remove_light")) {
+      e.kind = Edit::Kind::RemoveLight;
+      e.name = text(j, "remove_light", at);
+      requireLight(lightNames, e.name, at);
+      const auto k = static_cast<std::size_t>(std::find(lightNames.begin(), lightNames.end(), e.name) - lightNames.begin());
+      if (!areaLights[k]) {
+        lightNames.erase(lightNames.begin() + static_cast<std::ptrdiff_t>(k));
+        areaLights.erase(areaLights.begin() + static_cast<std::ptrdiff_t>(k));
+      }
+    } else if (j.contains("move")) {
+      e.kind = Edit::Kind::Move;
+      e.name = text(j, "move", at);
+      e.translate = j.contains("translate") ? vec3(j, "translate", at) : glm::vec3(0.0f);
+      e.rotateDegrees = j.contains("rotate_deg") ? vec3(j, "rotate_deg", at) : glm::vec3(0.0f);
+    } else if (j.contains("remove")) {
+      e.kind = Edit::Kind::Remove;
+      e.name = text(j, "remove", at);
+    } else if (j.contains("insert")) {
+      e.kind = Edit::Kind::Insert;
+      e.path = text(j, "insert", at);
+      e.name = text(j, "name", at);
+      e.translate = j.contains("translate") ? vec3(j, "translate", at) : glm::vec3(0.0f);
+    } else {
+      at.fail("unknown edit (known: light, add_light, remove_light, move, remove, insert)");
+    }
+    edits.push_back(std::move(e));
+  }
+  return edits;
+}
+
+} // namespace obscura::relight

@@ -1,0 +1,45 @@
+// light_edits.h — the edits file of `obscura relight SCENE --edits edits.json`: a JSON list applied
+// in order, each entry one of
+//   {"light": NAME, "scale": S}            the light's intensity multiplier (absolute, starts at 1)
+//   {"light": NAME, "color": [r, g, b]}    its RGB multipliers (absolute, start at 1, 1, 1)
+//   {"add_light": {"type": "point"|"spot", "name": N, "position": [..], "color": [..],
+//                  "intensity": I, "direction": [..], "inner_cone": a, "outer_cone": b}}
+//   {"remove_light": NAME}
+//   {"move": NODE, "translate": [..], "rotate_deg": [..]}, {"remove": NODE},
+//   {"insert": "other.gltf", "name": N, "translate": [..]}
+// A light's emission is E_s = (scene's E_s) x scale x color, as if the glTF's emissive strength
+// and factor (or the punctual light's intensity and colour) were edited.
+#pragma once
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace obscura::relight {
+
+struct Edit {
+  enum class Kind { Scale, Color, AddLight, RemoveLight, Move, Remove, Insert };
+  Kind kind = Kind::Scale;
+  std::size_t entry = 0;       // index in the file, for messages
+  std::string name;            // the light or node it names
+  float scale = 1.0f;
+  glm::vec3 color{1.0f};
+  scene::PunctualLight light;  // AddLight
+  glm::vec3 translate{0.0f};   // Move, Insert
+  glm::vec3 rotateDegrees{0.0f};
+  std::string path;            // Insert: the other glTF
+
+  std::string kindName() const;
+};
+
+// Reads and checks the whole file before anything is rendered: malformed entries and names
+// that do not exist at that point of the sequence (lights added or removed before it counted)
+// are InputErrors naming the file and the entry. `lightNames` are the scene's lights, `areaLights`
+// which of them are emissive meshes (removing one switches it off; its name stays).
+std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> lightNames,
+                            std::vector<bool> areaLights);
+
+} // namespace obscura::relight

@@ -1,0 +1,137 @@
+#include "relight/relight_state.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "io/image_io.h"
+#include "shared/host_device.h"
+
+namespace obscura::relight {
+namespace {
+namespace fs = std::filesystem;
+
+nlohmann::json vec3Json(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+
+glm::vec3 vec3From(const nlohmann::json& j, const std::string& file, const std::string& what) {
+  if (!j.is_array() || j.size() != 3 || !std::all_of(j.begin(), j.end(), [](const auto& x) { return x.is_number(); }))
+    throw InputError(fmt::format("{}: {} must be an array of 3 numbers", file, what));
+  return {j[0].get<float>(), j[1].get<float>(), j[2].get<float>()};
+}
+
+} // namespace
+
+std::vector<glm::vec3> RelightState::emissions() const {
+  std::vector<glm::vec3> out;
+  for (const auto& l : lights) out.push_back(l.emission);
+  return out;
+}
+
+std::vector<glm::vec3> RelightState::ambientWeights() const {
+  std::vector<glm::vec3> out;
+  for (const auto& l : lights) out.push_back(l.ambientWeight);
+  return out;
+}
+
+std::size_t RelightState::lightIndex(const std::string& name, const std::string& where) const {
+  for (std::size_t i = 0; i < lights.size(); ++i)
+    if (lights[i].name == name) return i;
+  std::vector<std::string> names;
+  for (const auto& l : lights) names.push_back(l.name);
+  throw InputError(fmt::format("{}: no light named '{}' (lights: {})", where, name, fmt::join(names, ", ")));
+}
+
+std::string lightTypeName(std::uint32_t gpuType) {
+  switch (gpuType) {
+    case gpu::kLightArea: return "area";
+    case gpu::kLightPoint: return "point";
+    case gpu::kLightSpot: return "spot";
+    default: return "directional";
+  }
+}
+
+void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const std::string& scenePath) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw InputError(fmt::format("{}: cannot create the state folder", dir));
+  const auto& lights = renderer.lights();
+  const auto& s = renderer.settings();
+  nlohmann::json json = {
+      {"version", kStateVersion},
+      {"scene", scenePath},
+      {"width", s.width},
+      {"height", s.height},
+      {"samples", renderer.samples()},
+      {"specular", renderer.specular()},
+      {"settings", {{"seed", s.seed}, {"shadow_rays", s.shadowRays}, {"obscurance_rays", s.obscuranceRays},
+                    {"dmax", renderer.dMax()}, {"rho", static_cast<int>(s.rho)}, {"systematic", s.systematic},
+                    {"colour_bleeding", s.colourBleeding}, {"max_depth", s.maxDepth}}},
+      {"average_reflectance", vec3Json(renderer.ambient().averageReflectance)},
+      {"lights", nlohmann::json::array()}};
+  for (std::size_t i = 0; i < lights.size(); ++i)
+    json["lights"].push_back({{"name", lights.names[i]}, {"type", lightTypeName(lights.lights[i].info.x)},
+                              {"emission", vec3Json(renderer.emissions()[i])},
+                              {"ambient_weight", vec3Json(renderer.ambient().weight[i])}});
+  io::writeExr((fs::path(dir) / "transport.exr").string(), renderer.transport().toImage());
+  const std::string path = (fs::path(dir) / "state.json").string(), temp = path + ".tmp";
+  {
+    std::ofstream out(temp);
+    out << json.dump(2) << "\n";
+    if (!out) throw InputError(fmt::format("{}: cannot write", path));
+  }
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    std::remove(temp.c_str());
+    throw InputError(fmt::format("{}: cannot write", path));
+  }
+}
+
+RelightState loadState(const std::string& dir) {
+  if (!fs::is_directory(dir)) throw InputError(fmt::format("{}: not a relighting state folder (it does not exist)", dir));
+  const std::string jsonPath = (fs::path(dir) / "state.json").string();
+  const std::string exrPath = (fs::path(dir) / "transport.exr").string();
+  std::ifstream in(jsonPath);
+  if (!in) throw InputError(fmt::format("{}: missing (not a state written by 'obscura render --save-state')", jsonPath));
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not valid JSON ({})", jsonPath, e.what()));
+  }
+  RelightState state;
+  try {
+    if (!json.contains("version") || json.at("version").get<int>() != kStateVersion)
+      throw InputError(fmt::format("{}: state version {} (this obscura reads version {}); render it again",
+                                   jsonPath, json.contains("version") ? json.at("version").dump() : "missing",
+                                   kStateVersion));
+    state.scene = json.at("scene").get<std::string>();
+    state.samples = json.at("samples").get<std::uint32_t>();
+    state.settings = json.at("settings");
+    const int width = json.at("width").get<int>(), height = json.at("height").get<int>();
+    const bool specular = json.at("specular").get<bool>();
+    std::vector<std::string> names;
+    for (const auto& l : json.at("lights")) {
+      LightRecord r;
+      r.name = l.at("name").get<std::string>();
+      r.type = l.at("type").get<std::string>();
+      r.emission = vec3From(l.at("emission"), jsonPath, "lights[].emission");
+      r.ambientWeight = vec3From(l.at("ambient_weight"), jsonPath, "lights[].ambient_weight");
+      names.push_back(r.name);
+      state.lights.push_back(r);
+    }
+    if (!fs::exists(exrPath)) throw InputError(fmt::format("{}: missing", exrPath));
+    io::Image image = io::readImage(exrPath);
+    if (image.width != width || image.height != height)
+      throw InputError(fmt::format("{}: {}x{} pixels, but {} says {}x{}", exrPath, image.width, image.height,
+                                   jsonPath, width, height));
+    state.transport = render::Transport::fromImage(image, names, specular, exrPath);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: malformed state ({})", jsonPath, e.what()));
+  }
+  return state;
+}
+
+} // namespace obscura::relight

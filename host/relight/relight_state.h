@@ -1,0 +1,51 @@
+// relight_state.h — what `obscura render --save-state DIR` keeps so that `obscura relight DIR`
+// can relight a finished render with no scene and no ray (as Cycles light groups or LightMix do):
+//   DIR/state.json     version, scene, size, samples, settings, and per light its name, type,
+//                      render-time emission E_s and I_a weight w_s [RTO eq. 12]
+//   DIR/transport.exr  the resolved per-light transport (render/transport.h channels)
+#pragma once
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "render/obscurance_renderer.h"
+#include "render/transport.h"
+
+namespace obscura::relight {
+
+inline constexpr int kStateVersion = 1;
+
+struct LightRecord {
+  std::string name;
+  std::string type;             // "area", "point", "spot", "directional"
+  glm::vec3 emission{0.0f};     // E_s at render time
+  glm::vec3 ambientWeight{0.0f};// w_s: I_a per unit E_s
+};
+
+struct RelightState {
+  std::string scene;
+  std::uint32_t samples = 0;
+  nlohmann::json settings;
+  std::vector<LightRecord> lights;
+  render::Transport transport;
+
+  std::vector<glm::vec3> emissions() const;
+  std::vector<glm::vec3> ambientWeights() const;
+  // The index of the light named `name`; InputError naming the state and listing the lights.
+  std::size_t lightIndex(const std::string& name, const std::string& where) const;
+};
+
+// The light's type as the state file names it.
+std::string lightTypeName(std::uint32_t gpuType);
+
+// Writes DIR (created when missing). The files are written under temporary names and renamed,
+// so an interrupted write leaves no half state.
+void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const std::string& scenePath);
+
+// Reads DIR; InputError naming the file for a missing, truncated, foreign-version or inconsistent
+// state.
+RelightState loadState(const std::string& dir);
+
+} // namespace obscura::relight

@@ -1,0 +1,154 @@
+#include "render/frame/obscurance_frame.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "shared/host_device.h"
+
+namespace obscura::render {
+namespace {
+
+using Usage = vk::BufferUsageFlagBits;
+constexpr std::uint64_t kVec4 = 16;
+constexpr std::uint64_t kAccumulator = gpu::kAccumulatorVec4s * kVec4; // a Kahan pair
+const auto kStorage = Usage::eStorageBuffer | Usage::eTransferSrc | Usage::eTransferDst;
+
+// Vulkan has no empty buffers: a kind a frame does not use still gets 16 bytes to bind.
+std::uint64_t atLeastOne(std::uint64_t bytes) { return std::max<std::uint64_t>(bytes, kVec4); }
+
+} // namespace
+
+std::vector<FrameBufferKind> ObscuranceFrame::bufferKinds(const FrameContents& contents) {
+  std::vector<FrameBufferKind> kinds = {
+      {"gbuffer", sizeof(gpu::GBufferTexel), false},
+      {"basis", kAccumulator, true},
+      {"emission_basis", kAccumulator, true},
+      {"ambient", kAccumulator, false},
+      {"composed", contents.composedSlots * kVec4, false},
+      {"display", 4, false},
+  };
+  if (contents.primaryAovs) kinds.push_back({"aovs", gpu::kAovSlots * kAccumulator, false});
+  if (contents.specular) {
+    kinds.push_back({"queue", 4, false});
+    kinds.push_back({"specular_basis", kAccumulator, true});
+    kinds.push_back({"specular_ambient", kAccumulator, false});
+  }
+  return kinds;
+}
+
+std::uint64_t ObscuranceFrame::bytesNeeded(std::uint32_t width, std::uint32_t height, std::uint32_t lights,
+                                           const FrameContents& contents) {
+  std::uint64_t perPixel = 0;
+  for (const auto& k : bufferKinds(contents)) perPixel += k.bytesPerPixel * (k.perLight ? lights : 1u);
+  return perPixel * width * height;
+}
+
+ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t width, std::uint32_t height,
+                                 std::uint32_t lights, const FrameContents& contents, std::uint64_t maxBufferBytes)
+    : context_(&context), lights_(lights), maxLights_(lights + kSpareLightSlots), contents_(contents) {
+  const bool specular = contents.specular;
+  const std::uint64_t limit = maxBufferBytes > 0 ? maxBufferBytes : context.info().maxStorageBufferRange;
+  std::uint64_t largest = 0;
+  for (const auto& k : bufferKinds(contents))
+    largest = std::max(largest, k.bytesPerPixel * (k.perLight ? maxLights_ : 1u));
+  layout_ = FrameLayout::split(width, height, largest, limit, "the per-light basis buffers");
+
+  const std::uint64_t need = bytesNeeded(width, height, lights, contents);
+  if (need > context.info().deviceLocalBytes)
+    throw InputError(fmt::format("{}x{} with {} light groups: the frame buffers need {:.1f} MiB, more than the device "
+                                 "'{}' offers ({:.0f} MiB); merge light groups (--light-groups material) or render "
+                                 "fewer pixels",
+                                 width, height, lights, static_cast<double>(need) / 1048576.0, context.info().name,
+                                 static_cast<double>(context.info().deviceLocalBytes) / 1048576.0));
+
+  for (std::size_t i = 0; i < layout_.bands.size(); ++i) {
+    Band b;
+    b.rows = layout_.bands[i];
+    const std::uint64_t px = layout_.bandPixels(i);
+    const std::string tag = layout_.bands.size() > 1 ? fmt::format("[band {}]", i) : "";
+    b.gbuffer = gpu::Buffer(context, px * sizeof(gpu::GBufferTexel), kStorage, "frame.gbuffer" + tag);
+    b.aovs = gpu::Buffer(context, contents.primaryAovs ? px * gpu::kAovSlots * kAccumulator : kVec4, kStorage,
+                         "frame.aovs" + tag);
+    b.ambient = gpu::Buffer(context, px * kAccumulator, kStorage, "frame.ambient" + tag);
+    b.specularAmbient = gpu::Buffer(context, specular ? px * kAccumulator : kVec4, kStorage,
+                                    "frame.specular_ambient" + tag);
+    b.queue = gpu::Buffer(context, (gpu::kQueueHeader + (specular ? px : 1)) * 4,
+                          kStorage | Usage::eIndirectBuffer, "frame.specular_queue" + tag);
+    b.composed = gpu::Buffer(context, px * contents.composedSlots * kVec4, kStorage, "frame.composed" + tag);
+    b.display = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.display" + tag);
+    allocatePerLight(b, lights);
+    bands_.push_back(std::move(b));
+  }
+  status_ = gpu::Buffer(context, gpu::kStatusWords * 4, kStorage, "frame.status");
+  resetStatus();
+}
+
+void ObscuranceFrame::allocatePerLight(Band& b, std::uint32_t lights) {
+  const std::uint64_t px = std::uint64_t(layout_.width) * b.rows.rows;
+  const std::string tag = layout_.bands.size() > 1 ? fmt::format("[rows {}+]", b.rows.firstRow) : "";
+  b.basis = gpu::Buffer(*context_, atLeastOne(px * lights * kAccumulator), kStorage, "frame.basis" + tag);
+  b.emissionBasis = gpu::Buffer(*context_, atLeastOne(px * lights * kAccumulator), kStorage,
+                                "frame.emission_basis" + tag);
+  b.specularBasis = gpu::Buffer(*context_, contents_.specular ? atLeastOne(px * lights * kAccumulator) : kVec4, kStorage,
+                                "frame.specular_basis" + tag);
+}
+
+std::uint64_t ObscuranceFrame::bytes() const {
+  std::uint64_t total = status_.size();
+  for (const auto& b : bands_)
+    for (const gpu::Buffer* buffer : {&b.gbuffer, &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
+                                      &b.specularAmbient, &b.queue, &b.composed, &b.display})
+      total += buffer->size();
+  return total;
+}
+
+std::vector<std::uint32_t> ObscuranceFrame::statusWords() const {
+  std::vector<std::uint32_t> words(gpu::kStatusWords);
+  status_.download(*context_, words.data(), words.size() * 4);
+  return words;
+}
+
+void ObscuranceFrame::resetStatus() {
+  std::uint32_t zeros[gpu::kStatusWords] = {};
+  status_.upload(*context_, zeros, sizeof(zeros));
+}
+
+void ObscuranceFrame::remapLights(gpu::CommandStream& stream, const std::vector<int>& source) {
+  const auto lights = static_cast<std::uint32_t>(source.size());
+  if (lights > maxLights_)
+    throw InputError(fmt::format("{} lights: this frame was laid out for at most {} (render again to add more)",
+                                 lights, maxLights_));
+  std::vector<Band> old;
+  for (auto& b : bands_) {
+    Band kept;
+    kept.basis = std::move(b.basis);
+    kept.emissionBasis = std::move(b.emissionBasis);
+    kept.specularBasis = std::move(b.specularBasis);
+    allocatePerLight(b, lights);
+    old.push_back(std::move(kept));
+  }
+  stream.submit([&](const vk::raii::CommandBuffer& cmd) {
+    for (std::size_t i = 0; i < bands_.size(); ++i) {
+      const std::uint64_t slot = layout_.bandPixels(i) * kAccumulator; // one light's pairs
+      Band& b = bands_[i];
+      for (auto [to, from] : {std::pair{&b.basis, &old[i].basis}, std::pair{&b.emissionBasis, &old[i].emissionBasis},
+                              std::pair{&b.specularBasis, &old[i].specularBasis}}) {
+        if (!contents_.specular && to == &b.specularBasis) continue;
+        for (std::uint32_t l = 0; l < lights; ++l) {
+          if (source[l] < 0) {
+            cmd.fillBuffer(to->handle(), l * slot, slot, 0u);
+          } else {
+            vk::BufferCopy region{.srcOffset = static_cast<std::uint64_t>(source[l]) * slot, .dstOffset = l * slot,
+                                  .size = slot};
+            cmd.copyBuffer(from->handle(), to->handle(), region);
+          }
+        }
+      }
+    }
+  });
+  lights_ = lights;
+}
+
+} // namespace obscura::render

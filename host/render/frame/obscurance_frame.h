@@ -1,0 +1,92 @@
+// obscurance_frame.h — frame-lifetime state of the obscurance renderer: everything that depends on
+// the resolution and the number of lights, split into bands (frame_layout.h).
+//
+// Per band: the G-buffer of the current sample, the primary AOV accumulators, and the basis
+// buffers that make the image linear in every light's emission [SPEC §3]:
+//   basis          D_s  direct light of light s at unit emission      [light][pixel] Kahan pairs
+//   emissionBasis  M_s  emission of light s the camera sees, unit E_s  [light][pixel]
+//   ambient        A    albedo x W_c (rgb), W (w)                      [pixel]
+//   specularBasis / specularAmbient: the same gathered along specular paths (glossy scenes only)
+// plus the specular queue, the composed AOVs and the tonemapped display bytes. The frame's ray
+// and truncation counters live here too.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gpu/buffer.h"
+#include "gpu/command_stream.h"
+#include "gpu/context.h"
+#include "render/frame/frame_layout.h"
+
+namespace obscura::render {
+
+// One frame-lifetime buffer kind and its bytes per pixel (per light where perLight).
+struct FrameBufferKind {
+  std::string name;
+  std::uint64_t bytesPerPixel = 0;
+  bool perLight = false;
+};
+
+// What a frame holds besides the basis buffers: only what was asked for is allocated.
+struct FrameContents {
+  bool specular = false;             // glossy scene: specular basis, ambient and queue
+  bool primaryAovs = true;           // albedo, normal, depth, ... (primary.comp's accumulators)
+  std::uint32_t composedSlots = 6;   // gpu::kComposeSlots, or 1 when only `combined` is wanted
+};
+
+// Lights that may be added to a frame without re-splitting it: its bands are sized for this many
+// more per-light buffers than the frame starts with.
+inline constexpr std::uint32_t kSpareLightSlots = 4;
+
+class ObscuranceFrame {
+public:
+  struct Band {
+    FrameBand rows;
+    gpu::Buffer gbuffer, aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, composed,
+        display;
+  };
+
+  // `maxBufferBytes` 0 = the device's per-buffer limit (a smaller one tests banding).
+  ObscuranceFrame(const gpu::Context& context, std::uint32_t width, std::uint32_t height, std::uint32_t lights,
+                  const FrameContents& contents, std::uint64_t maxBufferBytes = 0);
+
+  // The buffer kinds a frame allocates, from which both the allocation and the memory figures
+  // are computed.
+  static std::vector<FrameBufferKind> bufferKinds(const FrameContents& contents);
+  // Device bytes a frame of this shape allocates (all bands, all buffers).
+  static std::uint64_t bytesNeeded(std::uint32_t width, std::uint32_t height, std::uint32_t lights,
+                                   const FrameContents& contents);
+
+  const FrameLayout& layout() const { return layout_; }
+  Band& band(std::size_t i) { return bands_[i]; }
+  const Band& band(std::size_t i) const { return bands_[i]; }
+  std::uint32_t lightCount() const { return lights_; }
+  bool specular() const { return contents_.specular; }
+  const FrameContents& contents() const { return contents_; }
+
+  const gpu::Buffer& status() const { return status_; }
+  std::vector<std::uint32_t> statusWords() const;
+  void resetStatus();
+
+  // Device bytes allocated now (the real buffers' sizes).
+  std::uint64_t bytes() const;
+
+  // Re-sizes the per-light buffers to `source.size()` lights: light i keeps the transport of old
+  // light source[i], or starts at zero where source[i] < 0. Up to kSpareLightSlots more lights
+  // than the frame was made with fit; more throws InputError.
+  void remapLights(gpu::CommandStream& stream, const std::vector<int>& source);
+
+private:
+  void allocatePerLight(Band& band, std::uint32_t lights);
+
+  const gpu::Context* context_;
+  FrameLayout layout_;
+  std::uint32_t lights_ = 0;
+  std::uint32_t maxLights_ = 0;
+  FrameContents contents_;
+  std::vector<Band> bands_;
+  gpu::Buffer status_;
+};
+
+} // namespace obscura::render

@@ -1,0 +1,33 @@
+#include "render/passes/compose_pass.h"
+
+#include "compose.spv.h"
+
+namespace obscura::render {
+
+ComposePass::ComposePass(const gpu::Context& context, std::uint32_t bands)
+    : kernel_(context, {.name = "compose", .spirv = kSpirv_compose,
+                        .bindings = std::vector<gpu::BindingKind>(gpu::kComposeBindingCount,
+                                                                  gpu::BindingKind::StorageBuffer),
+                        .pushConstantBytes = sizeof(gpu::ComposePush), .setCount = bands}) {}
+
+void ComposePass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& emissions) {
+  const auto& b = frame.band(band);
+  kernel_.bind(gpu::kBindingComposeBasis, b.basis, band);
+  kernel_.bind(gpu::kBindingComposeAmbient, b.ambient, band);
+  kernel_.bind(gpu::kBindingComposeEmissionBasis, b.emissionBasis, band);
+  kernel_.bind(gpu::kBindingComposeEmissions, emissions, band);
+  kernel_.bind(gpu::kBindingComposeOutput, b.composed, band);
+  kernel_.bind(gpu::kBindingComposeSpecularBasis, b.specularBasis, band);
+  kernel_.bind(gpu::kBindingComposeSpecularAmbient, b.specularAmbient, band);
+}
+
+void ComposePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
+                         std::uint32_t samples, std::uint32_t lights, const glm::vec3& ambientIntensity,
+                         bool specular, std::uint32_t slots) const {
+  gpu::ComposePush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, samples, lights),
+                        .ambient = glm::vec4(ambientIntensity, specular ? 1.0f : 0.0f),
+                        .slots = glm::uvec4(slots, 0u, 0u, 0u)};
+  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+}
+
+} // namespace obscura::render

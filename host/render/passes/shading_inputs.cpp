@@ -1,0 +1,26 @@
+#include "render/passes/shading_inputs.h"
+
+namespace obscura::render {
+
+gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
+  auto bindings = sceneBindingKinds();
+  bindings.insert(bindings.end(), gpu::kShadingBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
+  return {.name = name, .spirv = spirv, .bindings = bindings, .pushConstantBytes = sizeof(gpu::ShadePush),
+          .setCount = bands};
+}
+
+void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInputs& in) {
+  in.scene.bindTo(kernel, band, &in.frame.status());
+  const auto& b = in.frame.band(band);
+  kernel.bind(gpu::kBindingGBuffer, b.gbuffer, band);
+  kernel.bind(gpu::kBindingLights, in.lights.lights, band);
+  kernel.bind(gpu::kBindingEmitters, in.lights.emitters, band);
+  kernel.bind(gpu::kBindingBasis, b.basis, band);
+  kernel.bind(gpu::kBindingAmbient, b.ambient, band);
+  kernel.bind(gpu::kBindingSpecularBasis, b.specularBasis, band);
+  kernel.bind(gpu::kBindingSpecularAmbient, b.specularAmbient, band);
+  kernel.bind(gpu::kBindingSpecularQueue, b.queue, band);
+  kernel.bind(gpu::kBindingLightScales, in.lights.scales, band);
+}
+
+} // namespace obscura::render

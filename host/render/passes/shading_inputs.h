@@ -1,0 +1,37 @@
+// shading_inputs.h — what the shading passes (shadow, obscurance, specular) bind: the scene,
+// the lights, and one band of the frame (shaders/lib/shading_bindings.glsl, bindings 0..14).
+#pragma once
+#include <span>
+
+#include "gpu/kernel.h"
+#include "render/frame/obscurance_frame.h"
+#include "render/scene/scene_buffers.h"
+
+namespace obscura::render {
+
+struct LightBuffers {
+  gpu::Buffer lights;      // GpuLight[]
+  gpu::Buffer emitters;    // GpuEmitter[]
+  gpu::Buffer scales;      // vec4[]: the render-time E_s, which makes seen emission unit
+};
+
+struct ShadingInputs {
+  const SceneBuffers& scene;
+  const LightBuffers& lights;
+  const ObscuranceFrame& frame;
+};
+
+// The kernel description every shading pass shares: scene bindings, then the shading bindings,
+// ShadePush, one descriptor set per band.
+gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+
+// Binds descriptor set `band` of a shading kernel.
+void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInputs& in);
+
+// Push constants of the shading passes for band `band` (the rest of `push` is the caller's).
+inline gpu::ShadePush forBand(gpu::ShadePush push, const FrameLayout& layout, std::uint32_t band) {
+  push.band = glm::uvec4(layout.bands[band].firstRow, layout.bands[band].rows, 0u, 0u);
+  return push;
+}
+
+} // namespace obscura::render

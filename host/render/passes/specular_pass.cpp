@@ -1,0 +1,33 @@
+#include "render/passes/specular_pass.h"
+
+#include <array>
+
+#include "specular.spv.h"
+#include "specular_queue.spv.h"
+
+namespace obscura::render {
+
+SpecularPass::SpecularPass(const gpu::Context& context, std::uint32_t bands)
+    : queue_(context, shadingKernelDesc("specular.queue", kSpirv_specular_queue, bands)),
+      paths_(context, shadingKernelDesc("specular", kSpirv_specular, bands)) {}
+
+void SpecularPass::bind(std::uint32_t band, const ShadingInputs& in) {
+  bindShadingInputs(queue_, band, in);
+  bindShadingInputs(paths_, band, in);
+}
+
+void SpecularPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
+                          const ObscuranceFrame& frame, const gpu::ShadePush& push) const {
+  // An empty queue dispatches (0, 1, 1) groups; specular_queue.comp raises x as it appends.
+  static constexpr std::array<std::uint32_t, gpu::kQueueHeader> kEmptyQueue = {0u, 1u, 1u, 0u};
+  const gpu::ShadePush p = forBand(push, layout, band);
+  const gpu::Buffer& queue = frame.band(band).queue;
+  cmd.updateBuffer<std::uint32_t>(queue.handle(), 0, kEmptyQueue);
+  gpu::computeBarrier(cmd);
+  queue_.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
+                  gpu::groupsFor(layout.bands[band].rows, gpu::kWorkgroupSizeY), 1, &p, band);
+  gpu::computeBarrier(cmd);
+  paths_.dispatchIndirect(cmd, queue, 0, &p, band);
+}
+
+} // namespace obscura::render

@@ -1,0 +1,23 @@
+// specular_pass.h — specular paths from glossy primary hits (specular_queue.comp compacts the
+// glossy pixels of a band into a queue and sizes an indirect dispatch of specular.comp), gathering
+// direct light and obscurance at their vertices [RTO §4.1 step 4].
+#pragma once
+#include "render/passes/shading_inputs.h"
+
+namespace obscura::render {
+
+class SpecularPass {
+public:
+  SpecularPass(const gpu::Context& context, std::uint32_t bands);
+
+  void bind(std::uint32_t band, const ShadingInputs& in);
+  // Clears band `band`'s queue, fills it and dispatches the paths (barriers included).
+  void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
+              const ObscuranceFrame& frame, const gpu::ShadePush& push) const;
+
+private:
+  gpu::Kernel queue_;
+  gpu::Kernel paths_;
+};
+
+} // namespace obscura::render
