@@ -56,9 +56,9 @@ void SceneBuilder::quad(glm::vec3 corner, glm::vec3 u, glm::vec3 v, std::uint32_
   }
 }
 
-void SceneBuilder::pointLight(glm::vec3 position, glm::vec3 color, float intensity) {
+void SceneBuilder::pointLight(glm::vec3 position, glm::vec3 color, float intensity, const std::string& name) {
   scene::PunctualLight l;
-  l.name = "point";
+  l.name = name;
   l.type = scene::PunctualType::Point;
   l.position = position;
   l.color = color;

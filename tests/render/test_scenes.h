@@ -19,7 +19,7 @@ public:
   std::uint32_t glossy(glm::vec3 baseColor, float metallic, float roughness);
   // Quad corner, edge u, edge v: two triangles, front face = the side cross(u, v) points to.
   void quad(glm::vec3 corner, glm::vec3 u, glm::vec3 v, std::uint32_t material, const std::string& group = "");
-  void pointLight(glm::vec3 position, glm::vec3 color, float intensity);
+  void pointLight(glm::vec3 position, glm::vec3 color, float intensity, const std::string& name = "point");
   void directionalLight(glm::vec3 direction, glm::vec3 color, float intensity);
   scene::Scene build();
 

@@ -1,0 +1,274 @@
+// Relighting [IVR; SPEC §3]: a light edit recomposes the kept per-light transport with no ray,
+// an added light traces only its own shadow rays, and every edited frame is statistically the
+// frame a fresh render of the scene edited the same way gives.
+#include <cmath>
+#include <cstring>
+
+#include <gtest/gtest.h>
+
+#include "bvh/bvh.h"
+#include "gpu_test.h"
+#include "render/obscurance_renderer.h"
+#include "render/one_shot.h"
+#include "render/scene/scene_buffers.h"
+#include "render/test_scenes.h"
+#include "render/transport.h"
+
+namespace obscura::test {
+namespace {
+
+// A room: white floor, red back wall, white side wall, two ceiling lamps (light groups lampA,
+// lampB) and a point light "bulb". What the edits change is passed in.
+struct RoomLights {
+  glm::vec3 lampA{3.0f}, lampB{2.0f, 2.0f, 1.5f};
+  float bulb = 2.0f;
+  bool withBulb = true;
+  bool withAdded = false; // a second point light, "added"
+};
+
+constexpr glm::vec3 kAddedPosition{0.6f, 0.5f, 0.6f};
+constexpr float kAddedIntensity = 1.5f;
+
+scene::Scene room(const RoomLights& l) {
+  SceneBuilder b;
+  auto white = b.lambertian(glm::vec3(0.7f));
+  auto red = b.lambertian(glm::vec3(0.7f, 0.15f, 0.1f));
+  auto lampA = b.lambertian(glm::vec3(0.0f), l.lampA);
+  auto lampB = b.lambertian(glm::vec3(0.0f), l.lampB);
+  b.quad({-1, 0, -1}, {0, 0, 2}, {2, 0, 0}, white);       // floor, faces +y
+  b.quad({-1, 0, -1}, {2, 0, 0}, {0, 2, 0}, red);         // back wall, faces +z
+  b.quad({-1, 0, -1}, {0, 2, 0}, {0, 0, 2}, white);       // left wall, faces +x
+  b.quad({-1, 2, -1}, {2, 0, 0}, {0, 0, 2}, white);       // ceiling, faces -y
+  b.quad({-0.6f, 1.99f, -0.6f}, {0.4f, 0, 0}, {0, 0, 0.4f}, lampA, "lampA");
+  b.quad({0.3f, 1.99f, 0.1f}, {0.3f, 0, 0}, {0, 0, 0.3f}, lampB, "lampB");
+  b.quad({-0.2f, 0.0f, -0.2f}, {0.4f, 0, 0}, {0, 0.6f, 0}, white); // a screen casting shadows
+  if (l.withBulb) b.pointLight({-0.5f, 1.2f, 0.5f}, glm::vec3(1.0f, 0.9f, 0.7f), l.bulb, "bulb");
+  if (l.withAdded) b.pointLight(kAddedPosition, glm::vec3(0.7f, 0.8f, 1.0f), kAddedIntensity, "added");
+  return b.build();
+}
+
+render::ObscuranceSettings roomSettings(std::uint32_t seed) {
+  render::ObscuranceSettings s;
+  s.width = 48;
+  s.height = 36;
+  s.spp = 32;
+  s.seed = seed;
+  s.shadowRays = 4;
+  s.obscuranceRays = 4;
+  s.camera = lookCamera({0.2f, 1.0f, 3.2f}, glm::normalize(glm::vec3(-0.1f, -0.05f, -1.0f)), {0, 1, 0}, 0.9f);
+  return s;
+}
+
+std::vector<float> channel(const io::Image& image, const std::string& name) {
+  const int c = image.channelIndex(name);
+  EXPECT_GE(c, 0) << name;
+  std::vector<float> out;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) out.push_back(image.at(x, y, c));
+  return out;
+}
+
+// Luminance means of 6x6 pixel blocks of `combined`.
+std::vector<double> blockMeans(const io::Image& image) {
+  std::vector<double> means;
+  const int r = image.channelIndex("combined.R");
+  for (int by = 0; by + 6 <= image.height; by += 6)
+    for (int bx = 0; bx + 6 <= image.width; bx += 6) {
+      double sum = 0.0;
+      for (int y = by; y < by + 6; ++y)
+        for (int x = bx; x < bx + 6; ++x)
+          for (int c = 0; c < 3; ++c) sum += image.at(x, y, r + c);
+      means.push_back(sum / 108.0);
+    }
+  return means;
+}
+
+double rmsDifference(const std::vector<double>& a, const std::vector<double>& b) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) sum += (a[i] - b[i]) * (a[i] - b[i]);
+  return std::sqrt(sum / static_cast<double>(a.size()));
+}
+
+class Relight : public GpuTest {
+protected:
+  render::ObscuranceRenderer& base() {
+    if (!renderer_) {
+      scene_ = room({});
+      bvh_ = bvh::build(render::triangleSoup(scene_));
+      renderer_ = std::make_unique<render::ObscuranceRenderer>(context(), scene_, bvh_, roomSettings(7));
+      renderer_->render();
+      EXPECT_EQ(renderer_->stats().truncatedTraversals, 0u);
+    }
+    return *renderer_;
+  }
+  // A fresh render of the room with these lights.
+  io::Image fresh(const RoomLights& lights, std::uint32_t seed) {
+    scene::Scene s = room(lights);
+    bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+    return renderObscurances(context(), s, tree, roomSettings(seed)).image;
+  }
+  // The contract: an edited frame is the fresh render of the edited scene up to noise. The
+  // tolerance comes from the same render's seed-to-seed spread: two fresh renders (seeds 11 and
+  // 12) differ in block means by an RMS of `spread`; the relit frame must be within 3 spread of
+  // a fresh one in RMS (a missing or doubled term, e.g. I_a not following the edit or the seen
+  // emission not dimmed, moves many blocks by far more).
+  void expectStatisticallyEqual(const io::Image& relit, const RoomLights& edited) {
+    const auto a = blockMeans(fresh(edited, 11)), b = blockMeans(fresh(edited, 12));
+    const double spread = rmsDifference(a, b);
+    const double error = rmsDifference(blockMeans(relit), a);
+    ASSERT_GT(spread, 0.0);
+    EXPECT_LT(error, 3.0 * spread) << "relit vs fresh RMS " << error << ", seed-to-seed RMS " << spread;
+  }
+  std::size_t light(const std::string& name) { return base().lightIndex(name); }
+
+  scene::Scene scene_;
+  bvh::Bvh bvh_;
+  std::unique_ptr<render::ObscuranceRenderer> renderer_;
+};
+
+TEST_F(Relight, IdentityEditGivesTheBitIdenticalFrame) {
+  auto& r = base();
+  const io::Image before = r.image();
+  r.setEmissions(r.emissions());
+  r.compose();
+  const io::Image after = r.image();
+  ASSERT_EQ(before.pixels.size(), after.pixels.size());
+  EXPECT_EQ(std::memcmp(before.pixels.data(), after.pixels.data(), before.pixels.size() * 4), 0);
+}
+
+TEST_F(Relight, ScalingEveryLightByKScalesTheFrameByK) {
+  auto& r = base();
+  const auto before = channel(r.image(), "combined.G");
+  std::vector<glm::vec3> scaled;
+  for (const auto& e : r.emissions()) scaled.push_back(e * 2.5f);
+  r.setEmissions(scaled);
+  r.compose();
+  const auto after = channel(r.image(), "combined.G");
+  for (std::size_t i = 0; i < before.size(); ++i)
+    EXPECT_NEAR(after[i], 2.5f * before[i], 1e-6f * std::max(1.0f, 2.5f * before[i])) << "pixel " << i;
+}
+
+TEST_F(Relight, LightLayersSumToCombined) {
+  auto& r = base();
+  std::vector<glm::vec3> e = r.emissions();
+  e[light("lampA")] *= glm::vec3(0.5f, 1.0f, 2.0f);
+  r.setEmissions(e);
+  r.compose();
+  const io::Image image = r.image(), layers = r.lightLayers();
+  ASSERT_EQ(layers.channels.size(), 3 * r.lights().size());
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        float sum = 0.0f;
+        for (std::size_t s = 0; s < r.lights().size(); ++s) sum += layers.at(x, y, static_cast<int>(s * 3 + c));
+        const float combined = image.at(x, y, image.channelIndex("combined.R") + c);
+        EXPECT_NEAR(sum, combined, 1e-5f * std::max(1.0f, combined)) << x << "," << y;
+      }
+}
+
+TEST_F(Relight, HostComposeTwinMatchesTheGpuCompose) {
+  auto& r = base();
+  std::vector<glm::vec3> e = r.emissions();
+  e[light("bulb")] *= 3.0f;
+  e[light("lampB")] = glm::vec3(0.5f, 4.0f, 0.0f);
+  r.setEmissions(e);
+  r.compose();
+  const io::Image gpu = r.image();
+  const io::Image host = render::composeTransport(r.transport(), e, r.ambient().weight);
+  for (const char* channelName : {"combined.R", "combined.B", "direct.G", "indirect.R", "emission.G", "obscurance.Y"}) {
+    const auto a = channel(gpu, channelName), b = channel(host, channelName);
+    for (std::size_t i = 0; i < a.size(); ++i)
+      EXPECT_NEAR(a[i], b[i], 1e-5f * std::max(1.0f, std::abs(a[i]))) << channelName << " pixel " << i;
+  }
+}
+
+TEST_F(Relight, DimmingALampTheCameraSeesDimsItsImage) {
+  auto& r = base();
+  // The room's lamps face down, so look at them from below: the seen emission M_s is per light.
+  std::vector<glm::vec3> e = r.emissions();
+  const auto before = channel(r.image(), "emission.R");
+  e[light("lampA")] *= 0.25f;
+  e[light("lampB")] = glm::vec3(0.0f);
+  r.setEmissions(e);
+  r.compose();
+  const auto after = channel(r.image(), "emission.R");
+  // Each seen-emission pixel belongs to one lamp: it is either a quarter (lampA) or 0 (lampB).
+  int seen = 0;
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    if (before[i] == 0.0f) continue;
+    ++seen;
+    const bool quarter = std::abs(after[i] - 0.25f * before[i]) <= 1e-6f * before[i];
+    EXPECT_TRUE(quarter || after[i] == 0.0f) << "pixel " << i << ": " << before[i] << " -> " << after[i];
+  }
+  EXPECT_GT(seen, 0) << "the camera must see a lamp for this test";
+}
+
+TEST_F(Relight, ScaledLampMatchesAFreshRenderOfTheEditedScene) {
+  auto& r = base();
+  std::vector<glm::vec3> e = r.emissions();
+  e[light("lampA")] *= 3.0f;
+  r.setEmissions(e);
+  r.compose();
+  RoomLights edited;
+  edited.lampA *= 3.0f;
+  expectStatisticallyEqual(r.image(), edited);
+}
+
+TEST_F(Relight, RecolouredLampMatchesAFreshRenderOfTheEditedScene) {
+  auto& r = base();
+  std::vector<glm::vec3> e = r.emissions();
+  e[light("lampB")] *= glm::vec3(1.0f, 0.2f, 0.2f);
+  r.setEmissions(e);
+  r.compose();
+  RoomLights edited;
+  edited.lampB *= glm::vec3(1.0f, 0.2f, 0.2f);
+  expectStatisticallyEqual(r.image(), edited);
+}
+
+TEST_F(Relight, SwitchedOffBulbMatchesAFreshRenderWithoutIt) {
+  auto& r = base();
+  std::vector<glm::vec3> e = r.emissions();
+  e[light("bulb")] = glm::vec3(0.0f);
+  r.setEmissions(e);
+  r.compose();
+  RoomLights edited;
+  edited.withBulb = false;
+  expectStatisticallyEqual(r.image(), edited);
+}
+
+TEST_F(Relight, RemovedBulbMatchesAFreshRenderWithoutIt) {
+  auto& r = base();
+  r.removeLight(light("bulb"));
+  EXPECT_EQ(r.lights().size(), 2u);
+  r.compose();
+  RoomLights edited;
+  edited.withBulb = false;
+  expectStatisticallyEqual(r.image(), edited);
+}
+
+TEST_F(Relight, AddedLightTracesOnlyItsShadowRaysAndMatchesAFreshRender) {
+  auto& r = base();
+  const render::RenderStats before = r.stats();
+  scene::PunctualLight added;
+  added.name = "added";
+  added.type = scene::PunctualType::Point;
+  added.position = kAddedPosition;
+  added.color = glm::vec3(0.7f, 0.8f, 1.0f);
+  added.intensity = kAddedIntensity;
+  r.addLight(added);
+  r.compose();
+  const render::RenderStats after = r.stats();
+  // No obscurance ray; shadow rays for the new light at every hit pixel of every sample.
+  EXPECT_EQ(after.passes.at("obscurance").rays, before.passes.at("obscurance").rays);
+  const std::uint64_t shadowRays = after.passes.at("shadow").rays - before.passes.at("shadow").rays;
+  const auto coverage = channel(r.image(), "coverage.A");
+  double hits = 0.0;
+  for (float c : coverage) hits += c;
+  EXPECT_NEAR(static_cast<double>(shadowRays), hits * 32 * 4, 32 * 4 * 2.0); // coverage is a mean over samples
+  RoomLights edited;
+  edited.withAdded = true;
+  expectStatisticallyEqual(r.image(), edited);
+}
+
+} // namespace
+} // namespace obscura::test
