@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "app/cli_runner.h"
 #include "gpu_test.h"
 
 namespace obscura::test {
@@ -27,51 +28,9 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct RunResult {
-  int exitCode; // -1 when killed by a signal
-  std::string output;
-};
-
-// Runs `prefix obscura args` through /bin/sh; prefix may set the environment or limits.
-RunResult runObscura(const std::string& args, const std::string& prefix = "") {
-  const std::string command = prefix + std::string(OBSCURA_BINARY_PATH) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  RunResult r{-1, ""};
-  if (!pipe) return r;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) r.output += buffer.data();
-  const int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  EXPECT_EQ(r.output.find("obscura: validation:"), std::string::npos) << r.output;
-  return r;
-}
-
-#define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
-
-class CliBadInput : public ::testing::Test {
+class CliBadInput : public CliTest {
 protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = std::string(info->test_suite_name()) + "_" + info->name();
-    for (char& c : name)
-      if (c == '/') c = '_';
-    dir_ = fs::temp_directory_path() / ("obscura_bad_" + std::to_string(::getpid()) + "_" + name);
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  // Everything in the test folder (recursively) that is not one of the inputs.
-  std::vector<std::string> strayFiles(const std::vector<std::string>& inputs = {}) const {
-    std::vector<std::string> out;
-    for (const auto& entry : fs::recursive_directory_iterator(dir_)) {
-      const std::string rel = fs::relative(entry.path(), dir_).string();
-      if (std::find(inputs.begin(), inputs.end(), rel) == inputs.end()) out.push_back(rel);
-    }
-    return out;
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  static std::string scene() { return repoPath("scenes/cornell-box/cornell-box.gltf"); }
-  fs::path dir_;
+  static std::string scene() { return cornellBox(); }
 };
 
 // ---- Malformed glTF through `obscura render bad.gltf -o out.exr` ------------------------------

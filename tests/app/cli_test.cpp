@@ -10,49 +10,19 @@
 
 #include <gtest/gtest.h>
 
+#include "app/cli_runner.h"
 #include "gpu_test.h"
 
 namespace obscura::test {
 namespace {
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int exitCode;
-  std::string output; // stdout and stderr together
-};
-
-RunResult runObscura(const std::string& args) {
-  std::string command = std::string(OBSCURA_BINARY_PATH) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  RunResult r{-1, ""};
-  if (!pipe) return r;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) r.output += buffer.data();
-  int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  // ctest runs every test with OBSCURA_VALIDATE=1, which the child inherits: any validation
-  // message it prints fails the test that caused it.
-  EXPECT_EQ(r.output.find("obscura: validation:"), std::string::npos) << r.output;
-  return r;
-}
-
-class Cli : public ::testing::Test {
+class Cli : public CliTest {
 protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("obscura_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  // Files in the test folder other than `allowed`: there must be no partial outputs.
+  // Files in the test folder other than `allowed`.
   std::vector<std::string> strayFiles(const std::string& allowed = "") const {
-    std::vector<std::string> out;
-    for (const auto& entry : fs::directory_iterator(dir_))
-      if (entry.path().filename() != allowed) out.push_back(entry.path().filename().string());
-    return out;
+    return allowed.empty() ? CliTest::strayFiles() : CliTest::strayFiles({allowed});
   }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
 };
 
 TEST_F(Cli, RendersTheDefaultSceneToPngAndExrWithMetrics) {

@@ -1,0 +1,174 @@
+// `obscura render --save-state` and `obscura relight` as a user runs them: a saved render is
+// relit with no scene and no ray; a scene is edited in order with one frame per edit and its
+// figures; bad states and bad edits are clear errors naming the file (and the entry), exit 2,
+// with nothing written.
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "app/cli_runner.h"
+#include "gpu_test.h"
+#include "io/image_io.h"
+
+namespace obscura::test {
+namespace {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr const char* kCornellLight = "light_rectangle_1"; // the Cornell box's emissive node
+
+class CliRelight : public CliTest {
+protected:
+  // Renders the Cornell box with its relighting state in `state`, the EXR in render.exr.
+  void renderWithState(const std::string& state = "state") {
+    const auto r = runObscura("render " + cornellBox() + " --width 24 --height 24 --spp 2 --save-state " +
+                              path(state) + " -o " + path("render.exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+  }
+  static std::vector<float> combined(const io::Image& image) {
+    std::vector<float> out;
+    const int c = image.channelIndex("combined.R");
+    EXPECT_GE(c, 0);
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        for (int k = 0; k < 3; ++k) out.push_back(image.at(x, y, c + k));
+    return out;
+  }
+  void writeText(const std::string& name, const std::string& text) { std::ofstream(path(name)) << text; }
+};
+
+TEST_F(CliRelight, SavedStateRecomposesTheRenderAndScalesALight) {
+  renderWithState();
+  const io::Image rendered = io::readImage(path("render.exr"));
+  EXPECT_GE(rendered.channelIndex(std::string("light.") + kCornellLight + ".R"), 0) << "per-light EXR layer";
+
+  auto r = runObscura("relight " + path("state") + " -o " + path("same.exr"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const auto before = combined(rendered), same = combined(io::readImage(path("same.exr")));
+  ASSERT_EQ(before.size(), same.size());
+  for (std::size_t i = 0; i < before.size(); ++i) EXPECT_NEAR(same[i], before[i], 1e-5f * std::max(1.0f, before[i]));
+
+  r = runObscura("relight " + path("state") + " --light " + kCornellLight + "=2 -o " + path("double.exr"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const auto doubled = combined(io::readImage(path("double.exr")));
+  for (std::size_t i = 0; i < before.size(); ++i)
+    EXPECT_NEAR(doubled[i], 2.0f * before[i], 1e-5f * std::max(1.0f, before[i]));
+
+  // The box's only light off: nothing is lit, not even indirectly (I_a follows the edit).
+  r = runObscura("relight " + path("state") + " --light " + kCornellLight + "=0 -o " + path("off.exr"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  for (float v : combined(io::readImage(path("off.exr")))) EXPECT_EQ(v, 0.0f);
+
+  r = runObscura("relight " + path("state") + " --light " + kCornellLight + "=1,1,0,0 -o " + path("red.png"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_TRUE(fs::exists(path("red.png")));
+}
+
+TEST_F(CliRelight, BrokenStatesAreRefusedNamingTheFile) {
+  renderWithState("good");
+  const std::vector<std::string> inputs = {"render.exr", "good", "good/state.json", "good/transport.exr"};
+  struct Case {
+    const char* name;
+    std::function<void(const fs::path&)> breakIt;
+    const char* expected;
+  };
+  const std::vector<Case> cases = {
+      {"missing-transport", [](const fs::path& d) { fs::remove(d / "transport.exr"); }, "transport.exr"},
+      {"missing-json", [](const fs::path& d) { fs::remove(d / "state.json"); }, "state.json"},
+      {"truncated-transport", [](const fs::path& d) { fs::resize_file(d / "transport.exr", fs::file_size(d / "transport.exr") / 2); },
+       "transport.exr"},
+      {"other-version", [](const fs::path& d) {
+         json j = json::parse(std::ifstream(d / "state.json"));
+         j["version"] = 99;
+         std::ofstream(d / "state.json") << j.dump();
+       }, "version"},
+      {"other-size", [](const fs::path& d) {
+         json j = json::parse(std::ifstream(d / "state.json"));
+         j["width"] = 25;
+         std::ofstream(d / "state.json") << j.dump();
+       }, "transport.exr"},
+      {"not-json", [](const fs::path& d) { std::ofstream(d / "state.json") << "{ nope"; }, "state.json"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path copy = dir_ / c.name;
+    fs::copy(dir_ / "good", copy);
+    c.breakIt(copy);
+    const auto r = runObscura("relight " + copy.string() + " -o " + path("out.exr"));
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_CONTAINS(r.output, c.expected);
+    EXPECT_FALSE(fs::exists(path("out.exr")));
+    fs::remove_all(copy);
+  }
+  const auto r = runObscura("relight " + path("good") + " --light nosuch=1 -o " + path("out.exr"));
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_CONTAINS(r.output, "nosuch");
+  EXPECT_CONTAINS(r.output, kCornellLight);
+  EXPECT_EQ(strayFiles(inputs), std::vector<std::string>{});
+}
+
+TEST_F(CliRelight, SceneEditsWriteAFramePerEditAndTheirFigures) {
+  writeText("edits.json", json::array({
+                              {{"light", kCornellLight}, {"scale", 0.5}},
+                              {{"light", kCornellLight}, {"color", {1.0, 0.5, 0.5}}},
+                              {{"add_light", {{"type", "point"}, {"name", "bulb"}, {"position", {0.0, 1.0, 0.0}},
+                                              {"color", {1, 1, 1}}, {"intensity", 2.0}}}},
+                              {{"remove_light", "bulb"}},
+                          }).dump());
+  const auto r = runObscura("relight " + cornellBox() + " --edits " + path("edits.json") + " -o " + path("out") +
+                            " --width 24 --height 24 --spp 2 --png");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  for (int n = 0; n <= 4; ++n) {
+    EXPECT_TRUE(fs::exists(path("out/frame-00" + std::to_string(n) + ".exr"))) << n;
+    EXPECT_TRUE(fs::exists(path("out/frame-00" + std::to_string(n) + ".png"))) << n;
+  }
+  std::ifstream log(path("out/edits.jsonl"));
+  std::vector<json> lines;
+  for (std::string line; std::getline(log, line);) lines.push_back(json::parse(line));
+  ASSERT_EQ(lines.size(), 4u);
+  for (const auto& line : lines)
+    for (const char* key : {"kind", "pixels_retraced", "rays", "gpu_ms", "total_ms"}) EXPECT_TRUE(line.contains(key)) << key;
+  EXPECT_EQ(lines[0]["kind"], "scale");
+  EXPECT_EQ(lines[0]["pixels_retraced"], 0);
+  EXPECT_FALSE(lines[0]["rays"].contains("shadow")) << "a light edit traces no ray";
+  EXPECT_EQ(lines[2]["kind"], "add_light");
+  EXPECT_GT(lines[2]["rays"]["shadow"].get<double>(), 0.0);
+  EXPECT_FALSE(lines[2]["rays"].contains("obscurance")) << "an added light traces only its shadow rays";
+  // Halving the light halves the frame; removing the added bulb gives frame 2 back.
+  const auto f0 = combined(io::readImage(path("out/frame-000.exr")));
+  const auto f1 = combined(io::readImage(path("out/frame-001.exr")));
+  const auto f2 = combined(io::readImage(path("out/frame-002.exr")));
+  const auto f4 = combined(io::readImage(path("out/frame-004.exr")));
+  for (std::size_t i = 0; i < f0.size(); ++i) {
+    EXPECT_NEAR(f1[i], 0.5f * f0[i], 1e-5f * std::max(1.0f, f0[i]));
+    EXPECT_NEAR(f4[i], f2[i], 1e-5f * std::max(1.0f, f2[i]));
+  }
+}
+
+TEST_F(CliRelight, BadEditsAreRefusedNamingTheEntryBeforeAnyFrame) {
+  const std::vector<std::pair<json, std::string>> cases = {
+      {json::array({{{"light", kCornellLight}, {"scale", 2}}, {{"light", "nosuch"}, {"scale", 2}}}), "entry 1"},
+      {json::array({{{"light", kCornellLight}}}), "entry 0"},
+      {json::array({{{"light", kCornellLight}, {"scale", -1}}}), "negative"},
+      {json::array({{{"add_light", {{"type", "point"}, {"name", "b"}}}}}), "position"},
+      {json::array({{{"remove_light", "b"}}}), "no light named 'b'"},
+      {json::array({{{"teleport", "x"}}}), "unknown edit"},
+      {json::object({{"light", kCornellLight}}), "list"},
+  };
+  for (const auto& [edits, expected] : cases) {
+    SCOPED_TRACE(edits.dump());
+    writeText("edits.json", edits.dump());
+    const auto r = runObscura("relight " + cornellBox() + " --edits " + path("edits.json") + " -o " + path("out") +
+                              " --width 16 --spp 1");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_CONTAINS(r.output, "edits.json");
+    EXPECT_CONTAINS(r.output, expected);
+    EXPECT_FALSE(fs::exists(path("out"))) << "no partial frame";
+  }
+}
+
+} // namespace
+} // namespace obscura::test

@@ -1,0 +1,36 @@
+// cli_runner.h — running the `obscura` binary as a user does, in a fresh folder per test.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace obscura::test {
+
+struct RunResult {
+  int exitCode; // -1 when killed by a signal
+  std::string output; // stdout and stderr together
+};
+
+// Runs `prefix obscura args` through /bin/sh; prefix may set the environment or limits. ctest
+// runs every test with OBSCURA_VALIDATE=1, which the child inherits: a validation message it
+// prints fails the test.
+RunResult runObscura(const std::string& args, const std::string& prefix = "");
+
+#define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+
+// A test with its own empty folder, removed afterwards.
+class CliTest : public ::testing::Test {
+protected:
+  void SetUp() override;
+  void TearDown() override;
+  // Everything in the test folder (recursively) that is not one of `inputs`: a failed command
+  // must leave no partial output.
+  std::vector<std::string> strayFiles(const std::vector<std::string>& inputs = {}) const;
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  static std::string cornellBox();
+  std::filesystem::path dir_;
+};
+
+} // namespace obscura::test
