@@ -140,7 +140,7 @@ void runRender(RenderOptions& o) {
   checkRenderOptions(o);
   if (!o.metrics.empty()) checkWritable(o.metrics);
 
-  LoadedScene loaded = loadScene(o.scenePath);
+  LoadedScene loaded = loadScene(o.scenePath, o.lightGroups);
   scene::Camera camera = chooseCamera(loaded.scene, o.camera);
   chooseSize(o, camera);
   fmt::print(stderr, "{}\n", sceneSummary(loaded));

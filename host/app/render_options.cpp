@@ -54,6 +54,9 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--sampling", o.sampling, "obscurance rays: systematic (default) or random")
       ->check(CLI::IsMember({"systematic", "random"}));
   cmd.add_flag("--no-bleed", o.noBleed, "grey obscurance W instead of colour bleeding W_c");
+  cmd.add_option("--light-groups", o.lightGroups,
+                 "lights edited as one: node (one per emissive mesh node, default), material (one per emissive "
+                 "material), or a JSON file {\"group\": [\"node\", ...]}");
 }
 
 void checkRenderOptions(const RenderOptions& o) {

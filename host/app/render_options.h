@@ -31,6 +31,7 @@ struct RenderOptions {
   bool noBleed = false;
   float dMax = 0.0f;
   bool dMaxGiven = false;
+  std::string lightGroups = "node";
   DeviceOptions device;
 };
 

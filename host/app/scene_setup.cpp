@@ -6,13 +6,17 @@
 
 #include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
+#include "scene/light_groups.h"
 
 namespace obscura::app {
 
-LoadedScene loadScene(const std::string& path) {
+LoadedScene loadScene(const std::string& path, const std::string& lightGroups) {
   LoadedScene loaded;
   auto start = std::chrono::steady_clock::now();
   loaded.scene = scene::loadGltf(path);
+  if (lightGroups == "material") scene::groupLightsByMaterial(loaded.scene);
+  else if (lightGroups != "node") scene::groupLightsFromFile(loaded.scene, lightGroups);
+  scene::makeLightNamesUnique(loaded.scene);
   loaded.loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   loaded.bvh = bvh::build(render::triangleSoup(loaded.scene));
   return loaded;

@@ -15,7 +15,9 @@ struct LoadedScene {
   double loadSeconds = 0.0;
 };
 
-LoadedScene loadScene(const std::string& path);
+// `lightGroups`: "node" (one light per emissive mesh node, the default), "material" (one per
+// emissive material) or a JSON file of groups (scene/light_groups.h). Light names are made unique.
+LoadedScene loadScene(const std::string& path, const std::string& lightGroups = "node");
 
 // Scene statistics and BVH figures for the metrics JSON.
 nlohmann::json sceneJson(const LoadedScene& loaded);

@@ -799,7 +799,7 @@ private:
     if (*instance_.lightGroup == kNoLightGroup) {
       const tinygltf::Node& node = ctx_.model.nodes[instance_.node];
       LightGroup group;
-      group.name = node.name.empty() ? indexed("node", instance_.node) : node.name;
+      group.name = node.name.empty() ? "light" + std::to_string(scene_.lightGroups.size()) : node.name;
       group.emission = scene_.materials[material].emission;
       *instance_.lightGroup = static_cast<std::uint32_t>(scene_.lightGroups.size());
       scene_.lightGroups.push_back(std::move(group));

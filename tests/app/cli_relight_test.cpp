@@ -172,3 +172,21 @@ TEST_F(CliRelight, BadEditsAreRefusedNamingTheEntryBeforeAnyFrame) {
 
 } // namespace
 } // namespace obscura::test
+
+namespace obscura::test {
+namespace {
+
+TEST_F(CliRelight, InfoListsTheLightsEditsCanName) {
+  const auto r = runObscura("info " + sharedScene("modern-hall/modern-hall.gltf"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "lights (13");
+  EXPECT_CONTAINS(r.output, "light_rectangle_6");
+  EXPECT_CONTAINS(r.output, "default dmax");
+  EXPECT_CONTAINS(r.output, "cameras (1");
+  const auto bad = runObscura("info " + path("nope.gltf"));
+  EXPECT_EQ(bad.exitCode, 2) << bad.output;
+  EXPECT_CONTAINS(bad.output, "nope.gltf");
+}
+
+} // namespace
+} // namespace obscura::test
