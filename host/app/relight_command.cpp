@@ -134,17 +134,24 @@ void relightScene(RelightOptions& o) {
   chooseSize(o.render, camera);
   gpu::Context context(o.render.device.contextOptions());
   render::ObscuranceRenderer renderer(context, loaded.scene, loaded.bvh, obscuranceSettings(o.render, camera));
+  // After renderer.composeDisplay(): the PNG from the fast path's display bytes, then the full
+  // compose for the EXR's AOVs and light layers.
   auto writeFrame = [&](std::size_t n) {
     if (renderer.stats().truncatedTraversals > 0)
       throw DeviceError("traversals ran out of steps (kMaxTraversalSteps); the frame would be wrong");
+    const fs::path stem = fs::path(o.output) / fmt::format("frame-{:03}", n);
+    const auto& layout = renderer.layout();
+    if (o.png)
+      io::writePngRgba8(stem.string() + ".png", static_cast<int>(layout.width), static_cast<int>(layout.height),
+                        renderer.display());
+    renderer.compose(o.exposure);
     io::Image image = renderer.image();
     io::appendChannels(image, renderer.lightLayers());
-    const fs::path stem = fs::path(o.output) / fmt::format("frame-{:03}", n);
     io::writeExr(stem.string() + ".exr", image);
-    if (o.png)
-      io::writePngRgba8(stem.string() + ".png", image.width, image.height, renderer.display());
   };
-  renderer.render();
+  renderer.reset();
+  renderer.iterate(renderer.settings().spp);
+  renderer.composeDisplay(o.exposure);
   writeFrame(0);
 
   // The scene's own emissions, and each light's intensity and colour multipliers.
@@ -192,7 +199,7 @@ void relightScene(RelightOptions& o) {
       default: break; // object edits were refused above
     }
     renderer.setEmissions(emissionsNow());
-    renderer.compose();
+    renderer.composeDisplay(o.exposure);
     const double totalMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     nlohmann::json line = {{"edit", n}, {"kind", e.kindName()}, {"name", e.name}, {"pixels_retraced", retraced}};
     line.update(passFigures(before, renderer.stats()));

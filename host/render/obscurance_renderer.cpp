@@ -64,6 +64,7 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
       primary_(context, frame_.layout().bandCount()), shadow_(context, frame_.layout().bandCount()),
       obscurance_(context, frame_.layout().bandCount()), specularPass_(context, frame_.layout().bandCount()),
       compose_(context, frame_.layout().bandCount()), tonemap_(context, frame_.layout().bandCount()),
+      resolve_(context, frame_.layout().bandCount()), lightMix_(context, frame_.layout().bandCount()),
       stream_(context), timestamps_(context) {
   for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
@@ -80,11 +81,17 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
   const bool bleedChanged = settings.colourBleeding != settings_.colourBleeding;
   settings_ = settings;
   dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax(scene_->bounds);
-  if (bleedChanged) ambient_ = computeAmbient(*scene_, lights_, meanAlbedo_, settings.colourBleeding);
+  if (bleedChanged) updateAmbientWeights(ambient_, lights_, settings.colourBleeding);
   reset();
 }
 
+void ObscuranceRenderer::markResolveStale(std::uint32_t fromLight, bool ambient) {
+  resolveFrom_ = std::min(resolveFrom_, fromLight);
+  resolveAmbient_ = resolveAmbient_ || ambient;
+}
+
 void ObscuranceRenderer::reset() {
+  markResolveStale(0, true);
   samples_ = 0;
   primaryRays_ = 0;
   wallSeconds_ = 0.0;
@@ -119,6 +126,8 @@ void ObscuranceRenderer::bindAll() {
     specularPass_.bind(b, inputs);
     compose_.bind(b, frame_, emissionBuffer_);
     tonemap_.bind(b, frame_);
+    resolve_.bind(b, frame_);
+    lightMix_.bind(b, frame_, emissionBuffer_);
   }
 }
 
@@ -145,6 +154,7 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
   const bool runObscurance = settings_.obscuranceRays > 0;
   const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
   const std::uint32_t end = samples_ + samples;
+  markResolveStale(0, true);
   while (samples_ < end) {
     const std::uint32_t last = std::min(end, samples_ + kSamplesPerSubmission);
     stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
@@ -214,6 +224,32 @@ void ObscuranceRenderer::compose(float exposureStops) {
     timestamps_.end(cmd, "tonemap");
   });
   timestamps_.collect();
+  wallSeconds_ += secondsSince(start);
+}
+
+void ObscuranceRenderer::composeDisplay(float exposureStops) {
+  const auto start = Clock::now();
+  const FrameLayout& layout = frame_.layout();
+  const glm::vec3 ia = ambientIntensity();
+  const auto lightCount = static_cast<std::uint32_t>(lights_.size());
+  const bool resolve = resolveFrom_ < lightCount || resolveAmbient_;
+  const std::uint32_t slots = frame_.lightCapacity();
+  stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+    timestamps_.reset(cmd);
+    if (resolve) {
+      timestamps_.begin(cmd, "resolve");
+      for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+        resolve_.record(cmd, b, layout, samples_, lightCount, slots, runSpecular_, resolveFrom_, resolveAmbient_);
+      timestamps_.end(cmd, "resolve");
+      gpu::computeBarrier(cmd);
+    }
+    timestamps_.begin(cmd, "lightmix");
+    for (std::uint32_t b = 0; b < layout.bandCount(); ++b) lightMix_.record(cmd, b, layout, lightCount, slots, ia, exposureStops);
+    timestamps_.end(cmd, "lightmix");
+  });
+  timestamps_.collect();
+  resolveFrom_ = lightCount;
+  resolveAmbient_ = false;
   wallSeconds_ += secondsSince(start);
 }
 
@@ -327,13 +363,12 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
   if (std::find(lights_.names.begin(), lights_.names.end(), light.name) != lights_.names.end())
     throw InputError(fmt::format("add light '{}': a light of that name exists", light.name));
   const std::size_t index = lights_.size();
-  std::vector<int> source(index + 1, -1);
-  for (std::size_t i = 0; i < index; ++i) source[i] = static_cast<int>(i);
-  frame_.remapLights(stream_, source);
+  frame_.addLightSlot(stream_);
+  markResolveStale(static_cast<std::uint32_t>(index), false);
   appendPunctual(lights_, light, scene_->bounds);
   updateSelection(lights_);
   emissions_.push_back(lights_.emission.back());
-  ambient_ = computeAmbient(*scene_, lights_, meanAlbedo_, settings_.colourBleeding);
+  updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   uploadLights();
 
   // The new light's shadow rays from the frame's own primary hits: the G-buffer of every sample
@@ -386,13 +421,11 @@ void ObscuranceRenderer::removeLight(std::size_t index) {
     emissionBuffer_.upload(*context_, asVec4(emissions_));
     return;
   }
-  std::vector<int> source;
-  for (std::size_t i = 0; i < lights_.size(); ++i)
-    if (i != index) source.push_back(static_cast<int>(i));
-  frame_.remapLights(stream_, source);
+  frame_.removeLightSlot(stream_, static_cast<std::uint32_t>(index));
+  markResolveStale(static_cast<std::uint32_t>(index), false);
   removePunctual(lights_, index);
   emissions_.erase(emissions_.begin() + static_cast<std::ptrdiff_t>(index));
-  ambient_ = computeAmbient(*scene_, lights_, meanAlbedo_, settings_.colourBleeding);
+  updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   uploadLights();
 }
 
@@ -411,6 +444,8 @@ RenderStats ObscuranceRenderer::stats() const {
   pass("specular", status[gpu::kStatusSpecularRays]);
   pass("compose", 0);
   pass("tonemap", 0);
+  pass("resolve", 0);
+  pass("lightmix", 0);
   st.deviceBytes = deviceBytes();
   st.wallSeconds = wallSeconds_;
   return st;

@@ -27,6 +27,8 @@
 #include "render/aovs.h"
 #include "render/frame/obscurance_frame.h"
 #include "render/passes/compose_pass.h"
+#include "render/passes/light_mix_pass.h"
+#include "render/passes/resolve_pass.h"
 #include "render/passes/obscurance_pass.h"
 #include "render/passes/primary_pass.h"
 #include "render/passes/shading_inputs.h"
@@ -102,7 +104,12 @@ public:
   Transport transport() const;
   // One RGB layer per light with the current E_s (render/transport.h lightLayers).
   io::Image lightLayers() const { return render::lightLayers(transport(), emissions_, ambient_.weight); }
-  // The tonemapped combined image of the last compose(), RGBA8 per pixel (R in the low byte).
+  // The display bytes alone, the fast way a light edit takes: the sums are resolved once to
+  // shared-exponent transport per light (again only after new samples or lights), then one pass
+  // composes and tonemaps combined. Agrees with compose() to 2 display levels (LightMix.*).
+  void composeDisplay(float exposureStops = 0.0f);
+  // The tonemapped combined image of the last compose() or composeDisplay(), RGBA8 per pixel
+  // (R in the low byte).
   std::vector<std::uint32_t> display() const;
 
   // Light edits that trace rays. addLight traces only the new light's shadow rays, from the same
@@ -159,6 +166,13 @@ private:
   SpecularPass specularPass_;
   ComposePass compose_;
   TonemapPass tonemap_;
+  ResolvePass resolve_;
+  LightMixPass lightMix_;
+  // The resolved transport is current for lights before resolveFrom_ (and the ambient unless
+  // resolveAmbient_); a new sample makes all of it stale, an added light only itself.
+  std::uint32_t resolveFrom_ = 0;
+  bool resolveAmbient_ = true;
+  void markResolveStale(std::uint32_t fromLight, bool ambient);
 
   gpu::CommandStream stream_;
   gpu::Timestamps timestamps_;

@@ -289,6 +289,35 @@ OBS_CONST uint kBindingTonemapInput = 0;  // vec4[pixel * kComposeSlots]
 OBS_CONST uint kBindingTonemapOutput = 1; // uint[pixel]: RGBA8, R in the low byte
 OBS_CONST uint kTonemapBindingCount = 2;
 
+// ---- resolve.comp and lightmix.comp: the fast relighting path [SPEC §3]. resolve.comp turns the
+// Kahan sums into the per-light transport T_s = (D_s + M_s + S_s) / n and the ambient
+// A_t = (A + A^spec) / n, as RGB9E5 words (lib/rgb9e5.glsl: 9-bit mantissas, shared exponent),
+// [light][pixel] then the ambient after the frame's light slots, at [slots][pixel]. lightmix.comp composes and tonemaps from them
+// in one pass: display = tonemap(sum_s E_s T_s + I_a(E) A_t). A term keeps 2^-9 of its pixel's
+// largest channel (tests: LightMix.*).
+struct ResolvePush {
+  uvec4 frame;     // 0:  width, rows (of the band), samples accumulated, light count
+  uvec4 flags;     // 16: x = 1 when the specular buffers hold data, y = first light to resolve (the
+                   //     ones before are current), z = 1 to resolve the ambient too
+  uvec4 capacity;  // 32: x = light slots of the frame (A_t lives after them)
+};                 // 48 bytes
+OBS_CONST uint kBindingResolveBasis = 0;           // vec4 pairs [light][pixel]: D_s
+OBS_CONST uint kBindingResolveEmissionBasis = 1;   // vec4 pairs [light][pixel]: M_s
+OBS_CONST uint kBindingResolveSpecularBasis = 2;   // vec4 pairs [light][pixel]: S_s
+OBS_CONST uint kBindingResolveAmbient = 3;         // vec4 pairs [pixel]: A
+OBS_CONST uint kBindingResolveSpecularAmbient = 4; // vec4 pairs [pixel]: A^spec
+OBS_CONST uint kBindingResolveOutput = 5;          // uint [(slots + 1) * pixels], RGB9E5
+OBS_CONST uint kResolveBindingCount = 6;
+
+struct LightMixPush {
+  uvec4 frame;     // 0:  width, rows (of the band), light count, light slots (A_t lives after them)
+  vec4 ambient;    // 16: I_a(E) rgb, w = exposure scale 2^stops
+};                 // 32 bytes
+OBS_CONST uint kBindingLightMixResolved = 0;  // uint [(slots + 1) * pixels] (resolve.comp)
+OBS_CONST uint kBindingLightMixEmissions = 1; // vec4[lights]: E_s
+OBS_CONST uint kBindingLightMixOutput = 2;    // uint[pixel]: RGBA8 (as tonemap.comp)
+OBS_CONST uint kLightMixBindingCount = 3;
+
 // ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,
 // then its Kahan compensation), so accumulation buffers hold kAccumulatorVec4s vec4 per entry.
 OBS_CONST uint kAccumulatorVec4s = 2;

@@ -270,5 +270,55 @@ TEST_F(Relight, AddedLightTracesOnlyItsShadowRaysAndMatchesAFreshRender) {
   expectStatisticallyEqual(r.image(), edited);
 }
 
+// The fast path a light edit takes (resolved RGB9E5 transport, one light-mix pass) shows what the
+// full compose + tonemap shows, to 2 display levels (a term keeps 2^-9 of its pixel's largest
+// channel; sRGB at 8 bits steps by about 2^-8 near white), before and after light edits.
+class LightMix : public Relight {
+protected:
+  void expectDisplaysAgree(render::ObscuranceRenderer& r, float exposure) {
+    r.compose(exposure);
+    const auto full = r.display();
+    r.composeDisplay(exposure);
+    const auto fast = r.display();
+    ASSERT_EQ(full.size(), fast.size());
+    int worst = 0;
+    for (std::size_t i = 0; i < full.size(); ++i)
+      for (int c = 0; c < 3; ++c)
+        worst = std::max(worst, std::abs(static_cast<int>((full[i] >> (8 * c)) & 255u) -
+                                         static_cast<int>((fast[i] >> (8 * c)) & 255u)));
+    EXPECT_LE(worst, 2);
+  }
+};
+
+TEST_F(LightMix, FastDisplayMatchesTheFullComposeAcrossEdits) {
+  auto& r = base();
+  expectDisplaysAgree(r, 0.0f);
+  std::vector<glm::vec3> e = r.emissions();
+  e[light("lampA")] *= glm::vec3(0.2f, 1.5f, 3.0f);
+  r.setEmissions(e);
+  expectDisplaysAgree(r, 1.0f);
+  scene::PunctualLight added;
+  added.name = "added";
+  added.position = kAddedPosition;
+  added.intensity = kAddedIntensity;
+  r.addLight(added);
+  expectDisplaysAgree(r, -0.5f);
+  r.removeLight(light("bulb"));
+  expectDisplaysAgree(r, 0.0f);
+}
+
+TEST_F(LightMix, ALightEditResolvesNothingAgain) {
+  auto& r = base();
+  r.composeDisplay();
+  const auto before = r.stats();
+  std::vector<glm::vec3> e = r.emissions();
+  e[light("lampB")] *= 0.5f;
+  r.setEmissions(e);
+  r.composeDisplay();
+  const auto after = r.stats();
+  EXPECT_EQ(after.passes.at("resolve").gpuMs, before.passes.at("resolve").gpuMs) << "no resolve after a light edit";
+  EXPECT_GT(after.passes.at("lightmix").gpuMs, before.passes.at("lightmix").gpuMs);
+}
+
 } // namespace
 } // namespace obscura::test

@@ -1,10 +1,12 @@
 #include "render/frame/obscurance_frame.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "gpu/kernel.h"
 #include "shared/host_device.h"
 
 namespace obscura::render {
@@ -28,6 +30,8 @@ std::vector<FrameBufferKind> ObscuranceFrame::bufferKinds(const FrameContents& c
       {"ambient", kAccumulator, false},
       {"composed", contents.composedSlots * kVec4, false},
       {"display", 4, false},
+      {"resolved", 4, true},
+      {"resolved_ambient", 4, false},
   };
   if (contents.primaryAovs) kinds.push_back({"aovs", gpu::kAovSlots * kAccumulator, false});
   if (contents.specular) {
@@ -55,7 +59,7 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     largest = std::max(largest, k.bytesPerPixel * (k.perLight ? maxLights_ : 1u));
   layout_ = FrameLayout::split(width, height, largest, limit, "the per-light basis buffers");
 
-  const std::uint64_t need = bytesNeeded(width, height, lights, contents);
+  const std::uint64_t need = bytesNeeded(width, height, maxLights_, contents);
   if (need > context.info().deviceLocalBytes)
     throw InputError(fmt::format("{}x{} with {} light groups: the frame buffers need {:.1f} MiB, more than the device "
                                  "'{}' offers ({:.0f} MiB); merge light groups (--light-groups material) or render "
@@ -78,28 +82,23 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
                           kStorage | Usage::eIndirectBuffer, "frame.specular_queue" + tag);
     b.composed = gpu::Buffer(context, px * contents.composedSlots * kVec4, kStorage, "frame.composed" + tag);
     b.display = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.display" + tag);
-    allocatePerLight(b, lights);
+    const std::uint64_t slots = maxLights_;
+    b.basis = gpu::Buffer(context, px * slots * kAccumulator, kStorage, "frame.basis" + tag);
+    b.emissionBasis = gpu::Buffer(context, px * slots * kAccumulator, kStorage, "frame.emission_basis" + tag);
+    b.specularBasis = gpu::Buffer(context, specular ? px * slots * kAccumulator : kVec4, kStorage,
+                                  "frame.specular_basis" + tag);
+    b.resolved = gpu::Buffer(context, px * (slots + 1) * 4, kStorage, "frame.resolved" + tag);
     bands_.push_back(std::move(b));
   }
   status_ = gpu::Buffer(context, gpu::kStatusWords * 4, kStorage, "frame.status");
   resetStatus();
 }
 
-void ObscuranceFrame::allocatePerLight(Band& b, std::uint32_t lights) {
-  const std::uint64_t px = std::uint64_t(layout_.width) * b.rows.rows;
-  const std::string tag = layout_.bands.size() > 1 ? fmt::format("[rows {}+]", b.rows.firstRow) : "";
-  b.basis = gpu::Buffer(*context_, atLeastOne(px * lights * kAccumulator), kStorage, "frame.basis" + tag);
-  b.emissionBasis = gpu::Buffer(*context_, atLeastOne(px * lights * kAccumulator), kStorage,
-                                "frame.emission_basis" + tag);
-  b.specularBasis = gpu::Buffer(*context_, contents_.specular ? atLeastOne(px * lights * kAccumulator) : kVec4, kStorage,
-                                "frame.specular_basis" + tag);
-}
-
 std::uint64_t ObscuranceFrame::bytes() const {
   std::uint64_t total = status_.size();
   for (const auto& b : bands_)
     for (const gpu::Buffer* buffer : {&b.gbuffer, &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
-                                      &b.specularAmbient, &b.queue, &b.composed, &b.display})
+                                      &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved})
       total += buffer->size();
   return total;
 }
@@ -115,40 +114,39 @@ void ObscuranceFrame::resetStatus() {
   status_.upload(*context_, zeros, sizeof(zeros));
 }
 
-void ObscuranceFrame::remapLights(gpu::CommandStream& stream, const std::vector<int>& source) {
-  const auto lights = static_cast<std::uint32_t>(source.size());
-  if (lights > maxLights_)
-    throw InputError(fmt::format("{} lights: this frame was laid out for at most {} (render again to add more)",
-                                 lights, maxLights_));
-  std::vector<Band> old;
-  for (auto& b : bands_) {
-    Band kept;
-    kept.basis = std::move(b.basis);
-    kept.emissionBasis = std::move(b.emissionBasis);
-    kept.specularBasis = std::move(b.specularBasis);
-    allocatePerLight(b, lights);
-    old.push_back(std::move(kept));
-  }
+void ObscuranceFrame::addLightSlot(gpu::CommandStream& stream) {
+  if (lights_ >= maxLights_)
+    throw InputError(fmt::format("{} lights: this frame has room for {} (render again to add more)", lights_ + 1,
+                                 maxLights_));
   stream.submit([&](const vk::raii::CommandBuffer& cmd) {
     for (std::size_t i = 0; i < bands_.size(); ++i) {
-      const std::uint64_t slot = layout_.bandPixels(i) * kAccumulator; // one light's pairs
+      const std::uint64_t slot = layout_.bandPixels(i) * kAccumulator;
       Band& b = bands_[i];
-      for (auto [to, from] : {std::pair{&b.basis, &old[i].basis}, std::pair{&b.emissionBasis, &old[i].emissionBasis},
-                              std::pair{&b.specularBasis, &old[i].specularBasis}}) {
-        if (!contents_.specular && to == &b.specularBasis) continue;
-        for (std::uint32_t l = 0; l < lights; ++l) {
-          if (source[l] < 0) {
-            cmd.fillBuffer(to->handle(), l * slot, slot, 0u);
-          } else {
-            vk::BufferCopy region{.srcOffset = static_cast<std::uint64_t>(source[l]) * slot, .dstOffset = l * slot,
-                                  .size = slot};
-            cmd.copyBuffer(from->handle(), to->handle(), region);
-          }
-        }
+      cmd.fillBuffer(b.basis.handle(), lights_ * slot, slot, 0u);
+      cmd.fillBuffer(b.emissionBasis.handle(), lights_ * slot, slot, 0u);
+      if (contents_.specular) cmd.fillBuffer(b.specularBasis.handle(), lights_ * slot, slot, 0u);
+    }
+  });
+  ++lights_;
+}
+
+void ObscuranceFrame::removeLightSlot(gpu::CommandStream& stream, std::uint32_t index) {
+  if (index >= lights_) throw std::logic_error("removeLightSlot: no such light");
+  stream.submit([&](const vk::raii::CommandBuffer& cmd) {
+    for (std::size_t i = 0; i < bands_.size(); ++i) {
+      const std::uint64_t slot = layout_.bandPixels(i) * kAccumulator;
+      Band& b = bands_[i];
+      // Slot by slot, each copy after the last (copies within one buffer must not overlap).
+      for (std::uint32_t l = index + 1; l < lights_; ++l) {
+        const vk::BufferCopy region{.srcOffset = l * slot, .dstOffset = (l - 1) * slot, .size = slot};
+        cmd.copyBuffer(b.basis.handle(), b.basis.handle(), region);
+        cmd.copyBuffer(b.emissionBasis.handle(), b.emissionBasis.handle(), region);
+        if (contents_.specular) cmd.copyBuffer(b.specularBasis.handle(), b.specularBasis.handle(), region);
+        gpu::computeBarrier(cmd);
       }
     }
   });
-  lights_ = lights;
+  --lights_;
 }
 
 } // namespace obscura::render

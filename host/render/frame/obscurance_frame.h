@@ -35,8 +35,8 @@ struct FrameContents {
   std::uint32_t composedSlots = 6;   // gpu::kComposeSlots, or 1 when only `combined` is wanted
 };
 
-// Lights that may be added to a frame without re-splitting it: its bands are sized for this many
-// more per-light buffers than the frame starts with.
+// Lights that may be added to a frame: its per-light buffers have this many spare slots from the
+// start, so that adding a light clears one slot instead of re-allocating and copying them all.
 inline constexpr std::uint32_t kSpareLightSlots = 4;
 
 class ObscuranceFrame {
@@ -45,6 +45,7 @@ public:
     FrameBand rows;
     gpu::Buffer gbuffer, aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, composed,
         display;
+    gpu::Buffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits
   };
 
   // `maxBufferBytes` 0 = the device's per-buffer limit (a smaller one tests banding).
@@ -72,13 +73,11 @@ public:
   // Device bytes allocated now (the real buffers' sizes).
   std::uint64_t bytes() const;
 
-  // Re-sizes the per-light buffers to `source.size()` lights: light i keeps the transport of old
-  // light source[i], or starts at zero where source[i] < 0. Up to kSpareLightSlots more lights
-  // than the frame was made with fit; more throws InputError.
-  void remapLights(gpu::CommandStream& stream, const std::vector<int>& source);
-
-private:
-  void allocatePerLight(Band& band, std::uint32_t lights);
+  // Appends a light slot (zero transport); InputError when the spare slots are used up.
+  void addLightSlot(gpu::CommandStream& stream);
+  // Drops light slot `index`; the slots after it move down one (lights keep their order).
+  void removeLightSlot(gpu::CommandStream& stream, std::uint32_t index);
+  std::uint32_t lightCapacity() const { return maxLights_; }
 
   const gpu::Context* context_;
   FrameLayout layout_;

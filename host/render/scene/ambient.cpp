@@ -52,9 +52,16 @@ AmbientTerm computeAmbient(const scene::Scene& scene, const LightSet& lights,
       term.reflectanceClamped = true;
     }
   term.averageReflectance = rAve;
+  updateAmbientWeights(term, lights, colourBleeding);
+  return term;
+}
+
+void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colourBleeding) {
   // [RTO eq. 4] (grey) or [RTO eq. 12] (colour bleeding), per unit E_s. The paper's I_a is a
   // radiosity (E_i = pi L_e); our images are radiance, so I_a is divided by pi: for a Lambertian
   // reflector the indirect radiance is R(P) I_a W / pi. OURS [SPEC §5: no hidden scale].
+  const glm::vec3 rAve = term.averageReflectance;
+  term.weight.clear();
   for (std::size_t s = 0; s < lights.size(); ++s) {
     glm::vec3 w(0.0f);
     if (term.totalArea > 0.0) {
@@ -63,7 +70,6 @@ AmbientTerm computeAmbient(const scene::Scene& scene, const LightSet& lights,
     }
     term.weight.push_back(w);
   }
-  return term;
 }
 
 } // namespace obscura::render

@@ -30,6 +30,10 @@ struct AmbientTerm {
 AmbientTerm computeAmbient(const scene::Scene& scene, const LightSet& lights,
                            const std::vector<glm::vec3>& meanAlbedo, bool colourBleeding);
 
+// The weights w_s of `term` (whose R_ave and A_t stay) for another set of lights: what adding or
+// removing a light changes, without summing the scene's areas and textures again.
+void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colourBleeding);
+
 // Mean linear colour of a texture (sRGB decoded when the texture is sRGB).
 glm::vec3 meanTextureColour(const scene::Texture& texture);
 

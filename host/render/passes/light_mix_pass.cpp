@@ -1,0 +1,29 @@
+#include "render/passes/light_mix_pass.h"
+
+#include <cmath>
+
+#include "lightmix.spv.h"
+
+namespace obscura::render {
+
+LightMixPass::LightMixPass(const gpu::Context& context, std::uint32_t bands)
+    : kernel_(context, {.name = "lightmix", .spirv = kSpirv_lightmix,
+                        .bindings = std::vector<gpu::BindingKind>(gpu::kLightMixBindingCount,
+                                                                  gpu::BindingKind::StorageBuffer),
+                        .pushConstantBytes = sizeof(gpu::LightMixPush), .setCount = bands}) {}
+
+void LightMixPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& emissions) {
+  kernel_.bind(gpu::kBindingLightMixResolved, frame.band(band).resolved, band);
+  kernel_.bind(gpu::kBindingLightMixEmissions, emissions, band);
+  kernel_.bind(gpu::kBindingLightMixOutput, frame.band(band).display, band);
+}
+
+void LightMixPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
+                          std::uint32_t lights, std::uint32_t slots, const glm::vec3& ambientIntensity,
+                          float exposureStops) const {
+  gpu::LightMixPush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, lights, slots),
+                         .ambient = glm::vec4(ambientIntensity, std::exp2(exposureStops))};
+  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+}
+
+} // namespace obscura::render

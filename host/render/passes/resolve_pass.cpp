@@ -1,0 +1,32 @@
+#include "render/passes/resolve_pass.h"
+
+#include "resolve.spv.h"
+
+namespace obscura::render {
+
+ResolvePass::ResolvePass(const gpu::Context& context, std::uint32_t bands)
+    : kernel_(context, {.name = "resolve", .spirv = kSpirv_resolve,
+                        .bindings = std::vector<gpu::BindingKind>(gpu::kResolveBindingCount,
+                                                                  gpu::BindingKind::StorageBuffer),
+                        .pushConstantBytes = sizeof(gpu::ResolvePush), .setCount = bands}) {}
+
+void ResolvePass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
+  const auto& b = frame.band(band);
+  kernel_.bind(gpu::kBindingResolveBasis, b.basis, band);
+  kernel_.bind(gpu::kBindingResolveEmissionBasis, b.emissionBasis, band);
+  kernel_.bind(gpu::kBindingResolveSpecularBasis, b.specularBasis, band);
+  kernel_.bind(gpu::kBindingResolveAmbient, b.ambient, band);
+  kernel_.bind(gpu::kBindingResolveSpecularAmbient, b.specularAmbient, band);
+  kernel_.bind(gpu::kBindingResolveOutput, b.resolved, band);
+}
+
+void ResolvePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
+                         std::uint32_t samples, std::uint32_t lights, std::uint32_t slots, bool specular,
+                         std::uint32_t firstLight, bool ambient) const {
+  gpu::ResolvePush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, samples, lights),
+                        .flags = glm::uvec4(specular ? 1u : 0u, firstLight, ambient ? 1u : 0u, 0u),
+                        .capacity = glm::uvec4(slots, 0u, 0u, 0u)};
+  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+}
+
+} // namespace obscura::render

@@ -1,0 +1,35 @@
+#version 460
+// resolve.comp — the Kahan sums of a frame band to the shared-exponent transport the fast relighting
+// path reads (host_device.h, "resolve.comp and lightmix.comp"): T_s = (D_s + M_s + S_s) / n per
+// light, then A_t = (A + A^spec) / n. Run once after the samples; every light edit reads them.
+#extension GL_GOOGLE_include_directive : require
+#include "shared/host_device.h"
+#include "lib/accumulate.glsl"
+#include "lib/rgb9e5.glsl"
+
+layout(local_size_x = kWorkgroupSize1D) in;
+layout(push_constant) uniform Push { ResolvePush pc; };
+layout(std430, binding = kBindingResolveBasis) readonly buffer Basis { vec4 basis[]; };
+layout(std430, binding = kBindingResolveEmissionBasis) readonly buffer EmissionBasis { vec4 emissionBasis[]; };
+layout(std430, binding = kBindingResolveSpecularBasis) readonly buffer SpecularBasis { vec4 specularBasis[]; };
+layout(std430, binding = kBindingResolveAmbient) readonly buffer Ambient { vec4 ambient[]; };
+layout(std430, binding = kBindingResolveSpecularAmbient) readonly buffer SpecularAmbient { vec4 specularAmbient[]; };
+layout(std430, binding = kBindingResolveOutput) writeonly buffer Resolved { uint resolved[]; };
+
+void main() {
+  uint pixel = gl_GlobalInvocationID.x;
+  uint pixelCount = pc.frame.x * pc.frame.y;
+  if (pixel >= pixelCount) return;
+  float inv = 1.0 / float(max(pc.frame.z, 1u));
+  const bool withSpecular = pc.flags.x != 0u;
+  for (uint s = pc.flags.y; s < pc.frame.w; ++s) {
+    uint i = s * pixelCount + pixel;
+    vec3 t = OBS_SUM(basis, i).rgb + OBS_SUM(emissionBasis, i).rgb;
+    if (withSpecular) t += OBS_SUM(specularBasis, i).rgb;
+    resolved[i] = packRgb9e5(t * inv);
+  }
+  if (pc.flags.z == 0u) return;
+  vec3 a = OBS_SUM(ambient, pixel).rgb;
+  if (withSpecular) a += OBS_SUM(specularAmbient, pixel).rgb;
+  resolved[pc.capacity.x * pixelCount + pixel] = packRgb9e5(a * inv);
+}
