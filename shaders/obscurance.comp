@@ -27,6 +27,7 @@ void main() {
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;
+  if (skipClean(pixel)) return;
   GBufferTexel g = gbuffer[pixel];
   if (g.albedo.a == 0.0) return;
 

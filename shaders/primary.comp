@@ -19,6 +19,8 @@ layout(std430, set = 0, binding = kBindingPrimaryGBuffer) writeonly buffer GBuff
 layout(std430, set = 0, binding = kBindingPrimaryAovs) buffer AovBuffer { vec4 aov[]; };
 layout(std430, set = 0, binding = kBindingPrimaryLightScales) readonly buffer LightScales { vec4 lightScales[]; };
 layout(std430, set = 0, binding = kBindingPrimaryEmissionBasis) buffer EmissionBasis { vec4 emissionBasis[]; };
+layout(std430, set = 0, binding = kBindingPrimaryHitBounds) buffer HitBounds { vec4 hitBounds[]; };
+layout(std430, set = 0, binding = kBindingPrimaryDirty) readonly buffer DirtyMask { uint dirty[]; };
 
 void accumulate(uint pixel, uint slot, vec4 value, bool first) {
   uint i = pixel * kAovSlots + slot;
@@ -31,6 +33,7 @@ void main() {
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;
+  if ((pc.band.w & kPrimaryFlagDirtyOnly) != 0u && dirty[pixel] == 0u) return;
   uint sampleIndex = pc.frame.z;
   bool first = sampleIndex == 0u;
   const uint lightCount = pc.band.z;
@@ -74,6 +77,18 @@ void main() {
   }
   gbuffer[pixel] = g;
   if (!accumulateSums) return;
+
+  // The box of the pixel's hits over its samples, for the dirty pixels of a geometry edit.
+  bool hitSomething = g.albedo.a != 0.0;
+  bool glossy = hitSomething && materials[floatBitsToUint(g.shadingNormal.w)].params.w != 0.0;
+  vec4 lo = vec4(hitSomething ? g.position.xyz : vec3(1e30), glossy ? 1.0 : 0.0);
+  vec4 hi = vec4(hitSomething ? g.position.xyz : vec3(-1e30), hitSomething ? 1.0 : 0.0);
+  if (!first) {
+    lo = vec4(min(lo.xyz, hitBounds[2u * pixel].xyz), max(lo.w, hitBounds[2u * pixel].w));
+    hi = vec4(max(hi.xyz, hitBounds[2u * pixel + 1u].xyz), max(hi.w, hitBounds[2u * pixel + 1u].w));
+  }
+  hitBounds[2u * pixel] = lo;
+  hitBounds[2u * pixel + 1u] = hi;
 
   // M_s: the emission the camera sees, per light at unit emission, so that relighting scales a
   // lamp the camera looks at with its light [SPEC §3]. Sample 0 starts every light's sum.

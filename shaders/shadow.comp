@@ -26,6 +26,7 @@ void main() {
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;
+  if (skipClean(pixel)) return;
   uint pixelCount = bp.count;
   GBufferTexel g = gbuffer[pixel];
   if (g.albedo.a == 0.0) return; // no hit: nothing to light

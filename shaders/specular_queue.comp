@@ -15,6 +15,7 @@ void main() {
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;
+  if (skipClean(pixel)) return;
   GBufferTexel g = gbuffer[pixel];
   if (g.albedo.a == 0.0 || materials[floatBitsToUint(g.shadingNormal.w)].params.w == 0.0) return;
   uint slot = atomicAdd(queue[kQueueCount], 1u);

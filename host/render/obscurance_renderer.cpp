@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 
 #include <fmt/format.h>
 
@@ -65,6 +66,7 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
       obscurance_(context, frame_.layout().bandCount()), specularPass_(context, frame_.layout().bandCount()),
       compose_(context, frame_.layout().bandCount()), tonemap_(context, frame_.layout().bandCount()),
       resolve_(context, frame_.layout().bandCount()), lightMix_(context, frame_.layout().bandCount()),
+      dirty_(context, frame_.layout().bandCount()), sceneScale_(sceneScale(scene.bounds)),
       stream_(context), timestamps_(context) {
   for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
@@ -114,6 +116,7 @@ void ObscuranceRenderer::uploadLights() {
   lightBuffers_.emitters = gpu::uploadArray(*context_, lights_.emitters, "lights.emitters");
   lightBuffers_.scales = gpu::uploadArray(*context_, asVec4(lights_.emission), "lights.render_scales");
   emissionBuffer_ = gpu::uploadArray(*context_, asVec4(emissions_), "compose.emissions");
+  lightBounds_ = gpu::uploadArray(*context_, lightBounds(lights_), "dirty.light_bounds");
   bindAll();
 }
 
@@ -128,6 +131,7 @@ void ObscuranceRenderer::bindAll() {
     tonemap_.bind(b, frame_);
     resolve_.bind(b, frame_);
     lightMix_.bind(b, frame_, emissionBuffer_);
+    dirty_.bind(b, frame_, lightBounds_);
   }
 }
 
@@ -140,7 +144,7 @@ gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
           .params = glm::vec4(dMax_, settings_.tau, static_cast<float>(settings_.rho),
                               static_cast<float>(settings_.maxDepth)),
           .rAve = glm::vec4(ambient_.averageReflectance, 0.0f),
-          .eye = glm::vec4(settings_.camera.position, sceneScale(scene_->bounds)),
+          .eye = glm::vec4(settings_.camera.position, sceneScale_),
           .band = glm::uvec4(0u)};
 }
 
@@ -148,11 +152,6 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
   const auto start = Clock::now();
   const double wallBefore = wallSeconds_;
   const FrameLayout& layout = frame_.layout();
-  const std::uint32_t bands = layout.bandCount();
-  const auto lightCount = static_cast<std::uint32_t>(lights_.size());
-  const bool runShadow = lights_.anySampled() && settings_.shadowRays > 0;
-  const bool runObscurance = settings_.obscuranceRays > 0;
-  const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
   const std::uint32_t end = samples_ + samples;
   markResolveStale(0, true);
   while (samples_ < end) {
@@ -161,28 +160,7 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
       timestamps_.reset(cmd);
       for (std::uint32_t s = samples_; s < last; ++s) {
         if (s > samples_) gpu::computeBarrier(cmd);
-        const gpu::ShadePush push = shadePush(s);
-        timestamps_.begin(cmd, "primary");
-        for (std::uint32_t b = 0; b < bands; ++b)
-          primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount,
-                          settings_.primaryAovs ? 0u : gpu::kPrimaryFlagNoAovs);
-        timestamps_.end(cmd, "primary");
-        gpu::computeBarrier(cmd);
-        if (runShadow) {
-          timestamps_.begin(cmd, "shadow");
-          for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push);
-          timestamps_.end(cmd, "shadow");
-        }
-        if (runObscurance) {
-          timestamps_.begin(cmd, "obscurance");
-          for (std::uint32_t b = 0; b < bands; ++b) obscurance_.record(cmd, b, layout, push);
-          timestamps_.end(cmd, "obscurance");
-        }
-        if (runSpecular_) {
-          timestamps_.begin(cmd, "specular");
-          for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, push);
-          timestamps_.end(cmd, "specular");
-        }
+        recordSample(cmd, s, settings_.primaryAovs ? 0u : gpu::kPrimaryFlagNoAovs, 0u);
       }
     });
     timestamps_.collect();
@@ -191,6 +169,83 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
     wallSeconds_ = wallBefore + secondsSince(start);
     if (progress) progress(samples_ - (end - samples), samples, secondsSince(start));
   }
+}
+
+void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t s, std::uint32_t primaryFlags,
+                                      std::uint32_t shadeFlags) {
+  const FrameLayout& layout = frame_.layout();
+  const std::uint32_t bands = layout.bandCount();
+  const auto lightCount = static_cast<std::uint32_t>(lights_.size());
+  const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
+  gpu::ShadePush push = shadePush(s);
+  push.band.z = shadeFlags;
+  timestamps_.begin(cmd, "primary");
+  for (std::uint32_t b = 0; b < bands; ++b) primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, primaryFlags);
+  timestamps_.end(cmd, "primary");
+  gpu::computeBarrier(cmd);
+  if (lights_.anySampled() && settings_.shadowRays > 0) {
+    timestamps_.begin(cmd, "shadow");
+    for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push);
+    timestamps_.end(cmd, "shadow");
+  }
+  if (settings_.obscuranceRays > 0) {
+    timestamps_.begin(cmd, "obscurance");
+    for (std::uint32_t b = 0; b < bands; ++b) obscurance_.record(cmd, b, layout, push);
+    timestamps_.end(cmd, "obscurance");
+  }
+  if (runSpecular_) {
+    timestamps_.begin(cmd, "specular");
+    for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, push);
+    timestamps_.end(cmd, "specular");
+  }
+}
+
+std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, const bvh::Bvh& bvh,
+                                                 const std::vector<scene::Bounds>& changed) {
+  const auto start = Clock::now();
+  const double wallBefore = wallSeconds_;
+  // Same lights: only an emitter that moved changes them, and then every pixel may change.
+  LightSet moved = buildLightSet(edited);
+  bool emittersMoved = moved.emitters.size() != lights_.emitters.size();
+  for (std::size_t i = 0; !emittersMoved && i < moved.emitters.size(); ++i)
+    emittersMoved = std::memcmp(&moved.emitters[i], &lights_.emitters[i], sizeof(gpu::GpuEmitter)) != 0;
+  if (emittersMoved) lights_.emitters = moved.emitters;
+  scene_ = &edited;
+  sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
+  uploadLights();
+
+  const FrameLayout& layout = frame_.layout();
+  const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
+  const auto lightCount = static_cast<std::uint32_t>(lights_.size());
+  for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+    dirty_.prepare(b, layout, camera, changed, dMax_, lightCount, emittersMoved);
+  const std::uint32_t dirtyBefore = frame_.statusWords()[gpu::kStatusDirtyPixels];
+  stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+    timestamps_.reset(cmd);
+    timestamps_.begin(cmd, "dirty");
+    for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.record(cmd, b, layout);
+    gpu::computeBarrier(cmd);
+    for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.recordClear(cmd, b, layout, lightCount, runSpecular_);
+    timestamps_.end(cmd, "dirty");
+  });
+  timestamps_.collect();
+  const std::uint64_t retraced = frame_.statusWords()[gpu::kStatusDirtyPixels] - dirtyBefore;
+  const std::uint32_t primaryFlags = gpu::kPrimaryFlagDirtyOnly | (settings_.primaryAovs ? 0u : gpu::kPrimaryFlagNoAovs);
+  for (std::uint32_t first = 0; retraced > 0 && first < samples_; first += kSamplesPerSubmission) {
+    const std::uint32_t last = std::min(samples_, first + kSamplesPerSubmission);
+    stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+      timestamps_.reset(cmd);
+      for (std::uint32_t s = first; s < last; ++s) {
+        gpu::computeBarrier(cmd);
+        recordSample(cmd, s, primaryFlags, gpu::kShadeFlagDirtyOnly);
+      }
+    });
+    timestamps_.collect();
+    primaryRays_ += retraced * (last - first);
+  }
+  markResolveStale(0, true);
+  wallSeconds_ = wallBefore + secondsSince(start);
+  return retraced;
 }
 
 void ObscuranceRenderer::render(const ProgressFn& progress) {

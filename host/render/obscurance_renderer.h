@@ -27,6 +27,7 @@
 #include "render/aovs.h"
 #include "render/frame/obscurance_frame.h"
 #include "render/passes/compose_pass.h"
+#include "render/passes/dirty_pass.h"
 #include "render/passes/light_mix_pass.h"
 #include "render/passes/resolve_pass.h"
 #include "render/passes/obscurance_pass.h"
@@ -117,6 +118,15 @@ public:
   // buffer; removeLight drops one. Both update I_a. Indices shift like a vector's.
   std::size_t addLight(const scene::PunctualLight& light);
   void removeLight(std::size_t index);
+  // A geometry edit [IVR §3.3]: `edited` (with its BVH) replaces the scene — the same lights,
+  // materials and camera — and `changed` holds the world boxes of what changed (an object's old
+  // and new places). Only the pixels those can change (dirty.comp) are retraced, for every sample
+  // so far with the same seeds, so every pixel ends as a full render of `edited` would make it;
+  // the others keep their sums bit for bit. `edited` must outlive the renderer. Returns the
+  // pixels retraced. Moving an emitter retraces every pixel.
+  std::uint64_t updateGeometry(const scene::Scene& edited, const bvh::Bvh& bvh,
+                               const std::vector<scene::Bounds>& changed);
+
   // The index of the light named `name`; InputError listing the names when there is none.
   std::size_t lightIndex(const std::string& name) const;
 
@@ -168,6 +178,11 @@ private:
   TonemapPass tonemap_;
   ResolvePass resolve_;
   LightMixPass lightMix_;
+  DirtyPass dirty_;
+  gpu::Buffer lightBounds_; // for dirty.comp
+  float sceneScale_ = 1.0f; // the ray-origin offset's scale, kept across geometry edits
+  void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, std::uint32_t primaryFlags,
+                    std::uint32_t shadeFlags);
   // The resolved transport is current for lights before resolveFrom_ (and the ambient unless
   // resolveAmbient_); a new sample makes all of it stale, an added light only itself.
   std::uint32_t resolveFrom_ = 0;

@@ -17,7 +17,11 @@ layout(std430, set = 0, binding = kBindingSpecularAmbient) buffer SpecularAmbien
 // queue[0..3] = indirect dispatch groups (x, y, z) and the entry count; pixel indices follow.
 layout(std430, set = 0, binding = kBindingSpecularQueue) buffer SpecularQueue { uint queue[]; };
 layout(std430, set = 0, binding = kBindingLightScales) readonly buffer LightScales { vec4 lightScales[]; };
+layout(std430, set = 0, binding = kBindingDirty) readonly buffer DirtyMask { uint dirty[]; };
 
 layout(push_constant) uniform Push { ShadePush pc; };
+
+// Whether this pass skips `pixel`: a retrace after a geometry edit runs the dirty pixels only.
+bool skipClean(uint pixel) { return (pc.band.z & kShadeFlagDirtyOnly) != 0u && dirty[pixel] == 0u; }
 
 #endif

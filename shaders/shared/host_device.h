@@ -172,6 +172,8 @@ struct PrimaryPush {
 OBS_CONST uint kPrimaryFlagGBufferOnly = 1u;
 // The frame keeps no primary AOVs (only what compose needs was asked for): M_s is still summed.
 OBS_CONST uint kPrimaryFlagNoAovs = 2u;
+// Only pixels the dirty mask marks run (a geometry edit retraces them); the others keep their sums.
+OBS_CONST uint kPrimaryFlagDirtyOnly = 4u;
 
 // ---- Push constants of the bench/trace kernel.
 struct TracePush {
@@ -194,6 +196,7 @@ OBS_CONST uint kStatusShadowRays = 1;      // shadow rays traced (for rays/s fig
 OBS_CONST uint kStatusObscuranceRays = 2;  // obscurance rays traced
 OBS_CONST uint kStatusSpecularRays = 3;    // rays traced along specular paths
 OBS_CONST uint kStatusPathRays = 4;        // rays traced by the path tracer
+OBS_CONST uint kStatusDirtyPixels = 5;     // pixels dirty.comp marked for retracing
 OBS_CONST uint kStatusWords = 8;
 
 // ---- Shading passes (shadow.comp, obscurance.comp): push constants.
@@ -210,8 +213,9 @@ struct ShadePush {
   vec4 rAve;    // 48: R_ave rgb (the reflectance of a miss within dmax, SPEC §1.2), w = unused
   vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = scene size
                 //     (largest bounding-box extent: scales the ray-origin offset, ray.glsl)
-  uvec4 band;   // 80: first row, rows, unused, unused (see "Frame bands")
+  uvec4 band;   // 80: first row, rows, flags (kShadeFlag*), unused (see "Frame bands")
 };              // 96 bytes
+OBS_CONST uint kShadeFlagDirtyOnly = 1u; // only pixels the dirty mask marks run
 
 // ---- Bindings of the shading passes (after the scene's 0..5).
 OBS_CONST uint kBindingGBuffer = 6;   // GBufferTexel[pixels] of the current sample
@@ -223,7 +227,8 @@ OBS_CONST uint kBindingSpecularBasis = 11;   // vec4[lights * pixels]: D_s gathe
 OBS_CONST uint kBindingSpecularAmbient = 12; // vec4[pixels]: A gathered along specular paths
 OBS_CONST uint kBindingSpecularQueue = 13;   // uint[]: kQueueHeader words, then glossy pixel indices
 OBS_CONST uint kBindingLightScales = 14;     // vec4[lights]: E_s (to make seen emission unit)
-OBS_CONST uint kShadingBindingCount = 15;
+OBS_CONST uint kBindingDirty = 15;           // uint[pixel]: 1 = retrace (kShadeFlagDirtyOnly)
+OBS_CONST uint kShadingBindingCount = 16;
 
 // ---- Bindings of primary.comp after the scene's (0..5).
 OBS_CONST uint kBindingPrimaryGBuffer = 6;       // GBufferTexel[pixel]
@@ -231,7 +236,11 @@ OBS_CONST uint kBindingPrimaryAovs = 7;          // vec4 pairs [pixel * kAovSlot
 OBS_CONST uint kBindingPrimaryLightScales = 8;   // vec4[lights]: E_s at render time (normaliser)
 OBS_CONST uint kBindingPrimaryEmissionBasis = 9; // vec4 pairs [light][pixel]: M_s, the emission
                                                  // the camera sees of light s at unit emission
-OBS_CONST uint kPrimaryBindingCount = 10;
+OBS_CONST uint kBindingPrimaryHitBounds = 10;    // vec4[2 * pixel]: the box of the pixel's primary
+                                                 // hits over samples (min xyz, w = 1 if a hit was
+                                                 // glossy; max xyz, w = 1 if any sample hit)
+OBS_CONST uint kBindingPrimaryDirty = 11;        // uint[pixel]: 1 = retrace (kPrimaryFlagDirtyOnly)
+OBS_CONST uint kPrimaryBindingCount = 12;
 
 // Header of the specular queue: an indirect dispatch (groups x, y, z) and the entry count.
 OBS_CONST uint kQueueGroupsX = 0;
@@ -317,6 +326,40 @@ OBS_CONST uint kBindingLightMixResolved = 0;  // uint [(slots + 1) * pixels] (re
 OBS_CONST uint kBindingLightMixEmissions = 1; // vec4[lights]: E_s
 OBS_CONST uint kBindingLightMixOutput = 2;    // uint[pixel]: RGBA8 (as tonemap.comp)
 OBS_CONST uint kLightMixBindingCount = 3;
+
+// ---- dirty.comp: the pixels a geometry edit can change [IVR §3.3; SPEC §2], conservatively:
+// those whose screen footprint the changed boxes cover (primary rays), those whose hit points lie
+// within dMax of a changed box (obscurance is local), those whose segments to a light pass near a
+// changed box (shadow rays: the paper's shafts, here the segment from the hit box's bounding
+// sphere to the light's bounding sphere against the changed box's sphere), and every glossy pixel
+// (its specular paths may go anywhere). Up to kMaxChangedBoxes boxes (old and new places).
+OBS_CONST uint kMaxChangedBoxes = 4;
+struct DirtyPush {
+  uvec4 frame;        // 0:   width, rows (of the band), first row, light count
+  vec4 spheres[4];    // 16:  changed boxes' bounding spheres: centre xyz, radius w (w < 0: unused)
+  uvec4 rects[4];     // 80:  their screen rectangles in frame pixels: x0, y0, x1, y1 (inclusive)
+  vec4 params;        // 144: dMax, all dirty (1) or not, unused, unused
+};                    // 160 bytes (> 128: passed in a uniform-like storage buffer, not push constants)
+// Light bounds for dirty.comp, two vec4 per light: (centre xyz, radius) and (direction xyz, 1 for
+// a directional light whose segments run to infinity along -direction, else 0).
+OBS_CONST uint kBindingDirtyParams = 0;    // DirtyPush (one element)
+OBS_CONST uint kBindingDirtyHitBounds = 1; // vec4[2 * pixel] (primary.comp)
+OBS_CONST uint kBindingDirtyLights = 2;    // vec4[2 * lights]
+OBS_CONST uint kBindingDirtyMask = 3;      // uint[pixel] out
+OBS_CONST uint kBindingDirtyStatus = 4;    // uint[kStatusWords]: kStatusDirtyPixels counted
+OBS_CONST uint kDirtyBindingCount = 5;
+
+// ---- clear.comp: zeroes the shading passes' sums (D_s, S_s, A, A^spec) of the dirty pixels
+// before they are retraced (primary.comp restarts the AOV and M_s sums itself at sample 0).
+struct ClearPush {
+  uvec4 frame;     // 0: width, rows (of the band), light count, 1 when specular buffers are used
+};                 // 16 bytes
+OBS_CONST uint kBindingClearDirty = 0;
+OBS_CONST uint kBindingClearBasis = 1;
+OBS_CONST uint kBindingClearAmbient = 2;
+OBS_CONST uint kBindingClearSpecularBasis = 3;
+OBS_CONST uint kBindingClearSpecularAmbient = 4;
+OBS_CONST uint kClearBindingCount = 5;
 
 // ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,
 // then its Kahan compensation), so accumulation buffers hold kAccumulatorVec4s vec4 per entry.

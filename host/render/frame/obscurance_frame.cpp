@@ -32,6 +32,8 @@ std::vector<FrameBufferKind> ObscuranceFrame::bufferKinds(const FrameContents& c
       {"display", 4, false},
       {"resolved", 4, true},
       {"resolved_ambient", 4, false},
+      {"hit_bounds", 2 * kVec4, false},
+      {"dirty", 4, false},
   };
   if (contents.primaryAovs) kinds.push_back({"aovs", gpu::kAovSlots * kAccumulator, false});
   if (contents.specular) {
@@ -88,6 +90,8 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.specularBasis = gpu::Buffer(context, specular ? px * slots * kAccumulator : kVec4, kStorage,
                                   "frame.specular_basis" + tag);
     b.resolved = gpu::Buffer(context, px * (slots + 1) * 4, kStorage, "frame.resolved" + tag);
+    b.hitBounds = gpu::Buffer(context, px * 2 * kVec4, kStorage, "frame.hit_bounds" + tag);
+    b.dirty = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.dirty" + tag);
     bands_.push_back(std::move(b));
   }
   status_ = gpu::Buffer(context, gpu::kStatusWords * 4, kStorage, "frame.status");
@@ -98,7 +102,7 @@ std::uint64_t ObscuranceFrame::bytes() const {
   std::uint64_t total = status_.size();
   for (const auto& b : bands_)
     for (const gpu::Buffer* buffer : {&b.gbuffer, &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
-                                      &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved})
+                                      &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved, &b.hitBounds, &b.dirty})
       total += buffer->size();
   return total;
 }

@@ -46,6 +46,8 @@ public:
     gpu::Buffer gbuffer, aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, composed,
         display;
     gpu::Buffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits
+    gpu::Buffer hitBounds; // per pixel, the box of its primary hits over samples (geometry edits)
+    gpu::Buffer dirty;     // per pixel, 1 = retrace after a geometry edit (dirty.comp)
   };
 
   // `maxBufferBytes` 0 = the device's per-buffer limit (a smaller one tests banding).

@@ -38,6 +38,8 @@ void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const Obsc
   kernel_.bind(gpu::kBindingPrimaryAovs, b.aovs, band);
   kernel_.bind(gpu::kBindingPrimaryLightScales, lightScales, band);
   kernel_.bind(gpu::kBindingPrimaryEmissionBasis, b.emissionBasis, band);
+  kernel_.bind(gpu::kBindingPrimaryHitBounds, b.hitBounds, band);
+  kernel_.bind(gpu::kBindingPrimaryDirty, b.dirty, band);
 }
 
 void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,

@@ -21,6 +21,7 @@ void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInp
   kernel.bind(gpu::kBindingSpecularAmbient, b.specularAmbient, band);
   kernel.bind(gpu::kBindingSpecularQueue, b.queue, band);
   kernel.bind(gpu::kBindingLightScales, in.lights.scales, band);
+  kernel.bind(gpu::kBindingDirty, b.dirty, band);
 }
 
 } // namespace obscura::render

@@ -1,0 +1,119 @@
+#include "render/passes/dirty_pass.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "clear.spv.h"
+#include "dirty.spv.h"
+
+namespace obscura::render {
+
+glm::uvec4 screenRect(const gpu::GpuCamera& camera, std::uint32_t width, std::uint32_t height,
+                      const scene::Bounds& box) {
+  const glm::uvec4 whole(0u, 0u, width - 1, height - 1);
+  const glm::vec3 origin(camera.origin), forward(camera.forward), right(camera.right), up(camera.up);
+  const float tanHalf = camera.origin.w, aspect = camera.forward.w;
+  float u0 = 1e30f, v0 = 1e30f, u1 = -1e30f, v1 = -1e30f;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::vec3 p((corner & 1) ? box.hi.x : box.lo.x, (corner & 2) ? box.hi.y : box.lo.y,
+                      (corner & 4) ? box.hi.z : box.lo.z);
+    const glm::vec3 d = p - origin;
+    const float z = glm::dot(d, forward);
+    if (!(z > 1e-6f)) return whole; // behind or at the eye: it may cover anything
+    // The inverse of cameraRayDirection (shaders/lib/camera.glsl).
+    const float u = (glm::dot(d, right) / z / (tanHalf * aspect) + 1.0f) * 0.5f * static_cast<float>(width);
+    const float v = (1.0f - glm::dot(d, up) / z / tanHalf) * 0.5f * static_cast<float>(height);
+    u0 = std::min(u0, u);
+    u1 = std::max(u1, u);
+    v0 = std::min(v0, v);
+    v1 = std::max(v1, v);
+  }
+  // A pixel x holds the samples in [x, x + 1): one more pixel each way absorbs rounding.
+  const auto clampTo = [](float x, std::uint32_t size) {
+    return static_cast<std::uint32_t>(std::clamp(x, 0.0f, static_cast<float>(size - 1)));
+  };
+  if (u1 < -1.0f || v1 < -1.0f || u0 > static_cast<float>(width) + 1.0f || v0 > static_cast<float>(height) + 1.0f)
+    return glm::uvec4(1u, 1u, 0u, 0u); // off screen: an empty rectangle
+  return glm::uvec4(clampTo(std::floor(u0) - 1.0f, width), clampTo(std::floor(v0) - 1.0f, height),
+                    clampTo(std::floor(u1) + 1.0f, width), clampTo(std::floor(v1) + 1.0f, height));
+}
+
+std::vector<glm::vec4> lightBounds(const LightSet& lights) {
+  std::vector<glm::vec4> out;
+  for (const auto& l : lights.lights) {
+    if (l.info.x == gpu::kLightArea) {
+      scene::Bounds b;
+      for (std::uint32_t e = l.info.y; e < l.info.y + l.info.z; ++e)
+        for (const glm::vec4* v : {&lights.emitters[e].v0, &lights.emitters[e].v1, &lights.emitters[e].v2})
+          b.grow(glm::vec3(*v));
+      const glm::vec3 centre = b.empty() ? glm::vec3(0.0f) : 0.5f * (b.lo + b.hi);
+      out.emplace_back(centre, b.empty() ? 0.0f : 0.5f * glm::length(b.hi - b.lo));
+      out.emplace_back(0.0f);
+    } else if (l.info.x == gpu::kLightDirectional) {
+      out.emplace_back(0.0f);
+      out.emplace_back(glm::vec3(l.direction), 1.0f);
+    } else {
+      out.emplace_back(glm::vec3(l.position), 0.0f);
+      out.emplace_back(0.0f);
+    }
+  }
+  if (out.empty()) out.emplace_back(0.0f);
+  return out;
+}
+
+DirtyPass::DirtyPass(const gpu::Context& context, std::uint32_t bands)
+    : context_(&context),
+      mark_(context, {.name = "dirty", .spirv = kSpirv_dirty,
+                      .bindings = std::vector<gpu::BindingKind>(gpu::kDirtyBindingCount, gpu::BindingKind::StorageBuffer),
+                      .setCount = bands}),
+      clear_(context, {.name = "clear", .spirv = kSpirv_clear,
+                       .bindings = std::vector<gpu::BindingKind>(gpu::kClearBindingCount, gpu::BindingKind::StorageBuffer),
+                       .pushConstantBytes = sizeof(gpu::ClearPush), .setCount = bands}) {
+  for (std::uint32_t b = 0; b < bands; ++b)
+    params_.emplace_back(context, sizeof(gpu::DirtyPush), vk::BufferUsageFlagBits::eStorageBuffer, "dirty.params");
+}
+
+void DirtyPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& bounds) {
+  const auto& b = frame.band(band);
+  mark_.bind(gpu::kBindingDirtyParams, params_[band], band);
+  mark_.bind(gpu::kBindingDirtyHitBounds, b.hitBounds, band);
+  mark_.bind(gpu::kBindingDirtyLights, bounds, band);
+  mark_.bind(gpu::kBindingDirtyMask, b.dirty, band);
+  mark_.bind(gpu::kBindingDirtyStatus, frame.status(), band);
+  clear_.bind(gpu::kBindingClearDirty, b.dirty, band);
+  clear_.bind(gpu::kBindingClearBasis, b.basis, band);
+  clear_.bind(gpu::kBindingClearAmbient, b.ambient, band);
+  clear_.bind(gpu::kBindingClearSpecularBasis, b.specularBasis, band);
+  clear_.bind(gpu::kBindingClearSpecularAmbient, b.specularAmbient, band);
+}
+
+void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu::GpuCamera& camera,
+                        const std::vector<scene::Bounds>& changed, float dMax, std::uint32_t lights, bool all) {
+  gpu::DirtyPush push{};
+  push.frame = glm::uvec4(layout.width, layout.bands[band].rows, layout.bands[band].firstRow, lights);
+  const bool tooMany = changed.size() > gpu::kMaxChangedBoxes;
+  for (std::uint32_t i = 0; i < gpu::kMaxChangedBoxes; ++i) {
+    if (i < changed.size() && !changed[i].empty()) {
+      const scene::Bounds& box = changed[i];
+      push.spheres[i] = glm::vec4(0.5f * (box.lo + box.hi), 0.5f * glm::length(box.hi - box.lo));
+      push.rects[i] = screenRect(camera, layout.width, layout.height, box);
+    } else {
+      push.spheres[i] = glm::vec4(0.0f, 0.0f, 0.0f, -1.0f);
+      push.rects[i] = glm::uvec4(1u, 1u, 0u, 0u);
+    }
+  }
+  push.params = glm::vec4(dMax, all || tooMany ? 1.0f : 0.0f, 0.0f, 0.0f);
+  params_[band].upload(*context_, &push, sizeof(push));
+}
+
+void DirtyPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout) const {
+  mark_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, nullptr, band);
+}
+
+void DirtyPass::recordClear(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
+                            std::uint32_t lights, bool specular) const {
+  gpu::ClearPush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, lights, specular ? 1u : 0u)};
+  clear_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+}
+
+} // namespace obscura::render

@@ -1,0 +1,41 @@
+// dirty_pass.h — the pixels a geometry edit can change (dirty.comp), and the clearing of their
+// shading sums before they are retraced (clear.comp).
+#pragma once
+#include <vector>
+
+#include "gpu/kernel.h"
+#include "render/frame/obscurance_frame.h"
+#include "render/scene/light_set.h"
+#include "scene/scene.h"
+#include "shared/host_device.h"
+
+namespace obscura::render {
+
+// The pixel rectangle (x0, y0, x1, y1 inclusive) the box covers on screen: its 8 corners
+// projected, rounded out to whole pixels. The whole frame when a corner lies behind the camera.
+glm::uvec4 screenRect(const gpu::GpuCamera& camera, std::uint32_t width, std::uint32_t height, const scene::Bounds& box);
+
+// Two vec4 per light for dirty.comp: (bounding sphere centre, radius), (direction, 1 if
+// directional). An area light's sphere holds all its emitters.
+std::vector<glm::vec4> lightBounds(const LightSet& lights);
+
+class DirtyPass {
+public:
+  DirtyPass(const gpu::Context& context, std::uint32_t bands);
+  void bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& lightBounds);
+  // Writes band `band`'s parameters (`changed`: up to kMaxChangedBoxes world boxes) for the next
+  // record. `all` marks every pixel.
+  void prepare(std::uint32_t band, const FrameLayout& layout, const gpu::GpuCamera& camera,
+               const std::vector<scene::Bounds>& changed, float dMax, std::uint32_t lights, bool all);
+  void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout) const;
+  void recordClear(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
+                   std::uint32_t lights, bool specular) const;
+
+private:
+  const gpu::Context* context_;
+  gpu::Kernel mark_;
+  gpu::Kernel clear_;
+  std::vector<gpu::Buffer> params_; // one DirtyPush per band
+};
+
+} // namespace obscura::render
