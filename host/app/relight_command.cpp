@@ -4,6 +4,7 @@
 //   obscura relight SCENE --edits edits.json -o DIR [render options] [--png]
 //       renders SCENE, then applies the edits in order, writing DIR/frame-NNN.exr (000 = before
 //       any edit) and DIR/edits.jsonl (per edit: kind, pixels retraced, rays and ms per pass).
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -133,7 +134,10 @@ void relightScene(RelightOptions& o) {
   const scene::Camera camera = chooseCamera(loaded.scene, o.render.camera);
   chooseSize(o.render, camera);
   gpu::Context context(o.render.device.contextOptions());
-  render::ObscuranceRenderer renderer(context, loaded.scene, loaded.bvh, obscuranceSettings(o.render, camera));
+  render::ObscuranceSettings settings = obscuranceSettings(o.render, camera);
+  settings.spareLightSlots = static_cast<std::uint32_t>(std::count_if(
+      edits.begin(), edits.end(), [](const relight::Edit& e) { return e.kind == relight::Edit::Kind::AddLight; }));
+  render::ObscuranceRenderer renderer(context, loaded.scene, loaded.bvh, settings);
   // After renderer.composeDisplay(): the PNG from the fast path's display bytes, then the full
   // compose for the EXR's AOVs and light layers.
   auto writeFrame = [&](std::size_t n) {

@@ -64,6 +64,9 @@ struct ObscuranceSettings {
   // normal, depth, ...), and all composed AOVs or `combined` alone.
   bool primaryAovs = true;
   bool composedAovs = true;
+  // Lights addLight may add (their basis buffers are reserved up front; 4 bytes x 16 per pixel
+  // each). `relight --edits` reserves one per add_light edit.
+  std::uint32_t spareLightSlots = 0;
 };
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.

@@ -486,7 +486,7 @@ TEST(GltfLoader, MaterialsLightsAndCameras) {
   EXPECT_EQ(s.triangleMaterial, (std::vector<std::uint32_t>{0, 0, 1}));
 
   ASSERT_EQ(s.lightGroups.size(), 1u);
-  EXPECT_EQ(s.lightGroups[0].name, "node[0]");
+  EXPECT_EQ(s.lightGroups[0].name, "light0"); // an unnamed emissive node
   EXPECT_EQ(s.lightGroups[0].triangles, (std::vector<std::uint32_t>{0, 1}));
   EXPECT_EQ(s.triangleLightGroup, (std::vector<std::uint32_t>{0, 0, ~0u}));
 

@@ -56,6 +56,7 @@ render::ObscuranceSettings roomSettings(std::uint32_t seed) {
   s.shadowRays = 4;
   s.obscuranceRays = 4;
   s.camera = lookCamera({0.2f, 1.0f, 3.2f}, glm::normalize(glm::vec3(-0.1f, -0.05f, -1.0f)), {0, 1, 0}, 0.9f);
+  s.spareLightSlots = 1; // the added-light tests
   return s;
 }
 

@@ -53,7 +53,7 @@ std::uint64_t ObscuranceFrame::bytesNeeded(std::uint32_t width, std::uint32_t he
 
 ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t width, std::uint32_t height,
                                  std::uint32_t lights, const FrameContents& contents, std::uint64_t maxBufferBytes)
-    : context_(&context), lights_(lights), maxLights_(lights + kSpareLightSlots), contents_(contents) {
+    : context_(&context), lights_(lights), maxLights_(lights + contents.spareLightSlots), contents_(contents) {
   const bool specular = contents.specular;
   const std::uint64_t limit = maxBufferBytes > 0 ? maxBufferBytes : context.info().maxStorageBufferRange;
   std::uint64_t largest = 0;
@@ -120,8 +120,8 @@ void ObscuranceFrame::resetStatus() {
 
 void ObscuranceFrame::addLightSlot(gpu::CommandStream& stream) {
   if (lights_ >= maxLights_)
-    throw InputError(fmt::format("{} lights: this frame has room for {} (render again to add more)", lights_ + 1,
-                                 maxLights_));
+    throw InputError(fmt::format("{} lights: this frame was made with room for {} (spare light slots: {})",
+                                 lights_ + 1, maxLights_, contents_.spareLightSlots));
   stream.submit([&](const vk::raii::CommandBuffer& cmd) {
     for (std::size_t i = 0; i < bands_.size(); ++i) {
       const std::uint64_t slot = layout_.bandPixels(i) * kAccumulator;

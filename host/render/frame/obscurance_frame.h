@@ -33,11 +33,11 @@ struct FrameContents {
   bool specular = false;             // glossy scene: specular basis, ambient and queue
   bool primaryAovs = true;           // albedo, normal, depth, ... (primary.comp's accumulators)
   std::uint32_t composedSlots = 6;   // gpu::kComposeSlots, or 1 when only `combined` is wanted
+  // Lights that may be added: the per-light buffers have this many spare slots from the start,
+  // so adding a light clears one slot instead of re-allocating and copying every basis buffer.
+  std::uint32_t spareLightSlots = 0;
 };
 
-// Lights that may be added to a frame: its per-light buffers have this many spare slots from the
-// start, so that adding a light clears one slot instead of re-allocating and copying them all.
-inline constexpr std::uint32_t kSpareLightSlots = 4;
 
 class ObscuranceFrame {
 public:
