@@ -13,6 +13,13 @@ vk::DescriptorType descriptorType(BindingKind kind) {
 }
 } // namespace
 
+KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
+                             std::uint32_t pushConstantBytes, std::uint32_t setCount) {
+  return {.name = std::move(name), .spirv = spirv,
+          .bindings = std::vector<BindingKind>(bindingCount, BindingKind::StorageBuffer),
+          .pushConstantBytes = pushConstantBytes, .setCount = setCount};
+}
+
 Kernel::Kernel(const Context& context, const KernelDesc& desc)
     : context_(&context), name_(desc.name), bindings_(desc.bindings), pushBytes_(desc.pushConstantBytes) {
   const auto& device = context.device();

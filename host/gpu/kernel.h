@@ -31,6 +31,10 @@ struct KernelDesc {
   std::uint32_t setCount = 1;
 };
 
+// A kernel whose bindings are all storage buffers (the frame passes: compose, tonemap, ...).
+KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
+                             std::uint32_t pushConstantBytes, std::uint32_t setCount = 1);
+
 class Kernel {
 public:
   Kernel(const Context& context, const KernelDesc& desc);

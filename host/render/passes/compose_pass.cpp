@@ -5,10 +5,7 @@
 namespace obscura::render {
 
 ComposePass::ComposePass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, {.name = "compose", .spirv = kSpirv_compose,
-                        .bindings = std::vector<gpu::BindingKind>(gpu::kComposeBindingCount,
-                                                                  gpu::BindingKind::StorageBuffer),
-                        .pushConstantBytes = sizeof(gpu::ComposePush), .setCount = bands}) {}
+    : kernel_(context, gpu::storageKernelDesc("compose", kSpirv_compose, gpu::kComposeBindingCount, sizeof(gpu::ComposePush), bands)) {}
 
 void ComposePass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& emissions) {
   const auto& b = frame.band(band);

@@ -63,12 +63,8 @@ std::vector<glm::vec4> lightBounds(const LightSet& lights) {
 
 DirtyPass::DirtyPass(const gpu::Context& context, std::uint32_t bands)
     : context_(&context),
-      mark_(context, {.name = "dirty", .spirv = kSpirv_dirty,
-                      .bindings = std::vector<gpu::BindingKind>(gpu::kDirtyBindingCount, gpu::BindingKind::StorageBuffer),
-                      .setCount = bands}),
-      clear_(context, {.name = "clear", .spirv = kSpirv_clear,
-                       .bindings = std::vector<gpu::BindingKind>(gpu::kClearBindingCount, gpu::BindingKind::StorageBuffer),
-                       .pushConstantBytes = sizeof(gpu::ClearPush), .setCount = bands}) {
+      mark_(context, gpu::storageKernelDesc("dirty", kSpirv_dirty, gpu::kDirtyBindingCount, 0, bands)),
+      clear_(context, gpu::storageKernelDesc("clear", kSpirv_clear, gpu::kClearBindingCount, sizeof(gpu::ClearPush), bands)) {
   for (std::uint32_t b = 0; b < bands; ++b)
     params_.emplace_back(context, sizeof(gpu::DirtyPush), vk::BufferUsageFlagBits::eStorageBuffer, "dirty.params");
 }

@@ -7,10 +7,7 @@
 namespace obscura::render {
 
 LightMixPass::LightMixPass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, {.name = "lightmix", .spirv = kSpirv_lightmix,
-                        .bindings = std::vector<gpu::BindingKind>(gpu::kLightMixBindingCount,
-                                                                  gpu::BindingKind::StorageBuffer),
-                        .pushConstantBytes = sizeof(gpu::LightMixPush), .setCount = bands}) {}
+    : kernel_(context, gpu::storageKernelDesc("lightmix", kSpirv_lightmix, gpu::kLightMixBindingCount, sizeof(gpu::LightMixPush), bands)) {}
 
 void LightMixPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& emissions) {
   kernel_.bind(gpu::kBindingLightMixResolved, frame.band(band).resolved, band);

@@ -5,10 +5,7 @@
 namespace obscura::render {
 
 ResolvePass::ResolvePass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, {.name = "resolve", .spirv = kSpirv_resolve,
-                        .bindings = std::vector<gpu::BindingKind>(gpu::kResolveBindingCount,
-                                                                  gpu::BindingKind::StorageBuffer),
-                        .pushConstantBytes = sizeof(gpu::ResolvePush), .setCount = bands}) {}
+    : kernel_(context, gpu::storageKernelDesc("resolve", kSpirv_resolve, gpu::kResolveBindingCount, sizeof(gpu::ResolvePush), bands)) {}
 
 void ResolvePass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
   const auto& b = frame.band(band);

@@ -7,10 +7,7 @@
 namespace obscura::render {
 
 TonemapPass::TonemapPass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, {.name = "tonemap", .spirv = kSpirv_tonemap,
-                        .bindings = std::vector<gpu::BindingKind>(gpu::kTonemapBindingCount,
-                                                                  gpu::BindingKind::StorageBuffer),
-                        .pushConstantBytes = sizeof(gpu::TonemapPush), .setCount = bands}) {}
+    : kernel_(context, gpu::storageKernelDesc("tonemap", kSpirv_tonemap, gpu::kTonemapBindingCount, sizeof(gpu::TonemapPush), bands)) {}
 
 void TonemapPass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
   kernel_.bind(gpu::kBindingTonemapInput, frame.band(band).composed, band);
