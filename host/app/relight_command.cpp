@@ -6,6 +6,8 @@
 //       any edit) and DIR/edits.jsonl (per edit: kind, pixels retraced, rays and ms per pass).
 #include <algorithm>
 #include <chrono>
+#include <deque>
+#include <map>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -20,7 +22,10 @@
 #include "io/image_io.h"
 #include "relight/light_edits.h"
 #include "relight/relight_state.h"
+#include "render/scene/scene_buffers.h"
 #include "render/transport.h"
+#include "scene/gltf_loader.h"
+#include "scene/scene_edit.h"
 
 namespace obscura::app {
 namespace {
@@ -121,12 +126,13 @@ void relightScene(RelightOptions& o) {
   const render::LightSet sceneLights = render::buildLightSet(loaded.scene);
   std::vector<bool> area;
   for (const auto& l : sceneLights.lights) area.push_back(l.info.x == gpu::kLightArea);
-  const std::vector<relight::Edit> edits = relight::readEdits(o.edits, sceneLights.names, area);
+  std::vector<std::string> objectNames;
+  for (const auto& obj : loaded.scene.objects) objectNames.push_back(obj.name);
+  const std::vector<relight::Edit> edits = relight::readEdits(o.edits, sceneLights.names, area, objectNames);
+  // Inserted glTFs are loaded (and so checked) before anything is rendered.
+  std::map<std::size_t, scene::Scene> inserts;
   for (const auto& e : edits)
-    if (e.kind == relight::Edit::Kind::Move || e.kind == relight::Edit::Kind::Remove ||
-        e.kind == relight::Edit::Kind::Insert)
-      throw InputError(fmt::format("{}: entry {}: '{}' edits of objects are not available in this version",
-                                   o.edits, e.entry, e.kindName()));
+    if (e.kind == relight::Edit::Kind::Insert) inserts[e.entry] = scene::loadGltf(e.path);
   std::error_code ec;
   fs::create_directories(o.output, ec);
   if (ec || !fs::is_directory(o.output)) throw InputError(fmt::format("{}: cannot create the output folder", o.output));
@@ -137,7 +143,33 @@ void relightScene(RelightOptions& o) {
   render::ObscuranceSettings settings = obscuranceSettings(o.render, camera);
   settings.spareLightSlots = static_cast<std::uint32_t>(std::count_if(
       edits.begin(), edits.end(), [](const relight::Edit& e) { return e.kind == relight::Edit::Kind::AddLight; }));
+  // Each geometry edit makes the next scene; the renderer keeps a pointer to the current one.
+  std::deque<scene::Scene> scenes;
+  std::deque<bvh::Bvh> trees;
   render::ObscuranceRenderer renderer(context, loaded.scene, loaded.bvh, settings);
+  const scene::Scene* current = &loaded.scene;
+  auto geometryEdit = [&](const relight::Edit& e) {
+    scene::Scene next = *current;
+    const std::string where = fmt::format("{}: entry {}", o.edits, e.entry);
+    std::vector<scene::Bounds> changed;
+    if (e.kind == relight::Edit::Kind::Insert) {
+      const std::size_t i = scene::insertObject(next, inserts.at(e.entry), e.name, e.translate);
+      changed.push_back(scene::objectBounds(next, i));
+    } else {
+      const std::size_t i = scene::objectIndex(next, e.name, where);
+      changed.push_back(scene::objectBounds(next, i));
+      if (e.kind == relight::Edit::Kind::Move) {
+        scene::moveObject(next, i, e.translate, e.rotateDegrees);
+        changed.push_back(scene::objectBounds(next, i));
+      } else {
+        scene::removeObject(next, i);
+      }
+    }
+    scenes.push_back(std::move(next));
+    trees.push_back(bvh::build(render::triangleSoup(scenes.back())));
+    current = &scenes.back();
+    return renderer.updateGeometry(scenes.back(), trees.back(), changed);
+  };
   // After renderer.composeDisplay(): the PNG from the fast path's display bytes, then the full
   // compose for the EXR's AOVs and light layers.
   auto writeFrame = [&](std::size_t n) {
@@ -200,7 +232,9 @@ void relightScene(RelightOptions& o) {
         }
         break;
       }
-      default: break; // object edits were refused above
+      case relight::Edit::Kind::Move:
+      case relight::Edit::Kind::Remove:
+      case relight::Edit::Kind::Insert: retraced = geometryEdit(e); break;
     }
     renderer.setEmissions(emissionsNow());
     renderer.composeDisplay(o.exposure);

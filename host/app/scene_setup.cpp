@@ -7,6 +7,7 @@
 #include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
 #include "scene/light_groups.h"
+#include "scene/scene_edit.h"
 
 namespace obscura::app {
 
@@ -17,6 +18,7 @@ LoadedScene loadScene(const std::string& path, const std::string& lightGroups) {
   if (lightGroups == "material") scene::groupLightsByMaterial(loaded.scene);
   else if (lightGroups != "node") scene::groupLightsFromFile(loaded.scene, lightGroups);
   scene::makeLightNamesUnique(loaded.scene);
+  scene::makeObjectNamesUnique(loaded.scene);
   loaded.loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   loaded.bvh = bvh::build(render::triangleSoup(loaded.scene));
   return loaded;

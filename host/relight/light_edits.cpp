@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -92,8 +93,17 @@ std::string Edit::kindName() const {
   return "?";
 }
 
+namespace {
+
+void requireObject(const std::vector<std::string>& names, const std::string& name, const EntryContext& at) {
+  if (std::find(names.begin(), names.end(), name) == names.end())
+    at.fail(fmt::format("no object named '{}' at this point (objects: {})", name, fmt::join(names, ", ")));
+}
+
+} // namespace
+
 std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> lightNames,
-                            std::vector<bool> areaLights) {
+                            std::vector<bool> areaLights, std::vector<std::string> objectNames) {
   std::ifstream in(path);
   if (!in) throw InputError(fmt::format("{}: cannot read the edits file", path));
   json list;
@@ -144,15 +154,24 @@ std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> li
     } else if (j.contains("move")) {
       e.kind = Edit::Kind::Move;
       e.name = text(j, "move", at);
+      requireObject(objectNames, e.name, at);
       e.translate = j.contains("translate") ? vec3(j, "translate", at) : glm::vec3(0.0f);
       e.rotateDegrees = j.contains("rotate_deg") ? vec3(j, "rotate_deg", at) : glm::vec3(0.0f);
     } else if (j.contains("remove")) {
       e.kind = Edit::Kind::Remove;
       e.name = text(j, "remove", at);
+      requireObject(objectNames, e.name, at);
+      objectNames.erase(std::find(objectNames.begin(), objectNames.end(), e.name));
     } else if (j.contains("insert")) {
       e.kind = Edit::Kind::Insert;
       e.path = text(j, "insert", at);
       e.name = text(j, "name", at);
+      if (std::filesystem::path(e.path).is_relative())
+        e.path = (std::filesystem::path(path).parent_path() / e.path).string();
+      if (!std::filesystem::exists(e.path)) at.fail(fmt::format("'{}': no such file", e.path));
+      if (std::find(objectNames.begin(), objectNames.end(), e.name) != objectNames.end())
+        at.fail(fmt::format("an object named '{}' exists already", e.name));
+      objectNames.push_back(e.name);
       e.translate = j.contains("translate") ? vec3(j, "translate", at) : glm::vec3(0.0f);
     } else {
       at.fail("unknown edit (known: light, add_light, remove_light, move, remove, insert)");

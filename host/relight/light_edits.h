@@ -6,7 +6,7 @@
 //                  "intensity": I, "direction": [..], "inner_cone": a, "outer_cone": b}}
 //   {"remove_light": NAME}
 //   {"move": NODE, "translate": [..], "rotate_deg": [..]}, {"remove": NODE},
-//   {"insert": "other.gltf", "name": N, "translate": [..]}
+//   {"insert": "other.gltf", "name": N, "translate": [..]}   (the path relative to the edits file)
 // A light's emission is E_s = (scene's E_s) x scale x color, as if the glTF's emissive strength
 // and factor (or the punctual light's intensity and colour) were edited.
 #pragma once
@@ -38,8 +38,9 @@ struct Edit {
 // Reads and checks the whole file before anything is rendered: malformed entries and names
 // that do not exist at that point of the sequence (lights added or removed before it counted)
 // are InputErrors naming the file and the entry. `lightNames` are the scene's lights, `areaLights`
-// which of them are emissive meshes (removing one switches it off; its name stays).
+// which of them are emissive meshes (removing one switches it off; its name stays), `objectNames`
+// its objects. An insert's path is made absolute here and must exist.
 std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> lightNames,
-                            std::vector<bool> areaLights);
+                            std::vector<bool> areaLights, std::vector<std::string> objectNames);
 
 } // namespace obscura::relight

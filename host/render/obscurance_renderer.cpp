@@ -502,6 +502,7 @@ RenderStats ObscuranceRenderer::stats() const {
   pass("tonemap", 0);
   pass("resolve", 0);
   pass("lightmix", 0);
+  pass("dirty", 0);
   st.deviceBytes = deviceBytes();
   st.wallSeconds = wallSeconds_;
   return st;

@@ -825,11 +825,17 @@ void appendMesh(const Context& ctx, Scene& scene, const NodeInstance& instance) 
   std::uint32_t lightGroup = kNoLightGroup;
   const MeshInstance meshInstance{instance.node, instance.world, normalMatrixOf(linear, det), det < 0.0, &lightGroup};
   ++scene.stats.meshNodes;
+  const auto first = static_cast<std::uint32_t>(scene.triangles.size());
   const auto& primitives = ctx.model.meshes[mesh].primitives;
   for (std::size_t p = 0; p < primitives.size(); ++p) {
     PrimitiveBuilder(ctx, scene, meshInstance, mesh, p).build();
     ++scene.stats.primitives;
   }
+  // The node's primitives were appended together: that range is the object edits name.
+  scene.objects.push_back({.name = node.name.empty() ? "object" + std::to_string(scene.objects.size()) : node.name,
+                           .firstTriangle = first,
+                           .triangleCount = static_cast<std::uint32_t>(scene.triangles.size()) - first,
+                           .world = glm::mat4(instance.world)});
 }
 
 // ---- Cameras and punctual lights ----------------------------------------------------------

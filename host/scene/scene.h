@@ -54,6 +54,16 @@ struct LightGroup {
   glm::vec3 emission{0.0f};             // the material emission of the group's first triangle
 };
 
+// One glTF mesh-node instance, kept through flattening so that edits can name and move it: its
+// triangles are Scene::triangles[firstTriangle, firstTriangle + triangleCount), with vertices of
+// their own (no vertex is shared with another object).
+struct SceneObject {
+  std::string name;                  // the node's name, object<N> without one; unique (#2, #3, ...)
+  std::uint32_t firstTriangle = 0;
+  std::uint32_t triangleCount = 0;
+  glm::mat4 world{1.0f};             // the node's world transform at load (or after edits)
+};
+
 struct Camera {
   std::string name;
   glm::vec3 position{0.0f};
@@ -92,6 +102,7 @@ struct Scene {
   std::vector<Texture> textures;
   std::vector<PunctualLight> punctualLights;
   std::vector<LightGroup> lightGroups;
+  std::vector<SceneObject> objects;  // in glTF node order; together they hold every triangle
   std::vector<Camera> cameras;       // in glTF node order
   Bounds bounds;
   LoadStats stats;

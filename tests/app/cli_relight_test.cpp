@@ -2,6 +2,7 @@
 // relit with no scene and no ray; a scene is edited in order with one frame per edit and its
 // figures; bad states and bad edits are clear errors naming the file (and the entry), exit 2,
 // with nothing written.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -175,6 +176,76 @@ TEST_F(CliRelight, BadEditsAreRefusedNamingTheEntryBeforeAnyFrame) {
 
 namespace obscura::test {
 namespace {
+
+// The contract of geometry edits: the frame after `{"move": ...}` is statistically the frame
+// `obscura render` makes of the glTF edited the same way (the node translated). Tolerance: the
+// block-mean RMS difference (4x4 blocks below the lamp) of two fresh renders (seeds 11 and 12) of
+// the edited glTF, times 3.
+TEST_F(CliRelight, MovedObjectFrameMatchesARenderOfTheEditedGltf) {
+  json gltf = json::parse(std::ifstream(repoPath("scenes/cornell-box/cornell-box.gltf")));
+  for (auto& node : gltf["nodes"])
+    if (node["name"] == "cube_2") node["translation"] = {0.35, 0.0, 0.3};
+  for (const auto& buffer : gltf["buffers"]) // beside the edited copy, as the glTF names it
+    fs::copy_file(repoPath("scenes/cornell-box/" + buffer["uri"].get<std::string>()),
+                  path(buffer["uri"].get<std::string>()));
+  writeText("edited.gltf", gltf.dump());
+  writeText("edits.json", json::array({{{"move", "cube_2"}, {"translate", {0.35, 0.0, 0.3}}}}).dump());
+  const std::string size = " --width 32 --height 32 --spp 32";
+  auto r = runObscura("relight " + cornellBox() + " --edits " + path("edits.json") + " -o " + path("out") + size);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  for (int seed : {11, 12}) {
+    r = runObscura("render " + path("edited.gltf") + " -o " + path("fresh" + std::to_string(seed) + ".exr") + size +
+                   " --seed " + std::to_string(seed));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+  }
+  auto blocks = [&](const std::string& file) {
+    const auto c = combined(io::readImage(path(file)));
+    std::vector<double> means;
+    for (int by = 8; by < 32; by += 4) // below the lamp, whose edge pixels are the noisiest
+      for (int bx = 0; bx < 32; bx += 4) {
+        double sum = 0.0;
+        for (int y = by; y < by + 4; ++y)
+          for (int x = bx; x < bx + 4; ++x)
+            for (int k = 0; k < 3; ++k) sum += c[(y * 32 + x) * 3 + k];
+        means.push_back(sum / 48.0);
+      }
+    return means;
+  };
+  auto rms = [](const std::vector<double>& a, const std::vector<double>& b) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) sum += (a[i] - b[i]) * (a[i] - b[i]);
+    return std::sqrt(sum / static_cast<double>(a.size()));
+  };
+  const auto a = blocks("fresh11.exr"), b = blocks("fresh12.exr"), moved = blocks("out/frame-001.exr"),
+             before = blocks("out/frame-000.exr");
+  const double spread = rms(a, b);
+  EXPECT_LT(rms(moved, a), 3.0 * spread) << "seed-to-seed " << spread;
+  EXPECT_GT(rms(before, a), 3.0 * spread) << "the move must show";
+  std::ifstream log(path("out/edits.jsonl"));
+  std::string line;
+  std::getline(log, line);
+  const json figures = json::parse(line);
+  EXPECT_GT(figures["pixels_retraced"].get<int>(), 0);
+  EXPECT_LT(figures["pixels_retraced"].get<int>(), 32 * 32) << "only the pixels the move can change";
+}
+
+TEST_F(CliRelight, ObjectEditsNameObjectsThatExist) {
+  const std::vector<std::pair<json, std::string>> cases = {
+      {json::array({{{"move", "nosuch"}, {"translate", {0, 1, 0}}}}), "no object named 'nosuch'"},
+      {json::array({{{"remove", "cube_1"}}, {{"remove", "cube_1"}}}), "entry 1"},
+      {json::array({{{"insert", "missing.gltf"}, {"name", "x"}}}), "missing.gltf"},
+      {json::array({{{"insert", repoPath("scenes/cornell-box/cornell-box.gltf")}, {"name", "cube_1"}}}), "exists"},
+  };
+  for (const auto& [edits, expected] : cases) {
+    SCOPED_TRACE(edits.dump());
+    writeText("edits.json", edits.dump());
+    const auto r = runObscura("relight " + cornellBox() + " --edits " + path("edits.json") + " -o " + path("out") +
+                              " --width 16 --spp 1");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_CONTAINS(r.output, expected);
+    EXPECT_FALSE(fs::exists(path("out")));
+  }
+}
 
 TEST_F(CliRelight, InfoListsTheLightsEditsCanName) {
   const auto r = runObscura("info " + sharedScene("modern-hall/modern-hall.gltf"));
