@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Relighting figures [issue: relighting]: per scene and size, the GPU ms and wall ms of a light
-# edit (the fast light-mix path), of adding a point light (its shadow rays only) and of removing
-# it, from `obscura relight SCENE --edits` (edits.jsonl), and the wall time of `obscura relight DIR`
-# on a saved state. Usage: tools/bench_relight.sh [build/obscura] [spp] > table.md
+# edit (the fast light-mix path), of adding a point light (its shadow rays only), of removing it,
+# and of moving an object (dirty pixels only; the fraction retraced), from
+# `obscura relight SCENE --edits` (edits.jsonl), and the wall time of `obscura relight DIR` on a
+# saved state. Usage: tools/bench_relight.sh [build/obscura] [spp] > table.md
 set -euo pipefail
 obscura=${1:-build/obscura}
 spp=${2:-1}
@@ -11,13 +12,14 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-bench() { # name scene light width height position
-  local name=$1 scene=$2 light=$3 width=$4 height=$5 position=$6
+bench() { # name scene light width height position object
+  local name=$1 scene=$2 light=$3 width=$4 height=$5 position=$6 object=$7
   cat > "$work/edits.json" <<JSON
 [{"light": "$light", "scale": 0.3},
  {"light": "$light", "color": [1.0, 0.6, 0.3]},
  {"add_light": {"type": "point", "name": "bench_bulb", "position": $position, "color": [1, 1, 1], "intensity": 5}},
- {"remove_light": "bench_bulb"}]
+ {"remove_light": "bench_bulb"},
+ {"move": "$object", "translate": [0.1, 0.0, 0.1]}]
 JSON
   "$obscura" relight "$scene" --edits "$work/edits.json" -o "$work/out" --width "$width" --height "$height" \
     --spp "$spp" >/dev/null 2>&1
@@ -33,16 +35,18 @@ lines = [json.loads(l) for l in open(sys.argv[1])]
 name, size, spp, state_ms = sys.argv[2:6]
 def gpu(l): return sum(l["gpu_ms"].values())
 def fmt(l): return "%.1f GPU / %.1f wall" % (gpu(l), l["total_ms"])
-add = lines[2]
-print("| %s | %s | %s | %s | %s | %s (%d shadow rays) | %s | %s |" % (
-    name, size, spp, fmt(lines[0]), fmt(lines[1]), fmt(add), add["rays"].get("shadow", 0), fmt(lines[3]), state_ms))
+add, move = lines[2], lines[4]
+w, h = map(int, size.split("x"))
+print("| %s | %s | %s | %s | %s | %s (%d shadow rays) | %s | %s (%.0f %% retraced) | %s |" % (
+    name, size, spp, fmt(lines[0]), fmt(lines[1]), fmt(add), add["rays"].get("shadow", 0), fmt(lines[3]), fmt(move),
+    100.0 * move["pixels_retraced"] / (w * h), state_ms))
 PY
 }
 
-echo "| scene | size | spp | light scale (ms) | light colour (ms) | add point light (ms) | remove it (ms) | relight DIR wall (ms) |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| scene | size | spp | light scale (ms) | light colour (ms) | add point light (ms) | remove it (ms) | move an object (ms) | relight DIR wall (ms) |"
+echo "|---|---|---|---|---|---|---|---|---|"
 for size in "400 300" "800 600"; do
   set -- $size
-  bench cornell-box "$repo/scenes/cornell-box/cornell-box.gltf" light_rectangle_1 "$1" "$2" "[0.0, 1.0, 0.3]"
-  bench modern-hall "$shared/modern-hall/modern-hall.gltf" light_rectangle_6 "$1" "$2" "[0.0, 3.0, 1.0]"
+  bench cornell-box "$repo/scenes/cornell-box/cornell-box.gltf" light_rectangle_1 "$1" "$2" "[0.0, 1.0, 0.3]" cube_2
+  bench modern-hall "$shared/modern-hall/modern-hall.gltf" light_rectangle_6 "$1" "$2" "[0.0, 3.0, 1.0]" Mesh017
 done

@@ -1,5 +1,5 @@
 // obscura info [SCENE] — the Vulkan devices, their limits and the one a render would choose; with
-// a scene, what edits can name: its lights (groups and punctual, with type and power), cameras,
+// a scene, what edits can name: its lights (groups and punctual, with type and power), objects, cameras,
 // triangles, bounds and the default dmax.
 #include <fmt/core.h>
 
@@ -8,6 +8,7 @@
 #include "render/obscurance_renderer.h"
 #include "render/scene/light_set.h"
 #include "relight/relight_state.h"
+#include "scene/scene_edit.h"
 
 namespace obscura::app {
 namespace {
@@ -53,6 +54,12 @@ void printScene(const InfoOptions& o) {
     fmt::print("  {:<28} {:<11} E ({:.4g}, {:.4g}, {:.4g})  power {:.4g}{}\n", lights.names[i],
                relight::lightTypeName(lights.lights[i].info.x), e.x, e.y, e.z, lights.power[i],
                triangles ? fmt::format("  ({} triangles)", triangles) : std::string());
+  }
+  fmt::print("objects ({}; names for move, remove):\n", s.objects.size());
+  for (std::size_t i = 0; i < s.objects.size(); ++i) {
+    const scene::Bounds b = scene::objectBounds(s, i);
+    fmt::print("  {:<28} {:>7} triangles  ({:.3g}, {:.3g}, {:.3g}) .. ({:.3g}, {:.3g}, {:.3g})\n", s.objects[i].name,
+               s.objects[i].triangleCount, b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
   }
   fmt::print("cameras ({}; --camera N):\n", s.cameras.size());
   for (std::size_t i = 0; i < s.cameras.size(); ++i) {

@@ -41,7 +41,7 @@ void expectConsistent(const Scene& s) {
 
 TEST(LightGroups, RepeatedNamesGetANumber) {
   Scene s = threeLamps();
-  s.lightGroups[1].name = "a";
+  s.lightGroups[1].name.assign(1, 'a');
   s.punctualLights.push_back({.name = "a"});
   makeLightNamesUnique(s);
   EXPECT_EQ(s.lightGroups[0].name, "a");

@@ -254,6 +254,7 @@ TEST_F(CliRelight, InfoListsTheLightsEditsCanName) {
   EXPECT_CONTAINS(r.output, "light_rectangle_6");
   EXPECT_CONTAINS(r.output, "default dmax");
   EXPECT_CONTAINS(r.output, "cameras (1");
+  EXPECT_CONTAINS(r.output, "objects (");
   const auto bad = runObscura("info " + path("nope.gltf"));
   EXPECT_EQ(bad.exitCode, 2) << bad.output;
   EXPECT_CONTAINS(bad.output, "nope.gltf");
