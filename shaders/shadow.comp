@@ -34,6 +34,27 @@ void main() {
   ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);
   uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x5bd1e995u);
   StepBudget budget = newStepBudget();
+  if ((pc.band.z & kShadeFlagPerLight) != 0u) {
+    // The paper's visibility sampling [IVR §3.1]: kPerLightRays rays to this light; where they
+    // disagree (a penumbra) more, up to kPerLightMaxRays, all averaged.
+    const uint light = pc.band.w;
+    vec3 sum = vec3(0.0);
+    uint taken = 0u, seen = 0u;
+    for (uint k = 0u; k < kPerLightMaxRays; ++k) {
+      if (k == kPerLightRays && (seen == 0u || seen == kPerLightRays)) break;
+      vec4 u = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
+      vec3 contribution;
+      bool visible;
+      directLightFrom(sp, sampleChosenLight(sp.position, u, light, 1.0), budget, contribution, visible);
+      sum += contribution;
+      seen += visible ? 1u : 0u;
+      ++taken;
+    }
+    OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(sum / float(taken), 0.0))
+    atomicAdd(status[kStatusShadowRays], taken);
+    if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
+    return;
+  }
   uint count = pc.counts.y;
   float invCount = 1.0 / float(count);
   for (uint k = 0u; k < count; ++k) {

@@ -19,5 +19,6 @@ void addInfoCommand(CLI::App& app);
 void addBenchRaysCommand(CLI::App& app);
 void addConvergeCommand(CLI::App& app);
 void addRelightCommand(CLI::App& app);
+void addCompareCommand(CLI::App& app);
 
 } // namespace obscura::app

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   obscura::app::addBenchRaysCommand(app);
   obscura::app::addConvergeCommand(app);
   obscura::app::addRelightCommand(app);
+  obscura::app::addCompareCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -32,6 +32,7 @@ struct RenderOptions {
   float dMax = 0.0f;
   bool dMaxGiven = false;
   std::string lightGroups = "node";
+  std::string shadowSampling = "selection";
   DeviceOptions device;
 };
 

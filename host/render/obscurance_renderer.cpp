@@ -184,7 +184,11 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   for (std::uint32_t b = 0; b < bands; ++b) primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, primaryFlags);
   timestamps_.end(cmd, "primary");
   gpu::computeBarrier(cmd);
-  if (lights_.anySampled() && settings_.shadowRays > 0) {
+  if (settings_.shadowSampling == ShadowSampling::PerLight) {
+    timestamps_.begin(cmd, "shadow");
+    for (std::uint32_t light = 0; light < lightCount; ++light) recordShadowForLight(cmd, push, light);
+    timestamps_.end(cmd, "shadow");
+  } else if (lights_.anySampled() && settings_.shadowRays > 0) {
     timestamps_.begin(cmd, "shadow");
     for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push);
     timestamps_.end(cmd, "shadow");
@@ -199,6 +203,13 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
     for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, push);
     timestamps_.end(cmd, "specular");
   }
+}
+
+void ObscuranceRenderer::recordShadowForLight(const vk::raii::CommandBuffer& cmd, gpu::ShadePush push,
+                                              std::uint32_t light) const {
+  push.band.z |= gpu::kShadeFlagPerLight;
+  push.band.w = light;
+  for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) shadow_.record(cmd, b, frame_.layout(), push);
 }
 
 std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, const bvh::Bvh& bvh,
@@ -434,14 +445,6 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
   const double wallBefore = wallSeconds_;
   const FrameLayout& layout = frame_.layout();
   const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
-  // The shadow pass samples lights through the selection CDF; with every other light's
-  // probability 0 it picks the new one alone (an exact single-light estimator: pdf 1).
-  std::vector<gpu::GpuLight> only = lights_.lights;
-  for (std::size_t i = 0; i < only.size(); ++i) {
-    only[i].params.x = i + 1 < only.size() ? 0.0f : 1.0f;
-    only[i].params.y = i + 1 < only.size() ? 0.0f : 1.0f;
-  }
-  lightBuffers_.lights.upload(*context_, only);
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
   for (std::uint32_t first = 0; first < samples_; first += kSamplesPerSubmission) {
     const std::uint32_t last = std::min(samples_, first + kSamplesPerSubmission);
@@ -455,15 +458,13 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
         timestamps_.end(cmd, "primary");
         gpu::computeBarrier(cmd);
         timestamps_.begin(cmd, "shadow");
-        const gpu::ShadePush push = shadePush(s);
-        for (std::uint32_t b = 0; b < layout.bandCount(); ++b) shadow_.record(cmd, b, layout, push);
+        recordShadowForLight(cmd, shadePush(s), static_cast<std::uint32_t>(index));
         timestamps_.end(cmd, "shadow");
       }
     });
     timestamps_.collect();
     primaryRays_ += layout.pixels() * (last - first);
   }
-  lightBuffers_.lights.upload(*context_, lights_.lights);
   wallSeconds_ = wallBefore + secondsSince(start);
   return index;
 }

@@ -46,6 +46,14 @@ namespace obscura::render {
 
 enum class RhoKind : std::uint32_t { Sqrt = 0, Exp = 1, Ao = 2 };
 
+// How the shadow pass spends its rays [SPEC §1.3, IVR §3.1].
+enum class ShadowSampling {
+  Selection, // shadowRays per hit, each to a light chosen by power (the obscurance paper's)
+  PerLight,  // every light alone, 4 rays per hit, up to 64 in penumbrae (the relighting paper's):
+             // each D_s is independent of the other lights' powers, and a light of zero power
+             // still gets transport, so switching it on later is a clean relight
+};
+
 struct ObscuranceSettings {
   std::uint32_t width = 512, height = 512;
   std::uint32_t spp = 8;             // primary samples (iterations) per pixel
@@ -67,6 +75,7 @@ struct ObscuranceSettings {
   // Lights addLight may add (their basis buffers are reserved up front; 4 bytes x 16 per pixel
   // each). `relight --edits` reserves one per add_light edit.
   std::uint32_t spareLightSlots = 0;
+  ShadowSampling shadowSampling = ShadowSampling::Selection;
 };
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.
@@ -117,8 +126,9 @@ public:
   std::vector<std::uint32_t> display() const;
 
   // Light edits that trace rays. addLight traces only the new light's shadow rays, from the same
-  // primary hits as the frame's samples (the G-buffer is made again per sample), into a new basis
-  // buffer; removeLight drops one. Both update I_a. Indices shift like a vector's.
+  // primary hits as the frame's samples (the G-buffer is made again per sample), sampled alone
+  // (4 rays per hit, up to 64 in penumbrae), into a new basis buffer; removeLight drops one. Both
+  // update I_a. Indices shift like a vector's.
   std::size_t addLight(const scene::PunctualLight& light);
   void removeLight(std::size_t index);
   // A geometry edit [IVR §3.3]: `edited` (with its BVH) replaces the scene — the same lights,
@@ -186,6 +196,8 @@ private:
   float sceneScale_ = 1.0f; // the ray-origin offset's scale, kept across geometry edits
   void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, std::uint32_t primaryFlags,
                     std::uint32_t shadeFlags);
+  // The shadow pass for `light` alone (kShadeFlagPerLight), over every band.
+  void recordShadowForLight(const vk::raii::CommandBuffer& cmd, gpu::ShadePush push, std::uint32_t light) const;
   // The resolved transport is current for lights before resolveFrom_ (and the ambient unless
   // resolveAmbient_); a new sample makes all of it stale, an added light only itself.
   std::uint32_t resolveFrom_ = 0;

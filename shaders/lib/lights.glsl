@@ -49,13 +49,21 @@ float spotFalloff(GpuLight light, vec3 wi) {
   return t * t;
 }
 
+LightSample sampleChosenLight(vec3 p, vec4 u, uint chosen, float selection);
+
 // One light sample for shading point p: light chosen with probability proportional to power,
 // triangle proportional to area, point uniform on it [SPEC §1.3]. u = 4 uniform numbers.
 LightSample sampleLight(vec3 p, vec4 u, uint lightCount) {
+  uint chosen = selectLight(u.x, lightCount);
+  return sampleChosenLight(p, u, chosen, lights[chosen].params.y);
+}
+
+// A point on light `chosen`, picked with probability `selection` (1 when it is sampled alone):
+// triangle proportional to area, point uniform on it. u.x is not used.
+LightSample sampleChosenLight(vec3 p, vec4 u, uint chosen, float selection) {
   LightSample s;
-  s.light = selectLight(u.x, lightCount);
+  s.light = chosen;
   GpuLight light = lights[s.light];
-  float selection = light.params.y;
   s.weight = vec3(0.0);
   s.pdf = 0.0;
   s.infinite = false;

@@ -58,11 +58,23 @@ vec3 obscuranceReflectance(ShadingPoint sp) {
 // through a surface; light above it but below the interpolated shading normal (the terminator of
 // a smooth low-poly mesh) uses |cos| with the shading normal, as pbrt does, so no facet turns
 // black while its geometry faces the light.
+void directLightFrom(ShadingPoint sp, LightSample ls, inout StepBudget budget, out vec3 contribution,
+                     out bool visible);
+
 void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, inout StepBudget budget,
                        out vec3 contribution, out uint light) {
-  contribution = vec3(0.0);
   LightSample ls = sampleLight(sp.position, u, lightCount);
   light = ls.light;
+  bool visible;
+  directLightFrom(sp, ls, budget, contribution, visible);
+}
+
+// The shadow ray of light sample `ls`; `visible` says whether it reached the light (false also
+// when the light faces away or lies below the surface: nothing to trace).
+void directLightFrom(ShadingPoint sp, LightSample ls, inout StepBudget budget, out vec3 contribution,
+                     out bool visible) {
+  contribution = vec3(0.0);
+  visible = false;
   float cosG = dot(sp.ng, ls.wi);
   float cosS = dot(sp.ns, ls.wi);
   if (cosG <= 0.0 || all(equal(ls.weight, vec3(0.0)))) return;
@@ -80,6 +92,7 @@ void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, inout StepBudge
   }
   RayHit h = traceWithBudget(budget, origin, direction, 0.0, tmax, true);
   if (h.primitive != kInvalidIndex) return; // occluded (or truncated, reported by the caller)
+  visible = true;
   // The BSDF sees the light mirrored above the shading normal when it lies below it.
   vec3 wiShading = dot(sp.ns, ls.wi) < 0.0 ? reflect(ls.wi, sp.ns) : ls.wi;
   contribution = shadingBsdf(sp, wiShading) * ls.weight * cosS;

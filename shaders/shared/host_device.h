@@ -213,9 +213,15 @@ struct ShadePush {
   vec4 rAve;    // 48: R_ave rgb (the reflectance of a miss within dmax, SPEC §1.2), w = unused
   vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = scene size
                 //     (largest bounding-box extent: scales the ray-origin offset, ray.glsl)
-  uvec4 band;   // 80: first row, rows, flags (kShadeFlag*), unused (see "Frame bands")
+  uvec4 band;   // 80: first row, rows, flags (kShadeFlag*), the light of a per-light dispatch
 };              // 96 bytes
 OBS_CONST uint kShadeFlagDirtyOnly = 1u; // only pixels the dirty mask marks run
+// shadow.comp samples light band.w alone, the paper's way [IVR §3.1]: kPerLightRays rays per
+// sample, up to kPerLightMaxRays where they disagree (a penumbra); one dispatch per light, so each
+// D_s is independent of the other lights' powers and each dispatch stays within the loop limiter.
+OBS_CONST uint kShadeFlagPerLight = 2u;
+OBS_CONST uint kPerLightRays = 4u;
+OBS_CONST uint kPerLightMaxRays = 64u;
 
 // ---- Bindings of the shading passes (after the scene's 0..5).
 OBS_CONST uint kBindingGBuffer = 6;   // GBufferTexel[pixels] of the current sample

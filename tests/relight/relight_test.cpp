@@ -271,6 +271,40 @@ TEST_F(Relight, AddedLightTracesOnlyItsShadowRaysAndMatchesAFreshRender) {
   expectStatisticallyEqual(r.image(), edited);
 }
 
+// The relighting paper's shadow sampling: every light alone, 4 rays per hit, up to 64 in penumbrae.
+TEST_F(Relight, PerLightShadowSamplingMatchesSelectionSampling) {
+  auto settings = roomSettings(7);
+  settings.shadowSampling = render::ShadowSampling::PerLight;
+  scene::Scene s = room({});
+  bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+  const auto perLight = renderObscurances(context(), s, tree, settings);
+  EXPECT_EQ(perLight.stats.truncatedTraversals, 0u);
+  expectStatisticallyEqual(perLight.image, RoomLights{});
+}
+
+TEST_F(Relight, PerLightTransportIgnoresTheOtherLightsPowers) {
+  // Two rooms that differ only in lamp B's emission: lamp A's D_s is the same bits with per-light
+  // sampling, and not with selection by power (whose choice of light depends on every power).
+  auto transportOfLampA = [&](render::ShadowSampling sampling, glm::vec3 lampB) {
+    RoomLights lights;
+    lights.lampB = lampB;
+    scene::Scene s = room(lights);
+    bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+    auto settings = roomSettings(7);
+    settings.shadowSampling = sampling;
+    render::ObscuranceRenderer r(context(), s, tree, settings);
+    r.render();
+    return r.transport().direct[r.lightIndex("lampA")];
+  };
+  const auto same = [](const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
+  };
+  EXPECT_TRUE(same(transportOfLampA(render::ShadowSampling::PerLight, glm::vec3(2.0f)),
+                   transportOfLampA(render::ShadowSampling::PerLight, glm::vec3(20.0f))));
+  EXPECT_FALSE(same(transportOfLampA(render::ShadowSampling::Selection, glm::vec3(2.0f)),
+                    transportOfLampA(render::ShadowSampling::Selection, glm::vec3(20.0f))));
+}
+
 // The fast path a light edit takes (resolved RGB9E5 transport, one light-mix pass) shows what the
 // full compose + tonemap shows, to 2 display levels (a term keeps 2^-9 of its pixel's largest
 // channel; sRGB at 8 bits steps by about 2^-8 near white), before and after light edits.

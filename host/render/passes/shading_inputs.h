@@ -30,7 +30,7 @@ void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInp
 
 // Push constants of the shading passes for band `band` (the rest of `push` is the caller's).
 inline gpu::ShadePush forBand(gpu::ShadePush push, const FrameLayout& layout, std::uint32_t band) {
-  push.band = glm::uvec4(layout.bands[band].firstRow, layout.bands[band].rows, push.band.z, 0u);
+  push.band = glm::uvec4(layout.bands[band].firstRow, layout.bands[band].rows, push.band.z, push.band.w);
   return push;
 }
 
