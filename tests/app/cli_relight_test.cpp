@@ -247,6 +247,23 @@ TEST_F(CliRelight, ObjectEditsNameObjectsThatExist) {
   }
 }
 
+TEST_F(CliRelight, CompareMeasuresTheErrorBetweenTwoRenders) {
+  for (const char* name : {"a.exr", "b.exr"}) {
+    const auto r = runObscura("render " + cornellBox() + " --width 16 --spp 1 -o " + path(name) +
+                              (std::string(name) == "b.exr" ? " --seed 9" : ""));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+  }
+  auto r = runObscura("compare " + path("a.exr") + " " + path("a.exr"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "rmse 0 relmse 0");
+  r = runObscura("compare " + path("a.exr") + " " + path("b.exr"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(r.output.find("rmse 0 "), std::string::npos) << "two seeds differ: " << r.output;
+  r = runObscura("compare " + path("a.exr") + " " + path("b.exr") + " --channel nosuch.R");
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_CONTAINS(r.output, "a.exr");
+}
+
 TEST_F(CliRelight, InfoListsTheLightsEditsCanName) {
   const auto r = runObscura("info " + sharedScene("modern-hall/modern-hall.gltf"));
   ASSERT_EQ(r.exitCode, 0) << r.output;
