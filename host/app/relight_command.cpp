@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -148,6 +149,8 @@ void relightScene(RelightOptions& o) {
   std::deque<bvh::Bvh> trees;
   render::ObscuranceRenderer renderer(context, loaded.scene, loaded.bvh, settings);
   const scene::Scene* current = &loaded.scene;
+  const bvh::Bvh* currentBvh = &loaded.bvh;
+  nlohmann::json bvhUpdate; // how the last geometry edit updated the BVH, for edits.jsonl
   auto geometryEdit = [&](const relight::Edit& e) {
     scene::Scene next = *current;
     const std::string where = fmt::format("{}: entry {}", o.edits, e.entry);
@@ -166,8 +169,20 @@ void relightScene(RelightOptions& o) {
       }
     }
     scenes.push_back(std::move(next));
-    trees.push_back(bvh::build(render::triangleSoup(scenes.back())));
+    // A move or a removal keeps every triangle: the BVH is refitted; an insert adds triangles
+    // and rebuilds it.
+    const auto start = Clock::now();
+    const bool refit = e.kind != relight::Edit::Kind::Insert;
+    if (refit) {
+      trees.push_back(*currentBvh);
+      bvh::refit(trees.back(), render::triangleSoup(scenes.back()));
+    } else {
+      trees.push_back(bvh::build(render::triangleSoup(scenes.back())));
+    }
+    bvhUpdate = {{"kind", refit ? "refit" : "rebuild"},
+                 {"ms", std::chrono::duration<double, std::milli>(Clock::now() - start).count()}};
     current = &scenes.back();
+    currentBvh = &trees.back();
     return renderer.updateGeometry(scenes.back(), trees.back(), changed);
   };
   // After renderer.composeDisplay(): the PNG from the fast path's display bytes, then the full
@@ -241,6 +256,7 @@ void relightScene(RelightOptions& o) {
     const double totalMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     nlohmann::json line = {{"edit", n}, {"kind", e.kindName()}, {"name", e.name}, {"pixels_retraced", retraced}};
     line.update(passFigures(before, renderer.stats()));
+    if (!bvhUpdate.is_null()) line["bvh"] = std::exchange(bvhUpdate, nlohmann::json());
     line["total_ms"] = totalMs;
     log << line.dump() << "\n";
     writeFrame(n + 1);

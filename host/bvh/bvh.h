@@ -56,6 +56,12 @@ struct Bvh {
 // gives a root with two empty children.
 Bvh build(const TriangleSoup& soup, const BuildOptions& options = {});
 
+// Refits `bvh` to the moved vertices of the same triangles (`soup` indexed as when it was built):
+// the tree keeps its topology, every box is recomputed bottom-up. Linear in the size, so an object
+// edit updates the structure without a rebuild; the tree's quality degrades with large moves
+// (measured in docs/BENCHMARKS.md), and a rebuild restores it.
+void refit(Bvh& bvh, const TriangleSoup& soup);
+
 // ---- CPU traversal (the reference).
 struct Ray {
   glm::vec3 origin;

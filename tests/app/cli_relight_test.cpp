@@ -226,6 +226,7 @@ TEST_F(CliRelight, MovedObjectFrameMatchesARenderOfTheEditedGltf) {
   std::getline(log, line);
   const json figures = json::parse(line);
   EXPECT_GT(figures["pixels_retraced"].get<int>(), 0);
+  EXPECT_EQ(figures["bvh"]["kind"], "refit") << "a move refits the BVH";
   EXPECT_LT(figures["pixels_retraced"].get<int>(), 32 * 32) << "only the pixels the move can change";
 }
 
