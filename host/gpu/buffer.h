@@ -66,6 +66,8 @@ public:
   TexelBuffer() = default;
   TexelBuffer(const Context& context, const void* data, vk::DeviceSize size, const std::string& name);
   const Buffer& buffer() const { return buffer_; }
+  // New contents of the same size; the view stays valid.
+  void upload(const Context& context, const void* data, vk::DeviceSize size) { buffer_.upload(context, data, size); }
   vk::BufferView view() const { return *view_; }
 
 private:

@@ -222,9 +222,15 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   for (std::size_t i = 0; !emittersMoved && i < moved.emitters.size(); ++i)
     emittersMoved = std::memcmp(&moved.emitters[i], &lights_.emitters[i], sizeof(gpu::GpuEmitter)) != 0;
   if (emittersMoved) lights_.emitters = moved.emitters;
+  // Same materials and textures (a move or a removal): only the BVH and the triangles' shading
+  // data are uploaded again; an insert brings surfaces of its own and uploads the scene anew.
+  const bool sameSurfaces = edited.materials.size() == scene_->materials.size() &&
+                            edited.textures.size() == scene_->textures.size();
   scene_ = &edited;
-  sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
-  uploadLights();
+  bool rebind = true;
+  if (sameSurfaces) rebind = sceneBuffers_.updateGeometry(edited, bvh);
+  else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
+  if (rebind || emittersMoved) uploadLights();
 
   const FrameLayout& layout = frame_.layout();
   const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);

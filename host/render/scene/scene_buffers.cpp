@@ -159,6 +159,25 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
            textures_.size() + texels_.size() + status_.size();
 }
 
+bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh) {
+  auto items = bvhItems(bvh);
+  auto shading = shadingData(scene);
+  const std::size_t itemBytes = items.size() * sizeof(gpu::BvhNode);
+  const std::size_t shadingBytes = shading.size() * sizeof(gpu::TriangleShading);
+  if (itemBytes == items_.buffer().size() && shadingBytes == shading_.size()) {
+    items_.upload(*context_, items.data(), itemBytes);
+    shading_.upload(*context_, shading);
+    return false;
+  }
+  checkTexelLimit(*context_, items.size() * gpu::kTexelsPerItem, "BVH nodes and triangles");
+  bytes_ -= items_.buffer().size() + shading_.size();
+  items_ = gpu::TexelBuffer(*context_, items.data(), itemBytes, "scene.bvhItems");
+  shading_ = gpu::Buffer(*context_, shadingBytes, vk::BufferUsageFlagBits::eStorageBuffer, "scene.shading");
+  shading_.upload(*context_, shading);
+  bytes_ += items_.buffer().size() + shading_.size();
+  return true;
+}
+
 void SceneBuffers::bindTo(gpu::Kernel& kernel, std::uint32_t set, const gpu::Buffer* status) const {
   kernel.bind(gpu::kBindingBvhItems, items_, set);
   kernel.bind(gpu::kBindingShading, shading_, set);

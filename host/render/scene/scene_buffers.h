@@ -39,6 +39,12 @@ public:
   // scene's own unless `status` is given: a renderer counts its frame's rays in its own buffer.
   void bindTo(gpu::Kernel& kernel, std::uint32_t set = 0, const gpu::Buffer* status = nullptr) const;
 
+  // After an edit that kept the materials and textures (a move or a removal): uploads the BVH items
+  // and the triangles' shading data again, in place when their sizes stayed (the texel buffer's
+  // view and every descriptor stay valid), else into new buffers (rebind the kernels then).
+  // Returns true when the buffers were re-created.
+  bool updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh);
+
   // Traversals cut off by kMaxTraversalSteps since the last reset (must stay 0).
   std::uint32_t truncatedTraversals() const;
   // All status words (kStatus*: truncations, rays per pass) since the last reset.
