@@ -221,7 +221,18 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   bool emittersMoved = moved.emitters.size() != lights_.emitters.size();
   for (std::size_t i = 0; !emittersMoved && i < moved.emitters.size(); ++i)
     emittersMoved = std::memcmp(&moved.emitters[i], &lights_.emitters[i], sizeof(gpu::GpuEmitter)) != 0;
-  if (emittersMoved) lights_.emitters = moved.emitters;
+  if (emittersMoved) {
+    // The area lights (first in both sets, one per light group) take their new emitters, areas,
+    // fluxes and powers (a removed emitter has none and is never sampled); added punctual lights stay.
+    lights_.emitters = moved.emitters;
+    for (std::size_t i = 0; i < edited.lightGroups.size(); ++i) {
+      lights_.lights[i] = moved.lights[i];
+      lights_.power[i] = moved.power[i];
+      lights_.unitFlux[i] = moved.unitFlux[i];
+    }
+    updateSelection(lights_);
+    updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
+  }
   // Same materials and textures (a move or a removal): only the BVH and the triangles' shading
   // data are uploaded again; an insert brings surfaces of its own and uploads the scene anew.
   const bool sameSurfaces = edited.materials.size() == scene_->materials.size() &&

@@ -230,6 +230,19 @@ TEST_F(CliRelight, MovedObjectFrameMatchesARenderOfTheEditedGltf) {
   EXPECT_LT(figures["pixels_retraced"].get<int>(), 32 * 32) << "only the pixels the move can change";
 }
 
+TEST_F(CliRelight, RemovingTheOnlyEmitterLeavesADarkRoom) {
+  // The lamp's triangles go, and with them its light: direct, indirect and seen emission all 0,
+  // with no NaN from its zero-area emitters (both shadow sampling modes).
+  writeText("edits.json", json::array({{{"remove", kCornellLight}}}).dump());
+  for (const char* mode : {"selection", "per-light"}) {
+    SCOPED_TRACE(mode);
+    const auto r = runObscura("relight " + cornellBox() + " --edits " + path("edits.json") + " -o " + path(mode) +
+                              " --width 24 --spp 2 --shadow-sampling " + mode);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (float v : combined(io::readImage(path(std::string(mode) + "/frame-001.exr")))) EXPECT_EQ(v, 0.0f);
+  }
+}
+
 TEST_F(CliRelight, ObjectEditsNameObjectsThatExist) {
   const std::vector<std::pair<json, std::string>> cases = {
       {json::array({{{"move", "nosuch"}, {"translate", {0, 1, 0}}}}), "no object named 'nosuch'"},
