@@ -1,7 +1,8 @@
 #version 460
 // dirty.comp — marks the pixels of a band that a geometry edit can change (host_device.h,
 // "dirty.comp"): covered by a changed box on screen, hit points within dMax of one, segments to a
-// light near one, or glossy. Conservative: every test bounds with spheres, so a pixel it leaves
+// light near one, or a specular path that left the scene. Conservative: every test bounds with
+// spheres (a glossy pixel's box holds its path vertices, so its segments too), so a pixel it leaves
 // clean cannot change (FrameEdits.* check the result against a full render bit for bit).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
@@ -31,7 +32,7 @@ bool touched(uint pixel, uvec2 framePixel) {
   }
   vec4 lo = hitBounds[2u * pixel], hi = hitBounds[2u * pixel + 1u];
   if (hi.w == 0.0) return false; // no sample hit anything: only its camera rays could change
-  if (lo.w != 0.0) return true;  // glossy: specular paths may reach anything
+  if (lo.w != 0.0) return true;  // a specular path left the scene: it may pass anywhere
   vec3 centre = 0.5 * (lo.xyz + hi.xyz);
   float radius = 0.5 * distance(lo.xyz, hi.xyz);
   const float dMax = pc.params.x;

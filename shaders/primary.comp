@@ -78,10 +78,10 @@ void main() {
   gbuffer[pixel] = g;
   if (!accumulateSums) return;
 
-  // The box of the pixel's hits over its samples, for the dirty pixels of a geometry edit.
+  // The box of the pixel's hits over its samples, for the dirty pixels of a geometry edit
+  // (specular.comp adds its paths' vertices, and w = 1 when one left the scene).
   bool hitSomething = g.albedo.a != 0.0;
-  bool glossy = hitSomething && materials[floatBitsToUint(g.shadingNormal.w)].params.w != 0.0;
-  vec4 lo = vec4(hitSomething ? g.position.xyz : vec3(1e30), glossy ? 1.0 : 0.0);
+  vec4 lo = vec4(hitSomething ? g.position.xyz : vec3(1e30), 0.0);
   vec4 hi = vec4(hitSomething ? g.position.xyz : vec3(-1e30), hitSomething ? 1.0 : 0.0);
   if (!first) {
     lo = vec4(min(lo.xyz, hitBounds[2u * pixel].xyz), max(lo.w, hitBounds[2u * pixel].w));

@@ -62,6 +62,9 @@ void main() {
   StepBudget budget = newStepBudget();
   vec3 throughput = vec3(1.0);
   uint rays = 0u;
+  // The box of this path's vertices, and whether a ray of it left the scene (dirty.comp).
+  vec3 pathLo = sp.position, pathHi = sp.position;
+  bool escaped = false;
   for (uint depth = 1u; depth < maxDepth && sp.glossy; ++depth) {
     vec3 t, b;
     orthonormalBasis(sp.ns, t, b);
@@ -76,8 +79,13 @@ void main() {
     vec3 origin = offsetRayOrigin(sp.position, sp.ng);
     RayHit h = traceWithBudget(budget, origin, wi, 0.0, 1.0 / 0.0, false);
     ++rays;
-    if (!rayHitValid(h) || h.primitive == kInvalidIndex) break;
+    if (!rayHitValid(h) || h.primitive == kInvalidIndex) {
+      escaped = true;
+      break;
+    }
     Surface s = surfaceAt(h, origin, wi);
+    pathLo = min(pathLo, s.position);
+    pathHi = max(pathHi, s.position);
     GpuMaterial m = materials[s.material];
     vec3 baseColor = materialBaseColor(m, s.uv).rgb;
     if (delta && s.lightGroup != kInvalidIndex) {
@@ -98,6 +106,9 @@ void main() {
     OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
     rays += shadowRays + pc.counts.z;
   }
+  vec4 lo = hitBounds[2u * pixel], hi = hitBounds[2u * pixel + 1u];
+  hitBounds[2u * pixel] = vec4(min(lo.xyz, pathLo), max(lo.w, escaped ? 1.0 : 0.0));
+  hitBounds[2u * pixel + 1u] = vec4(max(hi.xyz, pathHi), hi.w);
   atomicAdd(status[kStatusSpecularRays], rays);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

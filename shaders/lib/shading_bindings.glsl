@@ -18,6 +18,9 @@ layout(std430, set = 0, binding = kBindingSpecularAmbient) buffer SpecularAmbien
 layout(std430, set = 0, binding = kBindingSpecularQueue) buffer SpecularQueue { uint queue[]; };
 layout(std430, set = 0, binding = kBindingLightScales) readonly buffer LightScales { vec4 lightScales[]; };
 layout(std430, set = 0, binding = kBindingDirty) readonly buffer DirtyMask { uint dirty[]; };
+// Per pixel, the box of its hits and specular path vertices (primary.comp starts it; specular.comp
+// grows it), for the dirty pixels of a geometry edit.
+layout(std430, set = 0, binding = kBindingHitBounds) buffer HitBounds { vec4 hitBounds[]; };
 
 layout(push_constant) uniform Push { ShadePush pc; };
 

@@ -234,7 +234,9 @@ OBS_CONST uint kBindingSpecularAmbient = 12; // vec4[pixels]: A gathered along s
 OBS_CONST uint kBindingSpecularQueue = 13;   // uint[]: kQueueHeader words, then glossy pixel indices
 OBS_CONST uint kBindingLightScales = 14;     // vec4[lights]: E_s (to make seen emission unit)
 OBS_CONST uint kBindingDirty = 15;           // uint[pixel]: 1 = retrace (kShadeFlagDirtyOnly)
-OBS_CONST uint kShadingBindingCount = 16;
+OBS_CONST uint kBindingHitBounds = 16;       // = primary.comp's kBindingPrimaryHitBounds; specular
+                                             // paths grow it with their vertices
+OBS_CONST uint kShadingBindingCount = 17;
 
 // ---- Bindings of primary.comp after the scene's (0..5).
 OBS_CONST uint kBindingPrimaryGBuffer = 6;       // GBufferTexel[pixel]
@@ -243,8 +245,9 @@ OBS_CONST uint kBindingPrimaryLightScales = 8;   // vec4[lights]: E_s at render 
 OBS_CONST uint kBindingPrimaryEmissionBasis = 9; // vec4 pairs [light][pixel]: M_s, the emission
                                                  // the camera sees of light s at unit emission
 OBS_CONST uint kBindingPrimaryHitBounds = 10;    // vec4[2 * pixel]: the box of the pixel's primary
-                                                 // hits over samples (min xyz, w = 1 if a hit was
-                                                 // glossy; max xyz, w = 1 if any sample hit)
+                                                 // hits and specular path vertices over samples
+                                                 // (min xyz, w = 1 if a specular path left the
+                                                 // scene; max xyz, w = 1 if any sample hit)
 OBS_CONST uint kBindingPrimaryDirty = 11;        // uint[pixel]: 1 = retrace (kPrimaryFlagDirtyOnly)
 OBS_CONST uint kPrimaryBindingCount = 12;
 
@@ -337,8 +340,10 @@ OBS_CONST uint kLightMixBindingCount = 3;
 // those whose screen footprint the changed boxes cover (primary rays), those whose hit points lie
 // within dMax of a changed box (obscurance is local), those whose segments to a light pass near a
 // changed box (shadow rays: the paper's shafts, here the segment from the hit box's bounding
-// sphere to the light's bounding sphere against the changed box's sphere), and every glossy pixel
-// (its specular paths may go anywhere). Up to kMaxChangedBoxes boxes (old and new places).
+// sphere to the light's bounding sphere against the changed box's sphere), with a glossy pixel's
+// specular path vertices counted in its hit box (every segment of a path lies in the box of its
+// vertices); a path that left the scene makes its pixel always dirty. Up to kMaxChangedBoxes
+// boxes (old and new places).
 OBS_CONST uint kMaxChangedBoxes = 4;
 struct DirtyPush {
   uvec4 frame;        // 0:   width, rows (of the band), first row, light count

@@ -1,8 +1,8 @@
 // Geometry edits: moving an object retraces only the pixels it can change (dirty.comp) and ends
 // with the frame a full render of the edited scene gives — bit for bit in the per-pixel sums,
 // since every pixel is traced with the same seeds either way. A dirty set that is too small fails
-// here: the moved occluder's shadow falls far from its screen footprint, and a small object
-// changes the floor's obscurance only within dMax.
+// here: the moved occluder's shadow falls far from its screen footprint, a small object changes
+// the floor's obscurance only within dMax, and an object is seen in a mirror floor.
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -21,12 +21,13 @@ namespace {
 
 // A room lit by a ceiling lamp (or unlit: obscurance alone), with a small floating "object" (a
 // horizontal double quad) at `object`.
-scene::Scene roomWithObject(glm::vec3 object, float size, bool lamp = true) {
+scene::Scene roomWithObject(glm::vec3 object, float size, bool lamp = true, bool glossyFloor = false) {
   SceneBuilder b;
   auto white = b.lambertian(glm::vec3(0.7f));
+  auto floor = glossyFloor ? b.glossy(glm::vec3(0.8f), 1.0f, 0.05f) : white;
   auto green = b.lambertian(glm::vec3(0.2f, 0.7f, 0.2f));
   auto emitter = b.lambertian(glm::vec3(0.0f), glm::vec3(6.0f));
-  b.quad({-2, 0, -2}, {0, 0, 4}, {4, 0, 0}, white);  // floor, faces +y
+  b.quad({-2, 0, -2}, {0, 0, 4}, {4, 0, 0}, floor);  // floor, faces +y
   b.quad({-2, 0, -2}, {4, 0, 0}, {0, 3, 0}, white);  // back wall, faces +z
   if (lamp) b.quad({-0.3f, 2.99f, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f}, emitter, "lamp");
   const glm::vec3 c = object - glm::vec3(size / 2, 0, size / 2);
@@ -59,10 +60,11 @@ class GeometryEdit : public GpuTest {
 protected:
   // Renders with the object at `from`, moves it to `to` incrementally, and compares with a full
   // render of the moved scene. Returns the pixels retraced.
-  std::uint64_t moveAndCompare(glm::vec3 from, glm::vec3 to, float size, bool lamp = true) {
-    const scene::Scene before = roomWithObject(from, size, lamp);
+  std::uint64_t moveAndCompare(glm::vec3 from, glm::vec3 to, float size, bool lamp = true,
+                               bool glossyFloor = false) {
+    const scene::Scene before = roomWithObject(from, size, lamp, glossyFloor);
     const bvh::Bvh beforeBvh = bvh::build(render::triangleSoup(before));
-    edited_ = roomWithObject(to, size, lamp);
+    edited_ = roomWithObject(to, size, lamp, glossyFloor);
     // As `relight --edits` does for a move: the BVH refitted, not rebuilt.
     editedBvh_ = beforeBvh;
     bvh::refit(editedBvh_, render::triangleSoup(edited_));
@@ -77,7 +79,7 @@ protected:
     EXPECT_EQ(r.stats().truncatedTraversals, 0u);
     // The sums are the full render's bit for bit; composed values may differ in the last bits
     // because I_a's areas are summed from the moved vertices.
-    for (const char* channel : {"direct.R", "direct.G", "obscurance.Y", "albedo.G", "depth.Z", "emission.R"}) {
+    for (const char* channel : {"direct.R", "direct.G", "obscurance.Y", "albedo.G", "depth.Z", "emission.R", "specular.R", "indirect.R"}) {
       const int c = fresh.channelIndex(channel);
       std::size_t differ = 0;
       for (int y = 0; y < fresh.height; ++y)
@@ -116,6 +118,13 @@ TEST_F(GeometryEdit, LowTableTopChangesTheFloorsObscuranceWithinDmax) {
   // and beyond its screen footprint.
   const std::uint64_t retraced = moveAndCompare({-1.0f, 0.25f, 0.0f}, {1.0f, 0.25f, 0.0f}, 0.6f, false);
   EXPECT_LT(retraced, 48u * 36u);
+}
+
+TEST_F(GeometryEdit, ObjectSeenInAMirrorFloorIsRetracedWhereItsReflectionIs) {
+  // A glossy pixel is dirty when its specular paths' vertices come near the moved object: its
+  // reflection on the floor changes far from its screen footprint.
+  const std::uint64_t retraced = moveAndCompare({-0.8f, 1.2f, -1.0f}, {0.8f, 1.2f, -1.0f}, 0.5f, true, true);
+  EXPECT_LT(retraced, 48u * 36u) << "glossy pixels whose paths stay away are kept";
 }
 
 } // namespace
