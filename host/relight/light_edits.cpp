@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "io/json_file.h"
 
 namespace obscura::relight {
 namespace {
@@ -104,14 +105,7 @@ void requireObject(const std::vector<std::string>& names, const std::string& nam
 
 std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> lightNames,
                             std::vector<bool> areaLights, std::vector<std::string> objectNames) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot read the edits file", path));
-  json list;
-  try {
-    list = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
-  }
+  const json list = io::readJsonFile(path, "cannot read the edits file");
   if (!list.is_array()) throw InputError(fmt::format("{}: the edits must be a JSON list", path));
   std::vector<Edit> edits;
   for (std::size_t i = 0; i < list.size(); ++i) {

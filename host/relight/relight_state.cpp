@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "io/image_io.h"
+#include "io/json_file.h"
 #include "shared/host_device.h"
 
 namespace obscura::relight {
@@ -93,14 +94,8 @@ RelightState loadState(const std::string& dir) {
   if (!fs::is_directory(dir)) throw InputError(fmt::format("{}: not a relighting state folder (it does not exist)", dir));
   const std::string jsonPath = (fs::path(dir) / "state.json").string();
   const std::string exrPath = (fs::path(dir) / "transport.exr").string();
-  std::ifstream in(jsonPath);
-  if (!in) throw InputError(fmt::format("{}: missing (not a state written by 'obscura render --save-state')", jsonPath));
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({})", jsonPath, e.what()));
-  }
+  const nlohmann::json json =
+      io::readJsonFile(jsonPath, "missing (not a state written by 'obscura render --save-state')");
   RelightState state;
   try {
     if (!json.contains("version") || json.at("version").get<int>() != kStateVersion)

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "io/json_file.h"
 
 namespace obscura::scene {
 namespace {
@@ -36,13 +37,9 @@ void regroup(Scene& scene, const std::vector<std::string>& newName) {
 } // namespace
 
 void makeLightNamesUnique(Scene& scene) {
-  std::map<std::string, int> seen;
-  auto unique = [&](std::string& name) {
-    const int n = ++seen[name];
-    if (n > 1) name += "#" + std::to_string(n);
-  };
-  for (auto& g : scene.lightGroups) unique(g.name);
-  for (auto& l : scene.punctualLights) unique(l.name);
+  UniqueNames names;
+  for (auto& g : scene.lightGroups) names.apply(g.name);
+  for (auto& l : scene.punctualLights) names.apply(l.name);
 }
 
 void groupLightsByMaterial(Scene& scene) {
@@ -68,14 +65,7 @@ void groupLightsByMaterial(Scene& scene) {
 }
 
 void groupLightsFromFile(Scene& scene, const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot read the light groups file", path));
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
-  }
+  const nlohmann::json json = io::readJsonFile(path, "cannot read the light groups file");
   if (!json.is_object()) throw InputError(fmt::format("{}: expected an object {{\"group\": [\"light\", ...]}}", path));
   std::map<std::string, std::size_t> index;
   for (std::size_t g = 0; g < scene.lightGroups.size(); ++g) index[scene.lightGroups[g].name] = g;

@@ -6,6 +6,7 @@
 #pragma once
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -109,6 +110,18 @@ struct Scene {
   std::vector<std::string> warnings; // "<element>: <what was ignored or assumed>", for the log
 
   std::size_t triangleCount() const { return triangles.size(); }
+};
+
+// Makes names unique in the order they are given: a repeated name gets "#2", "#3", ...
+class UniqueNames {
+public:
+  void apply(std::string& name) {
+    const int n = ++seen_[name];
+    if (n > 1) name.append("#").append(std::to_string(n)); // append: GCC 12 warns on += of a temporary
+  }
+
+private:
+  std::map<std::string, int> seen_;
 };
 
 // The documented default camera when a scene has none: looks down -Z at the centre of the

@@ -30,11 +30,8 @@ void recomputeBounds(Scene& scene) {
 } // namespace
 
 void makeObjectNamesUnique(Scene& scene) {
-  std::map<std::string, int> seen;
-  for (auto& o : scene.objects) {
-    const int n = ++seen[o.name];
-    if (n > 1) o.name += "#" + std::to_string(n);
-  }
+  UniqueNames names;
+  for (auto& o : scene.objects) names.apply(o.name);
 }
 
 std::size_t objectIndex(const Scene& scene, const std::string& name, const std::string& where) {

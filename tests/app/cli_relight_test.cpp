@@ -39,6 +39,19 @@ protected:
     return out;
   }
   void writeText(const std::string& name, const std::string& text) { std::ofstream(path(name)) << text; }
+  // Each edits file is refused with exit 2, the file and `expected` in the message, and no frame.
+  void expectEditsRefused(const std::vector<std::pair<json, std::string>>& cases) {
+    for (const auto& [edits, expected] : cases) {
+      SCOPED_TRACE(edits.dump());
+      writeText("edits.json", edits.dump());
+      const auto r = runObscura("relight " + cornellBox() + " --edits " + path("edits.json") + " -o " + path("out") +
+                                " --width 16 --spp 1");
+      EXPECT_EQ(r.exitCode, 2) << r.output;
+      EXPECT_CONTAINS(r.output, "edits.json");
+      EXPECT_CONTAINS(r.output, expected);
+      EXPECT_FALSE(fs::exists(path("out"))) << "no partial frame";
+    }
+  }
 };
 
 TEST_F(CliRelight, SavedStateRecomposesTheRenderAndScalesALight) {
@@ -159,16 +172,7 @@ TEST_F(CliRelight, BadEditsAreRefusedNamingTheEntryBeforeAnyFrame) {
       {json::array({{{"teleport", "x"}}}), "unknown edit"},
       {json::object({{"light", kCornellLight}}), "list"},
   };
-  for (const auto& [edits, expected] : cases) {
-    SCOPED_TRACE(edits.dump());
-    writeText("edits.json", edits.dump());
-    const auto r = runObscura("relight " + cornellBox() + " --edits " + path("edits.json") + " -o " + path("out") +
-                              " --width 16 --spp 1");
-    EXPECT_EQ(r.exitCode, 2) << r.output;
-    EXPECT_CONTAINS(r.output, "edits.json");
-    EXPECT_CONTAINS(r.output, expected);
-    EXPECT_FALSE(fs::exists(path("out"))) << "no partial frame";
-  }
+  expectEditsRefused(cases);
 }
 
 } // namespace
@@ -250,15 +254,7 @@ TEST_F(CliRelight, ObjectEditsNameObjectsThatExist) {
       {json::array({{{"insert", "missing.gltf"}, {"name", "x"}}}), "missing.gltf"},
       {json::array({{{"insert", repoPath("scenes/cornell-box/cornell-box.gltf")}, {"name", "cube_1"}}}), "exists"},
   };
-  for (const auto& [edits, expected] : cases) {
-    SCOPED_TRACE(edits.dump());
-    writeText("edits.json", edits.dump());
-    const auto r = runObscura("relight " + cornellBox() + " --edits " + path("edits.json") + " -o " + path("out") +
-                              " --width 16 --spp 1");
-    EXPECT_EQ(r.exitCode, 2) << r.output;
-    EXPECT_CONTAINS(r.output, expected);
-    EXPECT_FALSE(fs::exists(path("out")));
-  }
+  expectEditsRefused(cases);
 }
 
 TEST_F(CliRelight, CompareMeasuresTheErrorBetweenTwoRenders) {
