@@ -2,6 +2,7 @@
 // the GPU path with reproducible rays (see bench/bench_rays.h), so other ray tracers can shoot the
 // same ones. --baseline embree traces the same rays with Embree 3 in the same process (when built
 // with it) and reports the ratio, which machine load affects on both sides alike.
+#include <cstdio>
 #include <cmath>
 #include <optional>
 #include <sys/resource.h>
@@ -12,6 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "scene/scene_edit.h"
+#include "render/scene/scene_buffers.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
 #include "bench/bench_rays.h"
@@ -33,8 +36,23 @@ struct BenchOptions {
   bool json = false;
   std::string saveRays;
   std::string baseline;
+  std::string move;   // OBJECT=dx,dy,dz: move an object first (what a remodelling edit does)
+  bool refit = false; // ...and refit the BVH instead of rebuilding it
   DeviceOptions device;
 };
+
+// Applies --move to the loaded scene and updates its BVH by refit or rebuild (traversal cost
+// after an edit: a refit keeps the old topology, docs/BENCHMARKS.md).
+void applyMove(const BenchOptions& o, LoadedScene& loaded) {
+  const auto eq = o.move.rfind('=');
+  glm::vec3 d(0.0f);
+  if (eq == std::string::npos || std::sscanf(o.move.c_str() + eq + 1, "%f,%f,%f", &d.x, &d.y, &d.z) != 3)
+    throw InputError(fmt::format("--move {}: expected OBJECT=dx,dy,dz", o.move));
+  const std::size_t object = scene::objectIndex(loaded.scene, o.move.substr(0, eq), "--move");
+  scene::moveObject(loaded.scene, object, d, glm::vec3(0.0f));
+  if (o.refit) bvh::refit(loaded.bvh, render::triangleSoup(loaded.scene));
+  else loaded.bvh = bvh::build(render::triangleSoup(loaded.scene));
+}
 
 // CPU time of the whole process (all threads), in ms. On lavapipe the "GPU" is this process's
 // threads, so the CPU time of a trace is a measure that other load on the machine hardly affects.
@@ -142,6 +160,7 @@ void runBench(const BenchOptions& o) {
                      "(install libembree-dev, e.g. tools/setup.sh, and re-run CMake)");
 #endif
   LoadedScene loaded = loadScene(o.scenePath);
+  if (!o.move.empty()) applyMove(o, loaded);
   gpu::Context context(o.device.contextOptions());
   if (!o.json) fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
 
@@ -246,6 +265,8 @@ void addBenchRaysCommand(CLI::App& app) {
   cmd->add_option("--baseline", o->baseline, "also trace the same rays with this ray tracer and print the ratio")
       ->check(CLI::IsMember({"embree"}));
   cmd->add_flag("--json", o->json, "print one JSON line");
+  cmd->add_option("--move", o->move, "OBJECT=dx,dy,dz: move an object first, then rebuild the BVH (or --refit)");
+  cmd->add_flag("--refit", o->refit, "with --move: refit the BVH (the topology of before the move) instead of a rebuild");
   addDeviceOptions(*cmd, o->device);
   cmd->callback([o] { runBench(*o); });
 }

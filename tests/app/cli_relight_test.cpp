@@ -274,6 +274,18 @@ TEST_F(CliRelight, CompareMeasuresTheErrorBetweenTwoRenders) {
   EXPECT_CONTAINS(r.output, "a.exr");
 }
 
+TEST_F(CliRelight, RefittedBvhAfterAMoveTracesLikeBruteForceOnTheGpu) {
+  for (const char* update : {"", " --refit"}) {
+    const auto r = runObscura("bench-rays " + cornellBox() + " --rays 4096 --verify 4096 --move cube_2=0.3,0,0.2" +
+                              update);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_CONTAINS(r.output, " 0 mismatches");
+  }
+  const auto bad = runObscura("bench-rays " + cornellBox() + " --rays 64 --move nosuch=1,0,0");
+  EXPECT_EQ(bad.exitCode, 2) << bad.output;
+  EXPECT_CONTAINS(bad.output, "nosuch");
+}
+
 TEST_F(CliRelight, InfoListsTheLightsEditsCanName) {
   const auto r = runObscura("info " + sharedScene("modern-hall/modern-hall.gltf"));
   ASSERT_EQ(r.exitCode, 0) << r.output;
