@@ -34,7 +34,7 @@ io::Image resolvePrimaryAovs(const std::vector<glm::vec4>& aov, std::uint32_t wi
   std::size_t k = 0;
   for (std::size_t p = 0; p < std::size_t(width) * height; ++p) {
     // Each accumulator is (sum, compensation): the sum of slot k is at k * kAccumulatorVec4s.
-    auto sum = [&](std::uint32_t k) { return aov[(p * gpu::kAovSlots + k) * gpu::kAccumulatorVec4s]; };
+    auto sum = [&](std::uint32_t slot) { return aov[(p * gpu::kAovSlots + slot) * gpu::kAccumulatorVec4s]; };
     const glm::vec4 slot[gpu::kAovSlots] = {sum(0), sum(1), sum(2), sum(3), sum(4), sum(5)};
     glm::vec4 albedo = slot[gpu::kAovAlbedo] * inv;
     glm::vec4 normalDepth = slot[gpu::kAovNormal] * inv;

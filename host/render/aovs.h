@@ -31,6 +31,10 @@ const std::vector<std::string>& aovNames();
 // Channel names of one AOV ("albedo" -> albedo.R, albedo.G, albedo.B).
 std::vector<std::string> aovChannels(const std::string& aov);
 
+// Progressive samples recorded into one submission by the renderers: each pass of a sample takes
+// one timestamp pair of a 256-pair pool, and fewer per submission keep the progress line moving.
+inline constexpr std::uint32_t kSamplesPerSubmission = 16;
+
 // Progress callback: samples done, samples total, seconds so far.
 using ProgressFn = std::function<void(std::uint32_t, std::uint32_t, double)>;
 

@@ -18,15 +18,6 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::vector<glm::vec4> asVec4(const std::vector<glm::vec3>& v) {
-  std::vector<glm::vec4> out;
-  for (const auto& e : v) out.emplace_back(e, 0.0f);
-  return out;
-}
-
-// Samples recorded into one submission: each pass of a sample takes one timestamp pair, and the
-// pool holds 256 pairs; fewer per submission keep the progress line moving.
-constexpr std::uint32_t kSamplesPerSubmission = 16;
 
 const std::vector<std::string> kComposeAovs = {"combined", "direct", "indirect", "specular", "obscurance"};
 
@@ -115,8 +106,8 @@ void ObscuranceRenderer::reset() {
 void ObscuranceRenderer::uploadLights() {
   lightBuffers_.lights = gpu::uploadArray(*context_, lights_.lights, "lights.lights");
   lightBuffers_.emitters = gpu::uploadArray(*context_, lights_.emitters, "lights.emitters");
-  lightBuffers_.scales = gpu::uploadArray(*context_, asVec4(lights_.emission), "lights.render_scales");
-  emissionBuffer_ = gpu::uploadArray(*context_, asVec4(emissions_), "compose.emissions");
+  lightBuffers_.scales = gpu::uploadArray(*context_, emissionRows(lights_.emission), "lights.render_scales");
+  emissionBuffer_ = gpu::uploadArray(*context_, emissionRows(emissions_), "compose.emissions");
   lightBounds_ = gpu::uploadArray(*context_, lightBounds(lights_), "dirty.light_bounds");
   bindAll();
 }
@@ -287,7 +278,7 @@ void ObscuranceRenderer::setEmissions(const std::vector<glm::vec3>& emissions) {
   if (emissions.size() != lights_.size())
     throw std::logic_error(fmt::format("setEmissions: {} emissions for {} lights", emissions.size(), lights_.size()));
   emissions_ = emissions;
-  emissionBuffer_.upload(*context_, asVec4(emissions_));
+  emissionBuffer_.upload(*context_, emissionRows(emissions_));
 }
 
 void ObscuranceRenderer::compose(float exposureStops) {
@@ -492,7 +483,7 @@ void ObscuranceRenderer::removeLight(std::size_t index) {
     // Area lights stay: their triangles name them by index. Off is a scale of 0, which is what
     // a scene without that emission renders (D_s, M_s and I_a's share all vanish).
     emissions_[index] = glm::vec3(0.0f);
-    emissionBuffer_.upload(*context_, asVec4(emissions_));
+    emissionBuffer_.upload(*context_, emissionRows(emissions_));
     return;
   }
   frame_.removeLightSlot(stream_, static_cast<std::uint32_t>(index));

@@ -18,7 +18,6 @@ namespace {
 using Usage = vk::BufferUsageFlagBits;
 using Clock = std::chrono::steady_clock;
 constexpr std::uint64_t kAccumulator = gpu::kAccumulatorVec4s * sizeof(glm::vec4);
-constexpr std::uint32_t kSamplesPerSubmission = 16;
 
 gpu::KernelDesc pathKernelDesc(std::uint32_t bands) {
   auto bindings = sceneBindingKinds();
@@ -33,12 +32,6 @@ const PathTraceSettings& checked(const PathTraceSettings& settings) {
   if (settings.maxDepth > kMaxPathDepth)
     throw InputError(fmt::format("path tracing: depth {} is above the limit of {}", settings.maxDepth, kMaxPathDepth));
   return settings;
-}
-
-std::vector<glm::vec4> asVec4(const std::vector<glm::vec3>& v) {
-  std::vector<glm::vec4> out;
-  for (const auto& e : v) out.emplace_back(e, 0.0f);
-  return out;
 }
 
 } // namespace
@@ -61,12 +54,12 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
                                  static_cast<double>(pathTraceBytesNeeded(settings.width, settings.height)) / 1048576.0));
   lightBuffer_ = gpu::uploadArray(context, lights_.lights, "pathtrace.lights");
   emitterBuffer_ = gpu::uploadArray(context, lights_.emitters, "pathtrace.emitters");
-  scaleBuffer_ = gpu::uploadArray(context, asVec4(lights_.emission), "pathtrace.emission");
-  status_ = gpu::Buffer(context, gpu::kStatusWords * 4, Usage::eStorageBuffer, "pathtrace.status");
+  scaleBuffer_ = gpu::uploadArray(context, emissionRows(lights_.emission), "pathtrace.emission");
+  status_ = StatusCounters(context, "pathtrace.status");
   for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
     radiance_.emplace_back(context, layout_.bandPixels(b) * kAccumulator,
                            Usage::eStorageBuffer | Usage::eTransferDst, fmt::format("pathtrace.radiance[{}]", b));
-    sceneBuffers_.bindTo(kernel_, b, &status_);
+    sceneBuffers_.bindTo(kernel_, b, &status_.buffer());
     kernel_.bind(gpu::kBindingPathRadiance, radiance_.back(), b);
     kernel_.bind(gpu::kBindingPathLights, lightBuffer_, b);
     kernel_.bind(gpu::kBindingPathEmitters, emitterBuffer_, b);
@@ -87,8 +80,7 @@ void PathTracer::reset() {
   samples_ = 0;
   wallSeconds_ = 0.0;
   timestamps_ = gpu::Timestamps(*context_);
-  std::uint32_t zeros[gpu::kStatusWords] = {};
-  status_.upload(*context_, zeros, sizeof(zeros));
+  status_.reset();
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     for (const auto& r : radiance_) cmd.fillBuffer(r.handle(), 0, VK_WHOLE_SIZE, 0u);
   });
@@ -165,14 +157,13 @@ std::uint64_t PathTracer::nonFiniteSamples() const {
 RenderStats PathTracer::stats() const {
   RenderStats st;
   st.notes = sceneBuffers_.notes();
-  std::vector<std::uint32_t> status(gpu::kStatusWords);
-  status_.download(*context_, status.data(), status.size() * 4);
+  const std::vector<std::uint32_t> status = status_.words();
   st.truncatedTraversals = status[gpu::kStatusTruncated];
   st.passes["pathtrace"] = {.gpuMs = timestamps_.totalsMs().contains("pathtrace") ? timestamps_.totalsMs().at("pathtrace")
                                                                                    : 0.0,
                             .rays = status[gpu::kStatusPathRays]};
   std::uint64_t bytes = sceneBuffers_.bytes() + lightBuffer_.size() + emitterBuffer_.size() + scaleBuffer_.size() +
-                        status_.size();
+                        status_.buffer().size();
   for (const auto& r : radiance_) bytes += r.size();
   st.deviceBytes = bytes;
   if (const auto n = nonFiniteSamples(); n > 0)

@@ -15,6 +15,7 @@
 #include "render/frame/frame_layout.h"
 #include "render/scene/light_set.h"
 #include "render/scene/scene_buffers.h"
+#include "render/status_counters.h"
 #include "scene/scene.h"
 
 namespace obscura::render {
@@ -74,7 +75,7 @@ private:
   gpu::Buffer lightBuffer_, emitterBuffer_, scaleBuffer_;
   FrameLayout layout_;
   std::vector<gpu::Buffer> radiance_; // per band
-  gpu::Buffer status_;
+  StatusCounters status_;
   gpu::Kernel kernel_;
   gpu::CommandStream stream_;
   gpu::Timestamps timestamps_;

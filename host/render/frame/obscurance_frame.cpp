@@ -94,28 +94,16 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.dirty = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.dirty" + tag);
     bands_.push_back(std::move(b));
   }
-  status_ = gpu::Buffer(context, gpu::kStatusWords * 4, kStorage, "frame.status");
-  resetStatus();
+  status_ = StatusCounters(context, "frame.status");
 }
 
 std::uint64_t ObscuranceFrame::bytes() const {
-  std::uint64_t total = status_.size();
+  std::uint64_t total = status_.buffer().size();
   for (const auto& b : bands_)
     for (const gpu::Buffer* buffer : {&b.gbuffer, &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
                                       &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved, &b.hitBounds, &b.dirty})
       total += buffer->size();
   return total;
-}
-
-std::vector<std::uint32_t> ObscuranceFrame::statusWords() const {
-  std::vector<std::uint32_t> words(gpu::kStatusWords);
-  status_.download(*context_, words.data(), words.size() * 4);
-  return words;
-}
-
-void ObscuranceFrame::resetStatus() {
-  std::uint32_t zeros[gpu::kStatusWords] = {};
-  status_.upload(*context_, zeros, sizeof(zeros));
 }
 
 void ObscuranceFrame::addLightSlot(gpu::CommandStream& stream) {

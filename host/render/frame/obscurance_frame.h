@@ -18,6 +18,7 @@
 #include "gpu/command_stream.h"
 #include "gpu/context.h"
 #include "render/frame/frame_layout.h"
+#include "render/status_counters.h"
 
 namespace obscura::render {
 
@@ -68,9 +69,9 @@ public:
   bool specular() const { return contents_.specular; }
   const FrameContents& contents() const { return contents_; }
 
-  const gpu::Buffer& status() const { return status_; }
-  std::vector<std::uint32_t> statusWords() const;
-  void resetStatus();
+  const gpu::Buffer& status() const { return status_.buffer(); }
+  std::vector<std::uint32_t> statusWords() const { return status_.words(); }
+  void resetStatus() { status_.reset(); }
 
   // Device bytes allocated now (the real buffers' sizes).
   std::uint64_t bytes() const;
@@ -87,7 +88,7 @@ public:
   std::uint32_t maxLights_ = 0;
   FrameContents contents_;
   std::vector<Band> bands_;
-  gpu::Buffer status_;
+  StatusCounters status_;
 };
 
 } // namespace obscura::render

@@ -34,6 +34,12 @@ float projectedBoxArea(const scene::Bounds& b, const glm::vec3& direction) {
 
 } // namespace
 
+std::vector<glm::vec4> emissionRows(const std::vector<glm::vec3>& emissions) {
+  std::vector<glm::vec4> out;
+  for (const auto& e : emissions) out.emplace_back(e, 0.0f);
+  return out;
+}
+
 float luminanceWeight(const glm::vec3& rgb) { return (rgb.x + rgb.y + rgb.z) / 3.0f; }
 
 bool LightSet::anySampled() const {

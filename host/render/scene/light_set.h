@@ -39,6 +39,10 @@ void removePunctual(LightSet& set, std::size_t index);
 // The selection CDF and probabilities from the lights' powers.
 void updateSelection(LightSet& set);
 
+// Emission scales E_s as the vec4 rows the shaders read (compose's emissions, the render-time
+// normaliser, the path tracer's scales).
+std::vector<glm::vec4> emissionRows(const std::vector<glm::vec3>& emissions);
+
 // Scalar "brightness" of an RGB value for selection weights: the channel mean.
 float luminanceWeight(const glm::vec3& rgb);
 

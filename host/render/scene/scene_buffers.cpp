@@ -153,10 +153,9 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
     offset += t.rgba8.size();
   }
 
-  status_ = gpu::Buffer(context, gpu::kStatusWords * 4, Usage::eStorageBuffer, "scene.status");
-  resetStatus();
+  status_ = StatusCounters(context, "scene.status");
   bytes_ = items_.buffer().size() + shading_.size() + materials_.size() +
-           textures_.size() + texels_.size() + status_.size();
+           textures_.size() + texels_.size() + status_.buffer().size();
 }
 
 bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh) {
@@ -184,20 +183,13 @@ void SceneBuffers::bindTo(gpu::Kernel& kernel, std::uint32_t set, const gpu::Buf
   kernel.bind(gpu::kBindingMaterials, materials_, set);
   kernel.bind(gpu::kBindingTextures, textures_, set);
   kernel.bind(gpu::kBindingTexels, texels_, set);
-  kernel.bind(gpu::kBindingStatus, status ? *status : status_, set);
+  kernel.bind(gpu::kBindingStatus, status ? *status : status_.buffer(), set);
 }
 
 std::uint32_t SceneBuffers::truncatedTraversals() const { return statusWords()[gpu::kStatusTruncated]; }
 
-std::vector<std::uint32_t> SceneBuffers::statusWords() const {
-  std::vector<std::uint32_t> words(gpu::kStatusWords);
-  status_.download(*context_, words.data(), words.size() * 4);
-  return words;
-}
+std::vector<std::uint32_t> SceneBuffers::statusWords() const { return status_.words(); }
 
-void SceneBuffers::resetStatus() {
-  std::uint32_t zeros[gpu::kStatusWords] = {};
-  status_.upload(*context_, zeros, sizeof(zeros));
-}
+void SceneBuffers::resetStatus() { status_.reset(); }
 
 } // namespace obscura::render

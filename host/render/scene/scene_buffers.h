@@ -7,6 +7,7 @@
 #include "gpu/buffer.h"
 #include "gpu/context.h"
 #include "gpu/kernel.h"
+#include "render/status_counters.h"
 #include "scene/scene.h"
 
 namespace obscura::render {
@@ -62,7 +63,7 @@ private:
   gpu::Buffer materials_;
   gpu::Buffer textures_;
   gpu::Buffer texels_;
-  gpu::Buffer status_;
+  StatusCounters status_;
   std::uint64_t bytes_ = 0;
   std::vector<std::string> notes_;
 };
