@@ -175,7 +175,7 @@ TEST_P(CliMalformedGltf, RenderRefusesItWithoutOutput) {
   EXPECT_EQ(strayFiles(inputs), std::vector<std::string>{});
 }
 
-INSTANTIATE_TEST_SUITE_P(Issue4, CliMalformedGltf, ::testing::Range<std::size_t>(0, malformedCases().size()),
+INSTANTIATE_TEST_SUITE_P(GlbDefects, CliMalformedGltf, ::testing::Range<std::size_t>(0, malformedCases().size()),
                          [](const ::testing::TestParamInfo<std::size_t>& param) {
                            return malformedCases()[param.param].name;
                          });
