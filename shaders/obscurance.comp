@@ -14,6 +14,7 @@
 #include "lib/sampling.glsl"
 #include "lib/bsdf.glsl"
 #include "lib/lights.glsl"
+#include "lib/mis.glsl"
 #include "lib/shade.glsl"
 #include "lib/obscurance.glsl"
 #include "lib/accumulate.glsl"

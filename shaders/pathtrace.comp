@@ -6,8 +6,9 @@
 // shadow-ray code as the obscurance passes (lib/*.glsl), so the two methods differ only in the
 // light transport they estimate. At each scattering vertex of the path:
 //   * emission seen along the ray that reached it (one-sided unless doubleSided, SPEC §5);
-//   * next-event estimation: one light by power, a point uniform by area on it (lights.glsl
-//     sampleLight), a shadow ray (shade.glsl directLightSample, unchanged);
+//   * next-event estimation: the shared direct-light estimator (lights.glsl sampleLight: light
+//     by importance at the vertex and a point by solid angle, or the paper's by power and area),
+//     a shadow ray (shade.glsl directLightSample);
 //   * one BSDF sample (bsdf.glsl sampleBsdf) continues the path;
 // area-light contributions reached by both techniques are combined with the power heuristic
 // (Veach & Guibas 1995, lib/mis.glsl); punctual lights (light sampling only) and emitters seen
@@ -56,8 +57,8 @@ layout(std430, set = 0, binding = kBindingPathScales) readonly buffer ScaleBuffe
 #include "lib/sampling.glsl"
 #include "lib/bsdf.glsl"
 #include "lib/lights.glsl"
-#include "lib/shade.glsl"
 #include "lib/mis.glsl"
+#include "lib/shade.glsl"
 #include "lib/accumulate.glsl"
 #include "lib/band.glsl"
 
@@ -83,6 +84,7 @@ void main() {
   const uint maxDepth = pc.params.y;
   const uint rrDepth = pc.params.z;
   const uint strategy = pc.params.w;
+  gLightSampling = pc.band.z;
 
   // The camera ray exactly as primary.comp makes it: the same per-pixel shift of the same R2
   // sub-pixel sequence, so sample i of both renderers goes through the same point of the pixel.
@@ -103,6 +105,7 @@ void main() {
   bool specularBounce = true;   // the ray came from the camera or a mirror's delta lobe
   float bsdfPdfPrev = 0.0;      // solid-angle pdf of the BSDF sample that made the ray
   vec3 previous = origin;       // the vertex the ray left from
+  vec3 previousNormal = vec3(0.0); // its geometric normal (light selection depends on it)
 
   // Vertex `depth` (1 = the camera ray's hit): its emission ends a path of depth - 1 scattering
   // vertices, its scattering (light sample, BSDF sample) makes depth of them.
@@ -117,8 +120,7 @@ void main() {
       float w = 1.0;
       if (!specularBounce && s.lightGroup < lightCount && strategy != kPathStrategyBsdfOnly) {
         // This point could also have come from sampleLight at the previous vertex [MIS].
-        vec3 d = s.position - previous;
-        float lightPdf = areaLightPdf(s.lightGroup, dot(d, d), abs(dot(s.geometricNormal, direction)));
+        float lightPdf = emitterHitLightPdf(s.lightGroup, previous, previousNormal, lightCount, hit, s.position, direction);
         w = strategy == kPathStrategyLightOnly ? (lightPdf > 0.0 ? 0.0 : 1.0)
                                                : powerHeuristic(bsdfPdfPrev, lightPdf);
       }
@@ -142,7 +144,7 @@ void main() {
     if (lightCount > 0u) {
       // sampleLight is deterministic in (p, u): this is the sample directLightSample draws below;
       // drawing it first gives its pdf for the MIS weight and skips shadow rays of weight 0.
-      LightSample ls = sampleLight(sp.position, uLight, lightCount);
+      LightSample ls = sampleLight(sp.position, sp.ng, uLight, lightCount);
       bool area = lights[ls.light].info.x == kLightArea;
       float w = 1.0;
       if (area && strategy == kPathStrategyBsdfOnly) {
@@ -155,7 +157,7 @@ void main() {
         vec3 contribution; // unit emission; x E_s below
         uint light;
         uint tracedBefore = budget.traced;
-        directLightSample(sp, uLight, lightCount, budget, contribution, light);
+        directLightSample(sp, uLight, lightCount, 0.0, budget, contribution, light);
         if (budget.traced != tracedBefore) rays++; // it traced a shadow ray
         L += beta * w * emissionScale[light].rgb * contribution;
       }
@@ -181,6 +183,7 @@ void main() {
     specularBounce = delta;
     bsdfPdfPrev = pdf;
     previous = s.position;
+    previousNormal = sp.ng;
     origin = offsetRayOrigin(s.position, sp.ng);
     direction = wi;
     hit = traceWithBudget(budget, origin, direction, 0.0, 1.0 / 0.0, false);

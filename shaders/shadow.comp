@@ -1,8 +1,10 @@
 #version 460
 // shadow.comp — direct light at the primary hit: N_s shadow rays per hit [RTO §4.1 step 2],
-// each to a light chosen by power and a point uniform on it, accumulated per light into the
+// each to a light and a point on it chosen by the shared estimator (lib/lights.glsl: by
+// importance and solid angle, or the paper's by power and area), accumulated per light into the
 // basis buffers D_s at unit emission [SPEC §3]:
-//   D_s += f(P, wo, wi) L_e cos(theta_P) cos(theta_L) / r^2 / pdf / N_s
+//   D_s += f(P, wo, wi) L_e cos(theta_P) / pdf_omega / N_s
+// (with MIS weights on a glossy lobe that specular.comp samples too, lib/shade.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -14,6 +16,7 @@
 #include "lib/sampling.glsl"
 #include "lib/bsdf.glsl"
 #include "lib/lights.glsl"
+#include "lib/mis.glsl"
 #include "lib/shade.glsl"
 #include "lib/accumulate.glsl"
 #include "lib/band.glsl"
@@ -22,6 +25,7 @@ layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
 void main() {
   gSceneScale = pc.eye.w;
+  gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
   BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, pc.frame.xy, pc.band.xy);
   if (!bp.inside) return;
   uvec2 p = bp.frame;
@@ -45,7 +49,7 @@ void main() {
       vec4 u = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
       vec3 contribution;
       bool visible;
-      directLightFrom(sp, sampleChosenLight(sp.position, u, light, 1.0), budget, contribution, visible);
+      directLightFrom(sp, sampleChosenLight(sp.position, u, light, 1.0), 0.0, budget, contribution, visible);
       sum += contribution;
       seen += visible ? 1u : 0u;
       ++taken;
@@ -57,11 +61,12 @@ void main() {
   }
   uint count = pc.counts.y;
   float invCount = 1.0 / float(count);
+  float misSamples = (pc.counts.w & kFlagGlossyMis) != 0u ? float(count) : 0.0;
   for (uint k = 0u; k < count; ++k) {
     vec4 u = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
     vec3 contribution;
     uint light;
-    directLightSample(sp, u, pc.counts.x, budget, contribution, light);
+    directLightSample(sp, u, pc.counts.x, misSamples, budget, contribution, light);
     OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(contribution * invCount, 0.0))
   }
   atomicAdd(status[kStatusShadowRays], count);

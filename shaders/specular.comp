@@ -6,8 +6,11 @@
 //
 // The primary hit's own direct light (full BSDF) and obscurance (diffuse part) come from
 // shadow.comp and obscurance.comp; this pass adds what arrives through the specular lobe.
-// Emitters seen through the lobe count only after a mirror (delta) bounce: for a glossy lobe the
-// shadow rays already sample that light (no MIS here, so counting both would double it).
+// Emitters seen through the lobe: after a mirror (delta) bounce they count whole (no light sample
+// can find that path); after a glossy bounce, with kFlagGlossyMis, they count with the power
+// heuristic against the vertex's N_s light samples (lib/shade.glsl weighs the other side), and
+// without it (the paper's estimator, per-light shadow rays) not at all, since the shadow rays
+// then take all of that light.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -21,6 +24,7 @@
 #include "lib/sampling.glsl"
 #include "lib/bsdf.glsl"
 #include "lib/lights.glsl"
+#include "lib/mis.glsl"
 #include "lib/shade.glsl"
 #include "lib/obscurance.glsl"
 #include "lib/accumulate.glsl"
@@ -46,6 +50,8 @@ bool sampleSpecularLobe(ShadingPoint sp, vec3 wo, vec2 u, out vec3 wi, out vec3 
 
 void main() {
   gSceneScale = pc.eye.w;
+  gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
+  const bool glossyMis = (pc.counts.w & kFlagGlossyMis) != 0u;
   uint entry = gl_GlobalInvocationID.x;
   if (entry >= queue[kQueueCount]) return;
   uint pixel = queue[kQueueHeader + entry];
@@ -74,6 +80,9 @@ void main() {
     if (wo.z <= 0.0 || !sampleSpecularLobe(sp, wo, vec2(rngNext(rng), rngNext(rng)), wiLocal, weight, delta)) break;
     vec3 wi = toWorld(wiLocal, t, b, sp.ns);
     if (dot(wi, sp.ng) <= 0.0) break; // below the geometric surface: no leaks
+    // What MIS needs of the vertex the lobe sample leaves (its light samples' density).
+    float lobePdf = delta ? 0.0 : ggxReflectionPdf(wo, wiLocal, ggxAlpha(sp.roughness));
+    vec3 previous = sp.position, previousNormal = sp.ng;
     throughput *= weight;
     if (all(equal(throughput, vec3(0.0)))) break;
     vec3 origin = offsetRayOrigin(sp.position, sp.ng);
@@ -88,18 +97,25 @@ void main() {
     pathHi = max(pathHi, s.position);
     GpuMaterial m = materials[s.material];
     vec3 baseColor = materialBaseColor(m, s.uv).rgb;
-    if (delta && s.lightGroup != kInvalidIndex) {
+    if ((delta || glossyMis) && s.lightGroup != kInvalidIndex && s.lightGroup < lightCount) {
+      float w = 1.0;
+      if (!delta) {
+        float lightPdf = emitterHitLightPdf(s.lightGroup, previous, previousNormal, lightCount, h, s.position, wi);
+        w = powerHeuristic(lobePdf, float(shadowRays) * lightPdf);
+      }
       // Seen emission in unit-emission terms: divided by the group's E_s (1 where E_s is 0).
       vec3 unit = unitEmission(materialEmission(m, s.uv, s.frontFacing), lightScales[s.lightGroup].rgb);
-      OBS_ACCUMULATE(specularBasis, s.lightGroup * pixelCount + pixel, vec4(throughput * unit, 0.0))
+      OBS_ACCUMULATE(specularBasis, s.lightGroup * pixelCount + pixel, vec4(w * throughput * unit, 0.0))
     }
     sp = shadingPoint(s.position, s.geometricNormal, s.shadingNormal, -wi, baseColor, s.material);
     // Gather as at P [RTO §4.1 step 4]: direct light, then obscurance.
+    // MIS only where a lobe sample follows from this vertex (the loop goes on past it).
+    float misSamples = glossyMis && depth + 1u < maxDepth ? float(shadowRays) : 0.0;
     for (uint k = 0u; k < shadowRays; ++k) {
       vec4 u = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
       vec3 contribution;
       uint light;
-      directLightSample(sp, u, lightCount, budget, contribution, light);
+      directLightSample(sp, u, lightCount, misSamples, budget, contribution, light);
       OBS_ACCUMULATE(specularBasis, light * pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
     }
     vec4 aw = gatherObscurance(sp, rng, budget);

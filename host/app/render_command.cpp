@@ -159,7 +159,8 @@ void runRender(RenderOptions& o) {
     if (!o.saveState.empty())
       throw InputError("--save-state: only the obscurance method keeps per-light transport (--method obscurance)");
     render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
-                                 .camera = camera, .maxDepth = settings.maxDepth};
+                                 .camera = camera, .maxDepth = settings.maxDepth,
+                                 .lightSampling = settings.lightSampling};
     render::PathTracer tracer(context, loaded.scene, loaded.bvh, pt);
     tracer.render(progress);
     writeOutputs(o, tracer.image(), tracer.stats(), context, loaded, {{"method", "pathtrace"}, {"max_depth", pt.maxDepth}});

@@ -58,6 +58,10 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
                  "selection (N_s rays per hit to lights chosen by power, default) or per-light (every light "
                  "alone, 4 rays per hit, up to 64 in penumbrae: relit images stay as clean as fresh ones)")
       ->check(CLI::IsMember({"selection", "per-light"}));
+  cmd.add_option("--light-sampling", o.lightSampling,
+                 "how shadow rays pick lights (both methods): spatial (default: by importance at the point, "
+                 "triangles by solid angle, MIS on glossy lobes) or area (the paper's: by power, uniform by area)")
+      ->check(CLI::IsMember({"spatial", "area"}));
   cmd.add_option("--light-groups", o.lightGroups,
                  "lights edited as one: node (one per emissive mesh node, default), material (one per emissive "
                  "material), or a JSON file {\"group\": [\"node\", ...]}");
@@ -81,7 +85,12 @@ render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scen
   settings.colourBleeding = !o.noBleed;
   settings.shadowSampling = o.shadowSampling == "per-light" ? render::ShadowSampling::PerLight
                                                             : render::ShadowSampling::Selection;
+  settings.lightSampling = lightSampling(o);
   return settings;
+}
+
+render::LightSampling lightSampling(const RenderOptions& o) {
+  return o.lightSampling == "area" ? render::LightSampling::Area : render::LightSampling::Spatial;
 }
 
 } // namespace obscura::app

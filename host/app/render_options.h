@@ -33,6 +33,7 @@ struct RenderOptions {
   bool dMaxGiven = false;
   std::string lightGroups = "node";
   std::string shadowSampling = "selection";
+  std::string lightSampling = "spatial";
   DeviceOptions device;
 };
 
@@ -46,5 +47,7 @@ scene::Camera chooseCamera(const scene::Scene& scene, int index);
 void chooseSize(RenderOptions& o, const scene::Camera& camera);
 // The obscurance renderer's settings from the options, for `camera` at the chosen size.
 render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scene::Camera& camera);
+// The light sampling --light-sampling names.
+render::LightSampling lightSampling(const RenderOptions& o);
 
 } // namespace obscura::app

@@ -128,8 +128,13 @@ void ObscuranceRenderer::bindAll() {
 }
 
 gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
+  // Glossy MIS needs the specular pass's lobe sample and light samples drawn over all lights.
+  const bool glossyMis = settings_.lightSampling == LightSampling::Spatial &&
+                         settings_.shadowSampling == ShadowSampling::Selection && runSpecular_;
   const std::uint32_t flags = (settings_.systematic ? gpu::kFlagSystematic : 0u) |
-                              (settings_.colourBleeding ? gpu::kFlagBleed : 0u);
+                              (settings_.colourBleeding ? gpu::kFlagBleed : 0u) |
+                              (settings_.lightSampling == LightSampling::Area ? gpu::kFlagAreaLightSampling : 0u) |
+                              (glossyMis ? gpu::kFlagGlossyMis : 0u);
   return {.frame = glm::uvec4(settings_.width, settings_.height, sample, settings_.seed),
           .counts = glm::uvec4(static_cast<std::uint32_t>(lights_.size()), settings_.shadowRays,
                                settings_.obscuranceRays, flags),

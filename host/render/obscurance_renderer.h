@@ -76,6 +76,7 @@ struct ObscuranceSettings {
   // each). `relight --edits` reserves one per add_light edit.
   std::uint32_t spareLightSlots = 0;
   ShadowSampling shadowSampling = ShadowSampling::Selection;
+  LightSampling lightSampling = LightSampling::Spatial;
 };
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.

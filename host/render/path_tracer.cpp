@@ -96,7 +96,7 @@ void PathTracer::iterate(std::uint32_t samples, const ProgressFn& progress) {
                      .frame = glm::uvec4(settings_.width, settings_.height, 0u, settings_.seed),
                      .params = glm::uvec4(lightCount, settings_.maxDepth, settings_.rrDepth,
                                           static_cast<std::uint32_t>(settings_.strategy)),
-                     .band = glm::uvec4(0u)};
+                     .band = glm::uvec4(0u, 0u, static_cast<std::uint32_t>(settings_.lightSampling), 0u)};
   push.camera.right.w = sceneScale(scene_->bounds); // the ray-origin offset's scale (ray.glsl)
   const std::uint32_t end = samples_ + samples;
   while (samples_ < end) {
@@ -108,7 +108,8 @@ void PathTracer::iterate(std::uint32_t samples, const ProgressFn& progress) {
         if (s > samples_) gpu::computeBarrier(cmd);
         push.frame.z = s;
         for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
-          push.band = glm::uvec4(layout_.bands[b].firstRow, layout_.bands[b].rows, 0u, 0u);
+          push.band.x = layout_.bands[b].firstRow;
+          push.band.y = layout_.bands[b].rows;
           kernel_.dispatch(cmd, gpu::groupsFor(settings_.width, gpu::kWorkgroupSizeX),
                            gpu::groupsFor(layout_.bands[b].rows, gpu::kWorkgroupSizeY), 1, &push, b);
         }

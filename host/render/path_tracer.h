@@ -37,6 +37,7 @@ struct PathTraceSettings {
   std::uint32_t maxDepth = 6;      // scattering vertices d [SPEC §5]: 1 = direct light only
   std::uint32_t rrDepth = 3;       // Russian roulette after this many vertices (>= maxDepth: never)
   PathStrategy strategy = PathStrategy::Mis;
+  LightSampling lightSampling = LightSampling::Spatial; // next-event estimation's light sampling
 };
 
 // The largest maxDepth accepted (each vertex costs loop passes of lavapipe's limiter; a deeper

@@ -60,6 +60,29 @@ glm::vec3 sampleUniformTriangle(glm::vec2 u, glm::vec3 v0, glm::vec3 v1, glm::ve
   return (1.0f - r) * v0 + (r * (1.0f - u.y)) * v1 + (r * u.y) * v2;
 }
 
+float sphericalTriangleArea(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
+  return 2.0f * std::atan2(std::abs(glm::dot(a, glm::cross(b, c))), 1.0f + glm::dot(a, b) + glm::dot(b, c) + glm::dot(c, a));
+}
+
+glm::vec3 orthogonalUnit(glm::vec3 v, glm::vec3 w) { return glm::normalize(v - glm::dot(v, w) * w); }
+
+glm::vec3 sampleSphericalTriangle(glm::vec2 u, glm::vec3 a, glm::vec3 b, glm::vec3 c) {
+  glm::vec3 nab = glm::normalize(glm::cross(a, b)), nac = glm::normalize(glm::cross(a, c));
+  float alpha = std::atan2(glm::length(glm::cross(nab, nac)), glm::dot(nab, nac));
+  float area = sphericalTriangleArea(a, b, c);
+  float areaPrime = u.x * area;
+  float s = std::sin(areaPrime - alpha), t = std::cos(areaPrime - alpha);
+  float sinAlpha = std::sin(alpha), cosAlpha = std::cos(alpha);
+  float uu = t - cosAlpha;
+  float vv = s + sinAlpha * glm::dot(a, b);
+  float denominator = (vv * s + uu * t) * sinAlpha;
+  float q = denominator != 0.0f ? std::clamp(((vv * t - uu * s) * cosAlpha - vv) / denominator, -1.0f, 1.0f) : 1.0f;
+  glm::vec3 cPrime = q * a + std::sqrt(std::max(0.0f, 1.0f - q * q)) * orthogonalUnit(c, a);
+  float z = 1.0f - u.y * (1.0f - glm::dot(cPrime, b));
+  z = std::clamp(z, -1.0f, 1.0f);
+  return glm::normalize(z * b + std::sqrt(std::max(0.0f, 1.0f - z * z)) * orthogonalUnit(cPrime, b));
+}
+
 float ggxAlpha(float roughness) { return std::max(roughness * roughness, kGgxMinAlpha); }
 
 float ggxD(float cosThetaH, float alpha) {
@@ -151,20 +174,23 @@ float specularProbability(glm::vec3 baseColor, float metallic, float cosThetaO) 
   return total > 0.0f ? spec / total : 1.0f;
 }
 
+glm::vec3 evalSpecularLobe(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 wo, glm::vec3 wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f || !isGlossy(metallic, roughness) || isMirror(roughness)) return glm::vec3(0.0f);
+  float alpha = ggxAlpha(roughness);
+  glm::vec3 f0 = glm::mix(glm::vec3(kDielectricF0), baseColor, metallic);
+  glm::vec3 h = glm::normalize(wo + wi);
+  float dg = ggxD(wo + wi, alpha) * smithG2(wo.z, wi.z, alpha) / (4.0f * wo.z * wi.z);
+  return fresnelSchlick(f0, std::max(glm::dot(wo, h), 0.0f)) * dg;
+}
+
 glm::vec3 evalBsdf(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 wo, glm::vec3 wi) {
   if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
   if (!isGlossy(metallic, roughness)) return baseColor * kInvPi;
   float transmit = (1.0f - fresnelSchlick(kDielectricF0, wo.z)) * (1.0f - fresnelSchlick(kDielectricF0, wi.z));
   glm::vec3 f = ((1.0f - metallic) * transmit * kInvPi / (1.0f - kDielectricFresnelMean)) * baseColor;
-  if (!isMirror(roughness)) {
-    float alpha = ggxAlpha(roughness);
-    glm::vec3 f0 = glm::mix(glm::vec3(kDielectricF0), baseColor, metallic);
-    glm::vec3 h = glm::normalize(wo + wi);
-    float dg = ggxD(wo + wi, alpha) * smithG2(wo.z, wi.z, alpha) / (4.0f * wo.z * wi.z);
-    f += fresnelSchlick(f0, std::max(glm::dot(wo, h), 0.0f)) * dg;
-  }
-  return f;
+  return f + evalSpecularLobe(baseColor, metallic, roughness, wo, wi);
 }
+
 
 float bsdfPdf(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 wo, glm::vec3 wi) {
   if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;

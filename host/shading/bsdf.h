@@ -46,6 +46,12 @@ glm::vec3 sampleSystematic(std::uint32_t i, glm::uvec2 grid, glm::vec2 offset);
 float triangleArea(glm::vec3 v0, glm::vec3 v1, glm::vec3 v2);
 glm::vec3 sampleUniformTriangle(glm::vec2 u, glm::vec3 v0, glm::vec3 v1, glm::vec3 v2);
 
+// Spherical triangles seen from a point (a, b, c: unit directions to the vertices): the solid
+// angle (Van Oosterom & Strackee 1983) and a direction uniform in it (Arvo 1995), pdf 1 / area.
+float sphericalTriangleArea(glm::vec3 a, glm::vec3 b, glm::vec3 c);
+glm::vec3 orthogonalUnit(glm::vec3 v, glm::vec3 w);
+glm::vec3 sampleSphericalTriangle(glm::vec2 u, glm::vec3 a, glm::vec3 b, glm::vec3 c);
+
 // GGX: D (Walter et al. 2007), Smith G1 and height-correlated G2 (Heitz 2014), visible normals
 // (Heitz, "Sampling the GGX Distribution of Visible Normals", 2018).
 float ggxAlpha(float roughness);
@@ -68,6 +74,8 @@ float averageRgb(glm::vec3 c);
 float specularProbability(glm::vec3 baseColor, float metallic, float cosThetaO);
 // f(wo, wi) without the cosine; the mirror's delta left out.
 glm::vec3 evalBsdf(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 wo, glm::vec3 wi);
+// The specular (GGX) lobe of evalBsdf alone (0 for diffuse materials and mirrors).
+glm::vec3 evalSpecularLobe(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 wo, glm::vec3 wi);
 // Density of sampleBsdf's continuous directions (the mirror's delta left out).
 float bsdfPdf(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 wo, glm::vec3 wi);
 // Returns f cos / pdf; pdf = 0: no sample; delta: a mirror reflection, pdf = its probability.

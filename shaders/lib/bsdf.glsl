@@ -78,21 +78,26 @@ float specularProbability(vec3 baseColor, float metallic, float cosThetaO) {
   return total > 0.0 ? spec / total : 1.0;
 }
 
+// The specular (GGX) lobe of evalBsdf alone: 0 for a diffuse material and for a mirror (delta).
+// MIS weighs this part of a light sample against the specular pass's lobe sample.
+vec3 evalSpecularLobe(vec3 baseColor, float metallic, float roughness, vec3 wo, vec3 wi) {
+  if (wo.z <= 0.0 || wi.z <= 0.0 || !isGlossy(metallic, roughness) || isMirror(roughness)) return vec3(0.0);
+  float alpha = ggxAlpha(roughness);
+  vec3 f0 = mix(vec3(kDielectricF0), baseColor, metallic);
+  vec3 h = normalize(wo + wi);
+  float dg = ggxD(wo + wi, alpha) * smithG2(wo.z, wi.z, alpha) / (4.0 * wo.z * wi.z);
+  return fresnelSchlick(f0, max(dot(wo, h), 0.0)) * dg;
+}
+
 // The BRDF f(wo, wi) WITHOUT the cosine (multiply by wi.z yourself). The mirror's delta is left out.
 vec3 evalBsdf(vec3 baseColor, float metallic, float roughness, vec3 wo, vec3 wi) {
   if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
   if (!isGlossy(metallic, roughness)) return baseColor * kInvPi;
   float transmit = (1.0 - fresnelSchlick(kDielectricF0, wo.z)) * (1.0 - fresnelSchlick(kDielectricF0, wi.z));
   vec3 f = ((1.0 - metallic) * transmit * kInvPi / (1.0 - kDielectricFresnelMean)) * baseColor;
-  if (!isMirror(roughness)) {
-    float alpha = ggxAlpha(roughness);
-    vec3 f0 = mix(vec3(kDielectricF0), baseColor, metallic);
-    vec3 h = normalize(wo + wi);
-    float dg = ggxD(wo + wi, alpha) * smithG2(wo.z, wi.z, alpha) / (4.0 * wo.z * wi.z);
-    f += fresnelSchlick(f0, max(dot(wo, h), 0.0)) * dg;
-  }
-  return f;
+  return f + evalSpecularLobe(baseColor, metallic, roughness, wo, wi);
 }
+
 
 // The density over solid angle of sampleBsdf's continuous directions (for MIS): the lobes' pdfs
 // mixed by specularProbability. A mirror's delta is left out (its mass is specularProbability).

@@ -1,9 +1,29 @@
-// lights.glsl — choosing a light and a point on it for a shadow ray [RTO §4.1 step 2, SPEC §1.3].
+// lights.glsl — the one direct-light estimator's sampling half: choosing a light and a point on it
+// for a shadow ray [RTO §4.1 step 2, SPEC §1.3], and the density of that choice (for MIS).
 // Needs the light bindings (kBindingLights, kBindingEmitters) declared by the including shader
-// as `lights[]` and `emitters[]`, and sampling.glsl (kPi, sampleUniformTriangle).
+// as `lights[]` and `emitters[]`, and sampling.glsl.
+//
+// Two estimators (kLightSampling* in host_device.h), chosen per dispatch through gLightSampling:
+// - Spatial (default): light i with probability importance_i(P, n) / sum_j importance_j(P, n)
+//   (lightImportance below); on an area light a triangle by area, then a direction uniform in the
+//   triangle's solid angle (Arvo 1995), so the estimator has no 1/r^2 at small emitters; area
+//   sampling only where the solid angle is too small for the spherical warp's float precision or
+//   too large (more than a hemisphere) for it.
+// - Area: the paper's [RTO §4.1]: light i with probability power_i / sum_j power_j, a triangle by
+//   area and a point uniform on it.
+// Both stay linear in every emission: the probabilities use the lights' render-time powers, never
+// the compose-time emissions, and each sample lands in the basis buffer of the light it chose.
 #ifndef OBSCURA_LIGHTS_GLSL
 #define OBSCURA_LIGHTS_GLSL
 
+// The estimator of this dispatch (set by main() from its push constants).
+uint gLightSampling = kLightSamplingSpatial;
+
+// Solid angles between which a triangle is sampled by Arvo's warp [sr]: below, its angles lose
+// float precision (pbrt-v4 uses the same bounds, §6.5.4); above, the triangle covers more than a
+// hemisphere seen from the point.
+const float kMinSphericalSampleArea = 3e-4;
+const float kMaxSphericalSampleArea = 6.22;
 
 struct LightSample {
   uint light;       // index of the light (and of its basis buffer)
@@ -15,8 +35,10 @@ struct LightSample {
   float pdf;        // solid-angle pdf (area lights), or the selection probability (punctual)
 };
 
-// First light whose selection CDF exceeds u (lights with zero power have empty intervals).
-uint selectLight(float u, uint count) {
+// ---- Choosing the light
+
+// First light whose selection CDF by power exceeds u (zero-power lights have empty intervals).
+uint selectLightByPower(float u, uint count) {
   uint lo = 0u, hi = count - 1u;
   while (lo < hi) {
     uint mid = (lo + hi) / 2u;
@@ -34,6 +56,134 @@ uint selectEmitter(float u, uint first, uint count) {
   return lo;
 }
 
+// cos(max(0, A - B)) from the cosines and sines of A and B in [0, pi].
+float cosOfClampedDifference(float cosA, float sinA, float cosB, float sinB) {
+  return cosA >= cosB ? 1.0 : cosA * cosB + sinA * sinB;
+}
+float sinOfClampedDifference(float cosA, float sinA, float cosB, float sinB) {
+  return cosA >= cosB ? 0.0 : sinA * cosB - cosA * sinB;
+}
+
+// An upper bound on the light light i can send to a receiver at p with normal n (facing the side
+// that reflects), up to a common factor: power x cos(theta') x cos(theta_i') / d^2, where theta'
+// is the smallest angle between the light's emission cone and the direction to p, and theta_i'
+// the smallest angle between n and a direction into the light's bounding sphere (Conty Estevez &
+// Kulla, "Importance Sampling of Many Lights with Adaptive Tree Splitting", HPG 2018, eq. 3, as in
+// pbrt-v4's LightBounds::Importance, with a sphere for the box). It is 0 only where the light
+// cannot reach p's reflecting side, so selection by it stays unbiased. Directional lights are
+// not bounded here (lightSelection gives them their own share).
+float lightImportance(uint i, vec3 p, vec3 n) {
+  GpuLight light = lights[i];
+  float power = light.params.y;
+  if (!(power > 0.0)) return 0.0;
+  vec3 toLight = light.position.xyz - p;
+  float d2 = dot(toLight, toLight);
+  float radius = light.info.x == kLightArea ? light.position.w : 0.0;
+  float r2 = radius * radius;
+  if (d2 <= r2 * 1.0001 || d2 == 0.0) return power / max(r2, 1e-12); // p inside the bounds
+  float d = sqrt(d2);
+  vec3 w = toLight / d;
+  // The cone of directions from p into the bounding sphere.
+  float sinB = radius / d, cosB = sqrt(max(0.0, 1.0 - sinB * sinB));
+  // Receiver: the light must be above p's surface.
+  float cosI = dot(n, w), sinI = sqrt(max(0.0, 1.0 - cosI * cosI));
+  float cosIPrime = cosOfClampedDifference(cosI, sinI, cosB, sinB);
+  if (cosIPrime <= 0.0) return 0.0;
+  float importance = power * cosIPrime / d2;
+  uint type = light.info.x;
+  if (type == kLightArea || type == kLightSpot) {
+    // Emitter: the angle between p (seen from the light) and the cone of emission directions.
+    float cosO = type == kLightArea ? light.direction.w : light.params.w;
+    if (cosO > -1.0) {
+      float sinO = sqrt(max(0.0, 1.0 - cosO * cosO));
+      float cosW = dot(light.direction.xyz, -w), sinW = sqrt(max(0.0, 1.0 - cosW * cosW));
+      float cosX = cosOfClampedDifference(cosW, sinW, cosO, sinO);
+      float sinX = sinOfClampedDifference(cosW, sinW, cosO, sinO);
+      float cosPrime = cosOfClampedDifference(cosX, sinX, cosB, sinB);
+      // An area light emits within 90 degrees of its normals; a spot nowhere past its outer cone.
+      if (type == kLightArea ? cosPrime <= 0.0 : cosPrime < 0.99999) return 0.0;
+      importance *= type == kLightArea ? cosPrime : 1.0;
+    }
+  }
+  return importance;
+}
+
+// Directional lights get an equal share of the selection among themselves and the bounded lights
+// as one (pbrt-v4's BVHLightSampler does the same for infinite lights).
+bool useSpatialSelection(uint count) {
+  return gLightSampling == kLightSamplingSpatial && count <= kMaxSpatialLights;
+}
+
+// The probability that the estimator picks light `chosen` at p with normal n.
+float lightSelectionPdf(uint chosen, vec3 p, vec3 n, uint count) {
+  if (!useSpatialSelection(count)) return lights[chosen].params.y;
+  float total = 0.0, mine = 0.0;
+  uint directional = 0u;
+  for (uint i = 0u; i < count; ++i) {
+    if (lights[i].info.x == kLightDirectional) {
+      directional += lights[i].params.y > 0.0 ? 1u : 0u;
+      continue;
+    }
+    float w = lightImportance(i, p, n);
+    total += w;
+    if (i == chosen) mine = w;
+  }
+  float shares = float(directional) + (total > 0.0 ? 1.0 : 0.0);
+  if (shares == 0.0) return 0.0;
+  if (lights[chosen].info.x == kLightDirectional) return lights[chosen].params.y > 0.0 ? 1.0 / shares : 0.0;
+  return total > 0.0 ? mine / total / shares : 0.0;
+}
+
+// Picks a light for p with normal n; selection = its probability (0: no light can light p).
+uint selectLight(float u, vec3 p, vec3 n, uint count, out float selection) {
+  if (!useSpatialSelection(count)) {
+    uint chosen = selectLightByPower(u, count);
+    selection = lights[chosen].params.y;
+    return chosen;
+  }
+  float total = 0.0;
+  uint directional = 0u;
+  for (uint i = 0u; i < count; ++i) {
+    if (lights[i].info.x == kLightDirectional) directional += lights[i].params.y > 0.0 ? 1u : 0u;
+    else total += lightImportance(i, p, n);
+  }
+  float shares = float(directional) + (total > 0.0 ? 1.0 : 0.0);
+  selection = 0.0;
+  if (shares == 0.0) return 0u;
+  // u in [0, directional / shares): the k-th directional light; beyond: bounded lights by importance.
+  float scaled = u * shares;
+  if (scaled < float(directional)) {
+    uint k = min(uint(scaled), directional - 1u);
+    for (uint i = 0u; i < count; ++i) {
+      if (lights[i].info.x != kLightDirectional || !(lights[i].params.y > 0.0)) continue;
+      if (k == 0u) {
+        selection = 1.0 / shares;
+        return i;
+      }
+      --k;
+    }
+    return 0u;
+  }
+  float target = (scaled - float(directional)) * total;
+  float running = 0.0;
+  uint last = 0u;
+  float lastWeight = 0.0;
+  for (uint i = 0u; i < count; ++i) {
+    if (lights[i].info.x == kLightDirectional) continue;
+    float w = lightImportance(i, p, n);
+    if (w <= 0.0) continue;
+    running += w;
+    last = i;
+    lastWeight = w;
+    if (target < running) break;
+  }
+  // Rounding can leave target just past the sum: the last light with weight takes it.
+  selection = lastWeight / total / shares;
+  return last;
+}
+
+// ---- The point on the light
+
 // glTF KHR_lights_punctual: smooth range window and the spot cone's smooth falloff.
 float rangeWindow(float distance, float range) {
   if (range <= 0.0) return 1.0;
@@ -49,17 +199,20 @@ float spotFalloff(GpuLight light, vec3 wi) {
   return t * t;
 }
 
-LightSample sampleChosenLight(vec3 p, vec4 u, uint chosen, float selection);
-
-// One light sample for shading point p: light chosen with probability proportional to power,
-// triangle proportional to area, point uniform on it [SPEC §1.3]. u = 4 uniform numbers.
-LightSample sampleLight(vec3 p, vec4 u, uint lightCount) {
-  uint chosen = selectLight(u.x, lightCount);
-  return sampleChosenLight(p, u, chosen, lights[chosen].params.y);
+// Whether the spatial estimator samples triangle (v0, v1, v2) from p by solid angle; its solid
+// angle in `solidAngle`. The same test decides the pdf of a point reached by BSDF sampling.
+bool sampleBySolidAngle(vec3 p, vec3 v0, vec3 v1, vec3 v2, out vec3 a, out vec3 b, out vec3 c,
+                        out float solidAngle) {
+  a = normalize(v0 - p);
+  b = normalize(v1 - p);
+  c = normalize(v2 - p);
+  solidAngle = sphericalTriangleArea(a, b, c);
+  return gLightSampling == kLightSamplingSpatial && solidAngle >= kMinSphericalSampleArea &&
+         solidAngle <= kMaxSphericalSampleArea;
 }
 
-// A point on light `chosen`, picked with probability `selection` (1 when it is sampled alone):
-// triangle proportional to area, point uniform on it. u.x is not used.
+// A point on light `chosen`, picked with probability `selection` (1 when it is sampled alone);
+// u.yzw: the triangle (by area) and the point on it.
 LightSample sampleChosenLight(vec3 p, vec4 u, uint chosen, float selection) {
   LightSample s;
   s.light = chosen;
@@ -68,25 +221,43 @@ LightSample sampleChosenLight(vec3 p, vec4 u, uint chosen, float selection) {
   s.pdf = 0.0;
   s.infinite = false;
   s.targetNormal = vec3(0.0);
+  s.wi = vec3(0.0, 0.0, 1.0);
+  s.target = p;
+  if (!(selection > 0.0)) return s;
   uint type = light.info.x;
   if (type == kLightArea) {
     uint e = selectEmitter(u.y, light.info.y, light.info.z);
     GpuEmitter em = emitters[e];
     float groupArea = uintBitsToFloat(light.info.w);
-    vec3 y = sampleUniformTriangle(u.zw, em.v0.xyz, em.v1.xyz, em.v2.xyz);
+    float triangleShare = em.v1.w / groupArea; // probability of this triangle
     vec3 ny = normalize(cross(em.v1.xyz - em.v0.xyz, em.v2.xyz - em.v0.xyz));
+    bool front = dot(p - em.v0.xyz, ny) > 0.0;
+    if (!front && em.v2.w == 0.0) return s; // one-sided, seen from behind [SPEC §5]
+    vec3 a, b, c;
+    float solidAngle;
+    if (sampleBySolidAngle(p, em.v0.xyz, em.v1.xyz, em.v2.xyz, a, b, c, solidAngle)) {
+      vec3 w = sampleSphericalTriangle(u.zw, a, b, c);
+      float cosL = abs(dot(ny, w));
+      float t = dot(em.v0.xyz - p, ny) / dot(w, ny); // where w meets the triangle's plane
+      if (!(t > 0.0) || !(cosL > 0.0) || isinf(t)) return s;
+      s.wi = w;
+      s.target = p + t * w;
+      s.targetNormal = front ? ny : -ny;
+      s.pdf = selection * triangleShare / solidAngle;
+      s.weight = em.radiance.rgb / s.pdf;
+      return s;
+    }
+    vec3 y = sampleUniformTriangle(u.zw, em.v0.xyz, em.v1.xyz, em.v2.xyz);
     vec3 d = y - p;
     float dist2 = dot(d, d);
     s.wi = d * inversesqrt(dist2);
-    float cosL = dot(ny, -s.wi);
-    bool emits = cosL > 0.0 || em.v2.w != 0.0; // one-sided unless double-sided [SPEC §5]
+    float cosL = abs(dot(ny, s.wi));
     s.target = y;
-    s.targetNormal = cosL > 0.0 ? ny : -ny;
-    cosL = abs(cosL);
+    s.targetNormal = front ? ny : -ny;
     // Area pdf of the point: selection x (A_tri / A_group) x (1 / A_tri).
     float pdfArea = selection / groupArea;
     s.pdf = pdfArea * dist2 / max(cosL, 1e-20);
-    s.weight = emits && pdfArea > 0.0 && cosL > 0.0 ? em.radiance.rgb * cosL / (dist2 * pdfArea) : vec3(0.0);
+    s.weight = pdfArea > 0.0 && cosL > 0.0 ? em.radiance.rgb * cosL / (dist2 * pdfArea) : vec3(0.0);
   } else if (type == kLightDirectional) {
     s.wi = -light.direction.xyz;
     s.infinite = true;
@@ -104,6 +275,31 @@ LightSample sampleChosenLight(vec3 p, vec4 u, uint chosen, float selection) {
     s.weight = vec3(falloff / (dist2 * selection));
   }
   return s;
+}
+
+// One light sample for shading point p with normal n (the side that reflects): the light, then a
+// point on it (see the header). u = 4 uniform numbers.
+LightSample sampleLight(vec3 p, vec3 n, vec4 u, uint lightCount) {
+  float selection;
+  uint chosen = selectLight(u.x, p, n, lightCount, selection);
+  return sampleChosenLight(p, u, chosen, selection);
+}
+
+// The solid-angle density with which sampleLight(p, n, ...) picks the point y on triangle
+// (v0, v1, v2) of area light `light` (y has |cos| cosL there, squared distance dist2 from p):
+// selection x (A_tri / A_group) x (1 / solid angle, or r^2 / (cos A_tri) where area sampling).
+// For MIS with BSDF sampling; 0 for a light that is never sampled, or not an area light.
+float areaLightPdf(uint light, vec3 p, vec3 n, uint count, vec3 v0, vec3 v1, vec3 v2, float dist2, float cosL) {
+  GpuLight l = lights[light];
+  float groupArea = uintBitsToFloat(l.info.w);
+  if (l.info.x != kLightArea || !(groupArea > 0.0) || !(cosL > 0.0)) return 0.0;
+  float selection = lightSelectionPdf(light, p, n, count);
+  if (!(selection > 0.0)) return 0.0;
+  vec3 a, b, c;
+  float solidAngle;
+  if (sampleBySolidAngle(p, v0, v1, v2, a, b, c, solidAngle))
+    return selection * triangleArea(v0, v1, v2) / groupArea / solidAngle;
+  return selection / groupArea * dist2 / cosL;
 }
 
 #endif

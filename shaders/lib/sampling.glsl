@@ -103,6 +103,45 @@ vec3 sampleUniformTriangle(vec2 u, vec3 v0, vec3 v1, vec3 v2) {
   return (1.0 - r) * v0 + (r * (1.0 - u.y)) * v1 + (r * u.y) * v2;
 }
 
+// ---- Spherical triangles: directions uniform over the solid angle a triangle subtends.
+// a, b, c: unit vectors from the shading point to the vertices.
+
+// Solid angle of the spherical triangle (a, b, c): Van Oosterom & Strackee, "The Solid Angle of a
+// Plane Triangle", IEEE Trans. Biomed. Eng. 30(2), 1983:
+//   tan(Omega / 2) = |a . (b x c)| / (1 + a.b + b.c + c.a)
+// Accurate for small triangles, where the angle-sum formula (alpha + beta + gamma - pi) cancels.
+float sphericalTriangleArea(vec3 a, vec3 b, vec3 c) {
+  return 2.0 * atan(abs(dot(a, cross(b, c))), 1.0 + dot(a, b) + dot(b, c) + dot(c, a));
+}
+
+// Component of v orthogonal to unit w, normalised.
+vec3 orthogonalUnit(vec3 v, vec3 w) { return normalize(v - dot(v, w) * w); }
+
+// A direction uniform over the spherical triangle (a, b, c) (pdf = 1 / its area): Arvo, "Stratified
+// Sampling of Spherical Triangles", SIGGRAPH 1995, §3. u.x picks the sub-triangle (a, b, c') of
+// area u.x * area, which fixes c' on the arc ac; u.y picks the point on the arc from b to c' so
+// that the area swept grows linearly. Callers keep it to triangles whose area is in
+// [kMinSphericalSampleArea, kMaxSphericalSampleArea] (lights.glsl); outside, area sampling.
+vec3 sampleSphericalTriangle(vec2 u, vec3 a, vec3 b, vec3 c) {
+  // The interior angle at a, between the great circles ab and ac, as atan2(|sin|, cos) (acos loses
+  // precision near 0 and pi); the area from Van Oosterom & Strackee rather than the angle sum
+  // alpha + beta + gamma - pi, which cancels for small triangles. The same area is the pdf's.
+  vec3 nab = normalize(cross(a, b)), nac = normalize(cross(a, c));
+  float alpha = atan(length(cross(nab, nac)), dot(nab, nac));
+  float area = sphericalTriangleArea(a, b, c);
+  float areaPrime = u.x * area;
+  float s = sin(areaPrime - alpha), t = cos(areaPrime - alpha);
+  float sinAlpha = sin(alpha), cosAlpha = cos(alpha);
+  float uu = t - cosAlpha;
+  float vv = s + sinAlpha * dot(a, b); // cos(c) = a.b: the arc opposite vertex c
+  float denominator = (vv * s + uu * t) * sinAlpha;
+  float q = denominator != 0.0 ? clamp(((vv * t - uu * s) * cosAlpha - vv) / denominator, -1.0, 1.0) : 1.0;
+  vec3 cPrime = q * a + sqrt(max(0.0, 1.0 - q * q)) * orthogonalUnit(c, a);
+  float z = 1.0 - u.y * (1.0 - dot(cPrime, b));
+  z = clamp(z, -1.0, 1.0);
+  return normalize(z * b + sqrt(max(0.0, 1.0 - z * z)) * orthogonalUnit(cPrime, b));
+}
+
 // ---- GGX (Trowbridge-Reitz) microfacets, isotropic, local frame (z = macro normal).
 // Walter, Marschner, Li & Torrance, "Microfacet Models for Refraction through Rough Surfaces",
 // EGSR 2007 (D); Heitz, "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs",

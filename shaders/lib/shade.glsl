@@ -1,6 +1,6 @@
-// shade.glsl — a shading point and its direct light, shared by the shadow pass (primary hits) and
-// the specular pass (diffuse vertices of specular paths). Needs scene/shading bindings, bvh.glsl,
-// ray.glsl, sampling.glsl, bsdf.glsl, lights.glsl.
+// shade.glsl — a shading point and its direct light, shared by the shadow pass (primary hits),
+// the specular pass (vertices of specular paths) and the path tracer. Needs scene/shading bindings, bvh.glsl,
+// ray.glsl, sampling.glsl, bsdf.glsl, lights.glsl, mis.glsl.
 #ifndef OBSCURA_SHADE_GLSL
 #define OBSCURA_SHADE_GLSL
 
@@ -53,26 +53,48 @@ vec3 obscuranceReflectance(ShadingPoint sp) {
   return sp.glossy ? sp.baseColor * (1.0 - sp.metallic) : sp.baseColor;
 }
 
+// Local-frame versions of wo and wi at sp (z = shading normal).
+void shadingLocal(ShadingPoint sp, vec3 wi, out vec3 woLocal, out vec3 wiLocal) {
+  vec3 t, b;
+  orthonormalBasis(sp.ns, t, b);
+  woLocal = vec3(dot(sp.wo, t), dot(sp.wo, b), dot(sp.wo, sp.ns));
+  wiLocal = vec3(dot(wi, t), dot(wi, b), dot(wi, sp.ns));
+}
+
+// The density with which specular.comp's lobe sample (GGX visible normals, reflected) picks wi
+// at sp; 0 where it cannot: mirrors (a delta), diffuse points, wo or wi below the shading normal.
+float specularLobePdf(ShadingPoint sp, vec3 wi) {
+  if (!sp.glossy || isMirror(sp.roughness)) return 0.0;
+  vec3 woLocal, wiLocal;
+  shadingLocal(sp, wi, woLocal, wiLocal);
+  if (woLocal.z <= 0.0 || wiLocal.z <= 0.0) return 0.0;
+  return ggxReflectionPdf(woLocal, wiLocal, ggxAlpha(sp.roughness));
+}
+
 // One shadow ray: contribution (unit emission, before E_s) and the light it belongs to.
 // Light arriving below the GEOMETRIC surface is dropped, so interpolated normals never leak light
 // through a surface; light above it but below the interpolated shading normal (the terminator of
 // a smooth low-poly mesh) uses |cos| with the shading normal, as pbrt does, so no facet turns
 // black while its geometry faces the light.
-void directLightFrom(ShadingPoint sp, LightSample ls, inout StepBudget budget, out vec3 contribution,
-                     out bool visible);
+//
+// lightSamples > 0: the specular lobe at sp is also sampled once (specular.comp), and this is one
+// of lightSamples light samples; the lobe's part of the BSDF gets the power-heuristic weight
+// [Veach & Guibas 1995] and the diffuse part stays whole (only light sampling covers it).
+void directLightFrom(ShadingPoint sp, LightSample ls, float lightSamples, inout StepBudget budget,
+                     out vec3 contribution, out bool visible);
 
-void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, inout StepBudget budget,
+void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, float lightSamples, inout StepBudget budget,
                        out vec3 contribution, out uint light) {
-  LightSample ls = sampleLight(sp.position, u, lightCount);
+  LightSample ls = sampleLight(sp.position, sp.ng, u, lightCount);
   light = ls.light;
   bool visible;
-  directLightFrom(sp, ls, budget, contribution, visible);
+  directLightFrom(sp, ls, lightSamples, budget, contribution, visible);
 }
 
 // The shadow ray of light sample `ls`; `visible` says whether it reached the light (false also
 // when the light faces away or lies below the surface: nothing to trace).
-void directLightFrom(ShadingPoint sp, LightSample ls, inout StepBudget budget, out vec3 contribution,
-                     out bool visible) {
+void directLightFrom(ShadingPoint sp, LightSample ls, float lightSamples, inout StepBudget budget,
+                     out vec3 contribution, out bool visible) {
   contribution = vec3(0.0);
   visible = false;
   float cosG = dot(sp.ng, ls.wi);
@@ -95,7 +117,17 @@ void directLightFrom(ShadingPoint sp, LightSample ls, inout StepBudget budget, o
   visible = true;
   // The BSDF sees the light mirrored above the shading normal when it lies below it.
   vec3 wiShading = dot(sp.ns, ls.wi) < 0.0 ? reflect(ls.wi, sp.ns) : ls.wi;
-  contribution = shadingBsdf(sp, wiShading) * ls.weight * cosS;
+  vec3 f = shadingBsdf(sp, wiShading);
+  if (lightSamples > 0.0 && ls.targetNormal != vec3(0.0)) { // an area light: the lobe can hit it
+    float lobePdf = specularLobePdf(sp, ls.wi);
+    if (lobePdf > 0.0) {
+      vec3 woLocal, wiLocal;
+      shadingLocal(sp, ls.wi, woLocal, wiLocal);
+      vec3 lobe = evalSpecularLobe(sp.baseColor, sp.metallic, sp.roughness, woLocal, wiLocal);
+      f -= (1.0 - powerHeuristic(lightSamples * ls.pdf, lobePdf)) * lobe;
+    }
+  }
+  contribution = f * ls.weight * cosS;
 }
 
 #endif

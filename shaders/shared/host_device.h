@@ -99,9 +99,24 @@ OBS_CONST uint kLightPoint = 1u;
 OBS_CONST uint kLightSpot = 2u;
 OBS_CONST uint kLightDirectional = 3u;
 
+// How a shadow ray picks its light and its point (lights.glsl) [SPEC §1.3]:
+// - Spatial (the default): the light by its importance at the shading point (power, distance and
+//   orientation bounds, after Conty Estevez & Kulla 2018), the point on a triangle uniform in solid
+//   angle (Arvo 1995), and MIS with BSDF sampling of glossy lobes;
+// - Area: the paper's estimator [RTO §4.1]: the light by power, the point uniform by area.
+OBS_CONST uint kLightSamplingSpatial = 0u;
+OBS_CONST uint kLightSamplingArea = 1u;
+// Spatial selection evaluates every light's importance per sample; with more lights than this it
+// falls back to selection by power (a light BVH would lift the limit; lavapipe's loop limiter
+// counts each light visited).
+OBS_CONST uint kMaxSpatialLights = 64u;
+
 struct GpuLight {
-  vec4 position;  // 0:  point/spot: world position, w = range (0 = infinite)
-  vec4 direction; // 16: spot/directional: unit direction the light travels, w = unused
+  vec4 position;  // 0:  point/spot: world position, w = range (0 = infinite); area: centre of the
+                  //     emitters' bounding sphere, w = its radius (light importance, lights.glsl)
+  vec4 direction; // 16: spot/directional: unit direction the light travels; area: axis of the
+                  //     cone holding every emitter's normal, w = cos of its half-angle (-1: any
+                  //     direction, e.g. a double-sided emitter)
   uvec4 info;     // 32: type, first emitter, emitter count (area), group area (float bits)
   vec4 params;    // 48: x = selection CDF (up to and including this light), y = selection
                   //     probability, z = cos inner cone, w = cos outer cone
@@ -202,6 +217,11 @@ OBS_CONST uint kStatusWords = 8;
 // ---- Shading passes (shadow.comp, obscurance.comp): push constants.
 OBS_CONST uint kFlagSystematic = 1u; // obscurance rays by systematic sampling [RTO §4.2]
 OBS_CONST uint kFlagBleed = 2u;      // colour bleeding: W_c instead of W [RTO eq. 6]
+OBS_CONST uint kFlagAreaLightSampling = 4u; // the paper's light sampling (kLightSamplingArea)
+// Glossy vertices share their specular lobe between light sampling (N_s shadow rays) and the
+// specular pass's lobe sample, weighted by the power heuristic; set when the specular pass runs
+// and the light sampling is spatial with selection over all lights.
+OBS_CONST uint kFlagGlossyMis = 8u;
 OBS_CONST uint kRhoSqrt = 0u;        // rho(d) = sqrt(d / dmax)          [RTO §3, SPEC §1.1]
 OBS_CONST uint kRhoExp = 1u;         // rho(d) = (1 - e^(-tau d/dmax)) / (1 - e^(-tau))
 OBS_CONST uint kRhoAo = 2u;          // rho(d) = 0 below dmax (ambient occlusion)
@@ -261,7 +281,7 @@ struct PathPush {
   GpuCamera camera; // 0: camera.right.w = scene size (scales the ray-origin offset, ray.glsl)
   uvec4 frame;      // 64: width, height, sample index, seed
   uvec4 params;     // 80: light count (0 = no light with power), max depth d, RR depth, strategy
-  uvec4 band;       // 96: first row, rows, unused, unused (see "Frame bands")
+  uvec4 band;       // 96: first row, rows, light sampling (kLightSampling*), unused
 };                  // 112 bytes
 OBS_CONST uint kPathStrategyMis = 0u;       // MIS of light and BSDF sampling (the reference)
 OBS_CONST uint kPathStrategyLightOnly = 1u; // area lights by light sampling only (tests)

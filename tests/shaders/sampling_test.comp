@@ -17,6 +17,8 @@ const uint kModeSystematic = 1u; // floor(64 / n) hits of n rays, one random off
 const uint kModeGrid = 2u;       // systematicGrid(n) in r[0].xy
 const uint kModeTriangle = 3u;   // 64 points on triangle (a, b, c): xyz, w = area
 const uint kModeWarps = 4u;      // deterministic warps of the inputs, see main()
+const uint kModeSpherical = 5u;  // 64 directions uniform over the spherical triangle of unit a, b, c:
+                                 // xyz, w = its solid angle; with mode.y = 1, a.w b.w c.w = u (one warp)
 const uint kOutPerCase = 64u;
 
 layout(std430, binding = 0) readonly buffer Cases { SamplingCase cases[]; };
@@ -49,6 +51,16 @@ void main() {
     for (uint k = 0u; k < kOutPerCase; ++k) {
       vec2 u = vec2(rngNext(state), rngNext(state));
       results[base + k] = vec4(sampleUniformTriangle(u, c.a.xyz, c.b.xyz, c.c.xyz), area);
+    }
+  } else if (c.mode.x == kModeSpherical) {
+    float area = sphericalTriangleArea(c.a.xyz, c.b.xyz, c.c.xyz);
+    if (c.mode.y == 1u) {
+      results[base] = vec4(sampleSphericalTriangle(vec2(c.a.w, c.b.w), c.a.xyz, c.b.xyz, c.c.xyz), area);
+      return;
+    }
+    for (uint k = 0u; k < kOutPerCase; ++k) {
+      vec2 u = vec2(rngNext(state), rngNext(state));
+      results[base + k] = vec4(sampleSphericalTriangle(u, c.a.xyz, c.b.xyz, c.c.xyz), area);
     }
   } else if (c.mode.x == kModeWarps) {
     // a.xy = u, a.zw = systematic offset, b.xyz = normal, c.xyz = local direction.

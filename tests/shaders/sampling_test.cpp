@@ -18,13 +18,15 @@
 namespace obscura::test {
 
 namespace {
+constexpr double kPi = 3.14159265358979323846;
 
 struct SamplingCase {
   glm::uvec4 mode; // x = mode, y = n, z = seed, w = ray index
   glm::vec4 a, b, c;
 };
 static_assert(sizeof(SamplingCase) == 64);
-constexpr std::uint32_t kModeCosine = 0, kModeSystematic = 1, kModeGrid = 2, kModeTriangle = 3, kModeWarps = 4;
+constexpr std::uint32_t kModeCosine = 0, kModeSystematic = 1, kModeGrid = 2, kModeTriangle = 3, kModeWarps = 4,
+                        kModeSpherical = 5;
 constexpr std::size_t kOutPerCase = 64;
 struct SamplingResult {
   std::array<glm::vec4, kOutPerCase> v;
@@ -154,6 +156,34 @@ TEST_F(SamplingShader, SystematicPutsOneRayInEachCell) {
   }
 }
 
+// The triangle split by a k x k grid of its barycentrics into k^2 congruent sub-triangles: the
+// index of the one holding barycentrics (b1, b2) of vertices 1 and 2. Row j holds 2 (k - j) - 1
+// sub-triangles, "up" ones at even positions and the "down" ones between them.
+int subTriangleCell(double b1, double b2, int k) {
+  double x = std::clamp(b1 * k, 0.0, k - 1e-9), y = std::clamp(b2 * k, 0.0, k - 1e-9);
+  int i = int(x), j = int(y);
+  bool up = (x - i) + (y - j) < 1.0;
+  int row = 0;
+  for (int jj = 0; jj < j; ++jj) row += 2 * (k - jj) - 1;
+  return std::min(row + 2 * i + (up ? 0 : 1), k * k - 1);
+}
+
+// The corners of sub-triangle `cell` (subTriangleCell's numbering) of triangle (v0, v1, v2).
+std::array<glm::dvec3, 3> subTriangle(int cell, int k, glm::dvec3 v0, glm::dvec3 v1, glm::dvec3 v2) {
+  auto at = [&](int i, int j) { return v0 + (double(i) / k) * (v1 - v0) + (double(j) / k) * (v2 - v0); };
+  int j = 0, row = 0;
+  while (cell >= row + 2 * (k - j) - 1) row += 2 * (k - j++) - 1;
+  int offset = cell - row, i = offset / 2;
+  if (offset % 2 == 0) return {at(i, j), at(i + 1, j), at(i, j + 1)};
+  return {at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
+}
+
+// Solid angle of a triangle seen from the origin, in double (Van Oosterom & Strackee 1983).
+double solidAngle(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+  a = glm::normalize(a), b = glm::normalize(b), c = glm::normalize(c);
+  return 2.0 * std::atan2(std::abs(glm::dot(a, glm::cross(b, c))), 1.0 + glm::dot(a, b) + glm::dot(b, c) + glm::dot(c, a));
+}
+
 // 10^6 points on a skewed triangle in 3-D, binned in its 8^2 congruent sub-triangles (equal areas).
 TEST_F(SamplingShader, UniformTriangleChiSquare) {
   const glm::vec3 v0(0.3f, -1.0f, 2.0f), v1(4.0f, 0.5f, 1.0f), v2(-1.0f, 2.0f, -0.5f);
@@ -173,14 +203,7 @@ TEST_F(SamplingShader, UniformTriangleChiSquare) {
       double b1 = (a22 * r1 - a12 * r2) / det, b2 = (a11 * r2 - a12 * r1) / det; // barycentrics of v1, v2
       maxOffPlane = std::max(maxOffPlane, glm::length(d - b1 * e1 - b2 * e2));
       minBary = std::min({minBary, b1, b2, 1.0 - b1 - b2});
-      double x = std::clamp(b1 * k, 0.0, k - 1e-9), y = std::clamp(b2 * k, 0.0, k - 1e-9);
-      int i = int(x), j = int(y);
-      bool up = (x - i) + (y - j) < 1.0;
-      // Row j holds 2 (k - j) - 1 sub-triangles; i indexes them left to right, down ones between.
-      int row = 0;
-      for (int jj = 0; jj < j; ++jj) row += 2 * (k - jj) - 1;
-      int cell = row + 2 * i + (up ? 0 : 1);
-      observed[std::min(cell, k * k - 1)] += 1.0;
+      observed[subTriangleCell(b1, b2, k)] += 1.0;
       ++count;
     }
   EXPECT_LT(maxOffPlane, 1e-5);
@@ -191,6 +214,96 @@ TEST_F(SamplingShader, UniformTriangleChiSquare) {
   EXPECT_TRUE(chi.passed()) << "chi2 = " << chi.value << ", dof " << chi.dof << ", threshold " << chi.threshold;
   std::printf("[ chi2     ] uniform triangle: %.1f (dof %d, threshold %.1f at p = 1e-4)\n", chi.value, chi.dof,
               chi.threshold);
+}
+
+// Directions uniform in solid angle over spherical triangles (Arvo 1995) [SPEC §1.3]: 640,000
+// directions per triangle, binned by where they cross the flat triangle into its 6^2 sub-triangles,
+// each expected in proportion to its own solid angle (double precision); a triangle seen head on,
+// one covering most of a hemisphere, and a sliver seen at a grazing angle (the adjacent facets of
+// a tessellated light). The solid angle matches the analytic octant's pi / 2.
+TEST_F(SamplingShader, SphericalTriangleChiSquare) {
+  struct Case {
+    const char* name;
+    glm::dvec3 v0, v1, v2; // seen from the origin
+  };
+  const Case cases[] = {
+      {"octant", {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+      {"near hemisphere", {4, -3, 0.2}, {-4, -3, 0.2}, {0, 5, 0.2}},
+      {"grazing sliver", {1, 1, 0.02}, {3, 1, 0.02}, {2, 3, 0.02}},
+  };
+  const int k = 6;
+  for (const Case& c : cases) {
+    glm::vec4 a(glm::normalize(glm::vec3(c.v0)), 0), b(glm::normalize(glm::vec3(c.v1)), 0), cc(glm::normalize(glm::vec3(c.v2)), 0);
+    auto results = runMode(kModeSpherical, 0, 640'000 / kOutPerCase, a, b, cc);
+    const double total = solidAngle(c.v0, c.v1, c.v2);
+    const glm::dvec3 n = glm::cross(c.v1 - c.v0, c.v2 - c.v0);
+    const glm::dvec3 e1 = c.v1 - c.v0, e2 = c.v2 - c.v0;
+    const double a11 = glm::dot(e1, e1), a12 = glm::dot(e1, e2), a22 = glm::dot(e2, e2), det = a11 * a22 - a12 * a12;
+    std::vector<double> observed(k * k, 0.0), expected(k * k, 0.0);
+    std::size_t count = 0, outside = 0;
+    for (const auto& r : results)
+      for (const auto& v : r.v) {
+        EXPECT_NEAR(v.w, total, 1e-4 * total) << c.name; // float inputs; the sliver cancels most
+        glm::dvec3 w = glm::dvec3(glm::vec3(v));
+        EXPECT_NEAR(glm::length(w), 1.0, 1e-5) << c.name;
+        glm::dvec3 y = w * (glm::dot(c.v0, n) / glm::dot(w, n)); // where w crosses the triangle's plane
+        glm::dvec3 d = y - c.v0;
+        double r1 = glm::dot(d, e1), r2 = glm::dot(d, e2);
+        double b1 = (a22 * r1 - a12 * r2) / det, b2 = (a11 * r2 - a12 * r1) / det;
+        if (std::min({b1, b2, 1.0 - b1 - b2}) < -1e-4) ++outside;
+        observed[subTriangleCell(b1, b2, k)] += 1.0;
+        ++count;
+      }
+    double sum = 0.0;
+    for (int cell = 0; cell < k * k; ++cell) {
+      auto t = subTriangle(cell, k, c.v0, c.v1, c.v2);
+      expected[cell] = solidAngle(t[0], t[1], t[2]);
+      sum += expected[cell];
+    }
+    EXPECT_NEAR(sum, total, 1e-9 * total) << c.name << ": the sub-triangles must tile the triangle";
+    for (double& e : expected) e *= double(count) / sum;
+    EXPECT_LE(outside, count / 100000) << c.name << ": directions must lie in the triangle";
+    ChiSquare chi = chiSquareTest(observed, expected);
+    EXPECT_TRUE(chi.passed()) << c.name << ": chi2 = " << chi.value << ", dof " << chi.dof << ", threshold " << chi.threshold;
+    std::printf("[ chi2     ] spherical triangle, %s (%.4g sr): %.1f (dof %d, threshold %.1f at p = 1e-4)\n", c.name,
+                total, chi.value, chi.dof, chi.threshold);
+  }
+  EXPECT_NEAR(render::sphericalTriangleArea({1, 0, 0}, {0, 1, 0}, {0, 0, 1}), kPi / 2.0, 1e-6);
+}
+
+// GPU == CPU twin for Arvo's warp on random triangles around the origin.
+TEST_F(SamplingShader, SphericalTriangleWarpMatchesCpu) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  std::normal_distribution<float> normal;
+  std::vector<SamplingCase> cases;
+  while (cases.size() < 4000) {
+    glm::vec3 v[3];
+    for (auto& x : v) x = glm::normalize(glm::vec3(normal(rng), normal(rng), normal(rng)));
+    float area = render::sphericalTriangleArea(v[0], v[1], v[2]);
+    if (area < 3e-4f || area > 6.22f) continue; // the range lights.glsl samples this way
+    cases.push_back({{kModeSpherical, 1u, 0u, 0u}, glm::vec4(v[0], uni(rng)), glm::vec4(v[1], uni(rng)), glm::vec4(v[2], 0)});
+  }
+  auto gpu = run(cases);
+  std::vector<double> differences;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const auto& c = cases[i];
+    glm::vec3 w = render::sampleSphericalTriangle({c.a.w, c.b.w}, glm::vec3(c.a), glm::vec3(c.b), glm::vec3(c.c));
+    EXPECT_NEAR(gpu[i].v[0].w, render::sphericalTriangleArea(glm::vec3(c.a), glm::vec3(c.b), glm::vec3(c.c)),
+                5e-5f * gpu[i].v[0].w + 1e-6f) << i; // lavapipe's atan: ~2e-5 relative
+    differences.push_back(glm::length(glm::vec3(gpu[i].v[0]) - w));
+  }
+  // lavapipe's atan, sin and cos are not libm's. Most warps agree to float precision; for a tiny
+  // u.x (a sliver sub-triangle at vertex a) Arvo's q is ill-conditioned in float on both sides,
+  // and the two land up to a few milliradians apart, still inside the triangle (the chi-square
+  // test above checks the distribution).
+  std::sort(differences.begin(), differences.end());
+  const double median = differences[differences.size() / 2], p99 = differences[differences.size() * 99 / 100];
+  EXPECT_LT(median, 1e-5);
+  EXPECT_LT(p99, 1e-3);
+  EXPECT_LT(differences.back(), 2e-2);
+  std::printf("[ twin     ] spherical triangle warp, GPU vs CPU: median %.2g, 99%% %.2g, largest %.2g\n", median, p99,
+              differences.back());
 }
 
 // GPU == CPU twin for the deterministic warps; invertCosineHemisphereSample undoes

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -30,6 +31,46 @@ float projectedBoxArea(const scene::Bounds& b, const glm::vec3& direction) {
   glm::vec3 e = b.extent();
   glm::vec3 d = glm::abs(direction);
   return d.x * e.y * e.z + d.y * e.x * e.z + d.z * e.x * e.y;
+}
+
+// The bounds lights.glsl's importance needs of an area light: the bounding sphere of its
+// triangles (position = centre, w = radius) and the cone holding their normals (direction = axis,
+// w = cos of its half-angle; -1 when the normals span too much or a triangle emits both ways).
+void setAreaLightBounds(gpu::GpuLight& light, const std::vector<gpu::GpuEmitter>& emitters, std::size_t first) {
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  glm::vec3 axis(0.0f);
+  bool twoSided = false;
+  for (std::size_t i = first; i < emitters.size(); ++i) {
+    const auto& e = emitters[i];
+    for (const glm::vec3 v : {glm::vec3(e.v0), glm::vec3(e.v1), glm::vec3(e.v2)}) {
+      lo = glm::min(lo, v);
+      hi = glm::max(hi, v);
+    }
+    axis += glm::cross(glm::vec3(e.v1) - glm::vec3(e.v0), glm::vec3(e.v2) - glm::vec3(e.v0)); // 2 x area x normal
+    twoSided = twoSided || e.v2.w != 0.0f;
+  }
+  if (first == emitters.size()) return;
+  glm::vec3 centre = 0.5f * (lo + hi);
+  float radius = 0.0f;
+  for (std::size_t i = first; i < emitters.size(); ++i)
+    for (const glm::vec3 v : {glm::vec3(emitters[i].v0), glm::vec3(emitters[i].v1), glm::vec3(emitters[i].v2)})
+      radius = std::max(radius, glm::length(v - centre));
+  light.position = glm::vec4(centre, radius * 1.001f + 1e-6f); // a hair larger: rounding stays inside
+  float length = glm::length(axis);
+  float cosCone = -1.0f;
+  if (!twoSided && length > 0.0f) {
+    axis /= length;
+    cosCone = 1.0f;
+    for (std::size_t i = first; i < emitters.size(); ++i) {
+      const auto& e = emitters[i];
+      glm::vec3 n = glm::cross(glm::vec3(e.v1) - glm::vec3(e.v0), glm::vec3(e.v2) - glm::vec3(e.v0));
+      float l = glm::length(n);
+      if (l > 0.0f) cosCone = std::min(cosCone, glm::dot(axis, n / l));
+    }
+    // A little slack for rounding; a cone past 90 degrees bounds nothing useful.
+    cosCone = cosCone > 0.0f ? std::max(0.0f, cosCone - 1e-4f) : -1.0f;
+  }
+  light.direction = glm::vec4(length > 0.0f ? axis : glm::vec3(0.0f, 0.0f, 1.0f), cosCone);
 }
 
 } // namespace
@@ -74,6 +115,7 @@ LightSet buildLightSet(const scene::Scene& scene) {
       set.emitters[i].v0.w = area > 0.0f ? set.emitters[i].v0.w / area : 0.0f;
     if (!set.emitters.empty() && set.emitters.size() > first) set.emitters.back().v0.w = 1.0f;
     light.info.w = std::bit_cast<std::uint32_t>(area); // the group's area, for the sample pdf
+    setAreaLightBounds(light, set.emitters, first);
     set.lights.push_back(light);
     set.names.push_back(group.name);
     set.emission.push_back(scale);

@@ -15,6 +15,11 @@
 
 namespace obscura::render {
 
+// How shadow rays pick a light and a point on it (shaders/lib/lights.glsl) [SPEC §1.3]: Spatial
+// (the default: importance at the point, solid angle, MIS on glossy lobes) or Area (the paper's:
+// by power, uniform by area), kept for reproducing the paper.
+enum class LightSampling : std::uint32_t { Spatial = gpu::kLightSamplingSpatial, Area = gpu::kLightSamplingArea };
+
 struct LightSet {
   std::vector<gpu::GpuLight> lights;     // selection CDF filled in; probability 0 = never sampled
   std::vector<gpu::GpuEmitter> emitters; // area lights' triangles, grouped per light
