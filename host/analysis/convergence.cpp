@@ -4,19 +4,28 @@
 
 namespace obscura::render {
 
-double rmseOf(const CurvePoint& p, ErrorKind kind) {
-  return kind == ErrorKind::Noise ? p.rmseNoise : p.rmseReference;
+double errorOf(const ImageError& e, Metric metric) {
+  switch (metric) {
+  case Metric::RmseTrimmed: return e.rmseTrimmed;
+  case Metric::Mae: return e.mae;
+  case Metric::Rmse: break;
+  }
+  return e.rmse;
 }
 
-TimeAt timeToReach(const Curve& curve, double target, ErrorKind kind) {
+double errorOf(const CurvePoint& p, ErrorKind kind, Metric metric) {
+  return errorOf(kind == ErrorKind::Noise ? p.noise : p.total, metric);
+}
+
+TimeAt timeToReach(const Curve& curve, double target, ErrorKind kind, Metric metric) {
   TimeAt out;
   if (curve.points.empty() || target <= 0.0) return out;
   const auto& first = curve.points.front();
-  if (rmseOf(first, kind) <= target) return {.ms = first.gpuMs, .extrapolated = false, .valid = true};
+  if (errorOf(first, kind, metric) <= target) return {.ms = first.gpuMs, .extrapolated = false, .valid = true};
   for (std::size_t i = 1; i < curve.points.size(); ++i) {
     const auto& a = curve.points[i - 1];
     const auto& b = curve.points[i];
-    double ea = rmseOf(a, kind), eb = rmseOf(b, kind);
+    double ea = errorOf(a, kind, metric), eb = errorOf(b, kind, metric);
     if (eb > target) continue;
     // log-log interpolation between a and b.
     double la = std::log(ea), lb = std::log(eb), lt = std::log(target);
@@ -25,9 +34,9 @@ TimeAt timeToReach(const Curve& curve, double target, ErrorKind kind) {
     return {.ms = ms, .extrapolated = false, .valid = true};
   }
   const auto& last = curve.points.back();
-  double e = rmseOf(last, kind);
+  double e = errorOf(last, kind, metric);
   if (e <= 0.0) return out;
-  // RMSE ~ t^(-1/2): t = t_last (e / target)^2.
+  // error ~ t^(-1/2): t = t_last (e / target)^2.
   return {.ms = last.gpuMs * (e / target) * (e / target), .extrapolated = true, .valid = true};
 }
 

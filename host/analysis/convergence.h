@@ -1,8 +1,10 @@
 // convergence.h — speed against error [SPEC §4]: error curves of several methods over GPU time
-// and the figures drawn from them (equal-noise speed-up, bias floor).
+// and the figures drawn from them (equal-noise speed-up, bias floor, crossover).
 #pragma once
 #include <string>
 #include <vector>
+
+#include "analysis/image_error.h"
 
 namespace obscura::render {
 
@@ -10,10 +12,8 @@ struct CurvePoint {
   unsigned spp = 0;            // primary samples per pixel
   double raysPerPixel = 0.0;   // rays of every kind traced per pixel
   double gpuMs = 0.0;          // GPU time of the render (all passes)
-  double rmseNoise = 0.0;      // against the same method converged: noise
-  double relMseNoise = 0.0;
-  double rmseReference = 0.0;  // against converged path tracing: bias + noise
-  double relMseReference = 0.0;
+  ImageError noise;            // against the same method converged
+  ImageError total;            // against converged path tracing: bias + noise
 };
 
 struct Curve {
@@ -22,6 +22,8 @@ struct Curve {
 };
 
 enum class ErrorKind { Noise, AgainstReference };
+// Which error measure a figure is read in (image_error.h).
+enum class Metric { Rmse, RmseTrimmed, Mae };
 
 struct TimeAt {
   double ms = 0.0;
@@ -29,11 +31,12 @@ struct TimeAt {
   bool valid = false;
 };
 
-// GPU time at which the curve's RMSE falls to `target`: interpolated linearly in log-log between
-// the two measured points around it; past the last point, extrapolated along RMSE ~ time^(-1/2),
-// the Monte Carlo rate of an unbiased estimator (only meaningful for noise).
-TimeAt timeToReach(const Curve& curve, double target, ErrorKind kind);
+double errorOf(const CurvePoint& p, ErrorKind kind, Metric metric = Metric::Rmse);
+double errorOf(const ImageError& e, Metric metric);
 
-double rmseOf(const CurvePoint& p, ErrorKind kind);
+// GPU time at which the curve's error falls to `target`: interpolated linearly in log-log between
+// the two measured points around it; past the last point, extrapolated along error ~ time^(-1/2),
+// the Monte Carlo rate of an unbiased estimator (only meaningful for noise).
+TimeAt timeToReach(const Curve& curve, double target, ErrorKind kind, Metric metric = Metric::Rmse);
 
 } // namespace obscura::render

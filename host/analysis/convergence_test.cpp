@@ -11,8 +11,9 @@ Curve monteCarloCurve() {
   // RMSE = 1 / sqrt(t): an unbiased estimator.
   Curve c{.method = "pt", .points = {}};
   for (double t : {1.0, 4.0, 16.0, 64.0})
-    c.points.push_back({.spp = 1, .raysPerPixel = 1, .gpuMs = t, .rmseNoise = 1.0 / std::sqrt(t),
-                        .relMseNoise = 0, .rmseReference = 1.0 / std::sqrt(t), .relMseReference = 0});
+    c.points.push_back({.spp = 1, .raysPerPixel = 1, .gpuMs = t,
+                        .noise = {.rmse = 1.0 / std::sqrt(t), .mae = 0.5 / std::sqrt(t)},
+                        .total = {.rmse = 1.0 / std::sqrt(t)}});
   return c;
 }
 
@@ -21,6 +22,8 @@ TEST(Convergence, InterpolatesInLogLog) {
   ASSERT_TRUE(t.valid);
   EXPECT_FALSE(t.extrapolated);
   EXPECT_NEAR(t.ms, 8.0, 1e-9);
+  // The same curve read in another measure.
+  EXPECT_NEAR(timeToReach(monteCarloCurve(), 0.5 / std::sqrt(8.0), ErrorKind::Noise, Metric::Mae).ms, 8.0, 1e-9);
 }
 
 TEST(Convergence, ExtrapolatesAtTheMonteCarloRate) {

@@ -1,10 +1,20 @@
 // obscura converge SCENE -o DIR — speed against error [SPEC §4]. Renders converged references
 // (cached as EXR in DIR, each with a .txt naming the command and settings that made it), then
-// each method at increasing sample counts, recording GPU time and the error against (a) the same
-// method converged (noise) and (b) converged path tracing (bias + noise). Writes a CSV, a log-log
-// plot (tools/plot_convergence.py) and prints the equal-noise speed-up of obscurances over path
-// tracing at the paper's budget, the obscurance bias floor, and when path tracing beats it.
+// each method at increasing sample counts, recording GPU time and the error against (a) the
+// converged obscurance image (noise) and (b) converged path tracing (bias + noise), in RMSE and in
+// two robust measures (image_error.h). Writes a CSV, a log-log plot (tools/plot_convergence.py),
+// the obscurance image at the paper's budget beside path tracing at equal GPU time (PNG), and
+// prints for each obscurance method: the equal-noise speed-up over path tracing, the error
+// against converged path tracing against time, the bias floor, and the crossover time after
+// which path tracing's error is lower.
+//
+// Every obscurance method estimates the same image (ray counts and light sampling change the
+// noise, not the expectation), so one converged obscurance render, made with the best
+// estimators, is the noise reference of all of them.
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <map>
 #include <filesystem>
 #include <memory>
 #include <fstream>
@@ -29,7 +39,7 @@ namespace fs = std::filesystem;
 struct ConvergeOptions {
   std::string scenePath;
   std::string outputDir;
-  std::uint32_t width = 128;
+  std::uint32_t width = 256; // per-pixel noise as a user sees it
   std::uint32_t obscuranceMaxSpp = 16;
   std::uint32_t pathMaxSpp = 256;
   std::uint32_t referenceFactor = 64;   // a reference has this many times the largest curve's spp
@@ -42,20 +52,25 @@ struct ConvergeOptions {
 struct Method {
   std::string name;
   bool pathTrace = false;
-  render::RhoKind rho = render::RhoKind::Sqrt;
-  bool systematic = true;
-};
-
-const std::vector<Method> kMethods = {
-    {"obscurance-systematic-sqrt", false, render::RhoKind::Sqrt, true},
-    {"obscurance-random-sqrt", false, render::RhoKind::Sqrt, false},
-    {"obscurance-systematic-ao", false, render::RhoKind::Ao, true},
-    {"obscurance-random-ao", false, render::RhoKind::Ao, false},
-    {"pathtrace", true, render::RhoKind::Sqrt, true},
+  render::LightSampling lightSampling = render::LightSampling::Spatial;
+  std::uint32_t raysPerHit = 5;   // shadow and obscurance rays per hit (obscurance methods)
+  std::uint32_t budgetSpp = 8;    // the budget its summary is read at
+  std::string what;
 };
 
 // The paper's budget [RTO §4.1]: 8 primary samples x (5 obscurance + 5 shadow rays) per hit.
 constexpr std::uint32_t kPaperSpp = 8, kPaperRays = 5;
+
+// Each method with its best estimators, the paper's estimator for reproduction, and a real-time
+// budget (one primary sample with 1 + 1 rays per hit). Path tracing comes last.
+const std::vector<Method> kMethods = {
+    {"obscurance", false, render::LightSampling::Spatial, kPaperRays, kPaperSpp,
+     "spatial light sampling, 5+5 rays per hit, 8 spp (the paper's budget)"},
+    {"obscurance-paper", false, render::LightSampling::Area, kPaperRays, kPaperSpp,
+     "the paper's light sampling (by power, by area), 5+5 rays per hit, 8 spp"},
+    {"obscurance-realtime", false, render::LightSampling::Spatial, 1, 1, "spatial, 1+1 rays per hit, 1 spp"},
+    {"pathtrace", true, render::LightSampling::Spatial, 0, 1, "path tracing, NEE with spatial light sampling + MIS"},
+};
 
 struct Rendered {
   io::Image image;
@@ -80,7 +95,8 @@ public:
     Rendered r;
     const render::RenderStats* stats = nullptr;
     if (m.pathTrace) {
-      render::PathTraceSettings s{.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_};
+      render::PathTraceSettings s{.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_,
+                                  .lightSampling = m.lightSampling};
       if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, loaded_.scene, loaded_.bvh, s);
       pathTracer_->configure(s);
       pathTracer_->render();
@@ -93,10 +109,9 @@ public:
       s.spp = spp;
       s.seed = seed;
       s.camera = camera_;
-      s.shadowRays = kPaperRays;
-      s.obscuranceRays = kPaperRays;
-      s.rho = m.rho;
-      s.systematic = m.systematic;
+      s.shadowRays = m.raysPerHit;
+      s.obscuranceRays = m.raysPerHit;
+      s.lightSampling = m.lightSampling;
       if (!obscurance_)
         obscurance_ = std::make_unique<render::ObscuranceRenderer>(context_, loaded_.scene, loaded_.bvh, s);
       obscurance_->configure(s);
@@ -121,8 +136,9 @@ public:
     fs::path exr = fs::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
     fs::path txt = exr;
     txt.replace_extension(".txt");
-    std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} shadow_rays={} obs_rays={}",
-                                          o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, kPaperRays, kPaperRays);
+    std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} light_sampling={}",
+                                          o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
+                                          m.lightSampling == render::LightSampling::Area ? "area" : "spatial");
     if (fs::exists(exr) && fs::exists(txt)) {
       std::ifstream in(txt);
       std::string first;
@@ -180,65 +196,102 @@ void runConverge(const ConvergeOptions& o) {
   fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
   Study study(o, loaded, context);
 
-  std::map<std::string, io::Image> references;
-  for (const auto& m : kMethods) references[m.name] = study.reference(m);
-  const io::Image& ptReference = references.at("pathtrace");
+  const Method& best = kMethods.front();
+  const Method& pathMethod = kMethods.back();
+  const io::Image obscuranceReference = study.reference(best);
+  const io::Image ptReference = study.reference(pathMethod);
 
   std::vector<render::Curve> curves;
+  std::map<std::string, io::Image> atBudget; // each method's image at its budget
   const fs::path csvPath = fs::path(o.outputDir) / (study.stem() + ".convergence.csv");
   std::ofstream csv(csvPath);
-  csv << "method,spp,rays_per_pixel,gpu_ms,rmse_noise,relmse_noise,rmse_vs_pathtrace,relmse_vs_pathtrace\n";
+  csv << "method,spp,rays_per_pixel,gpu_ms,rmse_noise,relmse_noise,mae_noise,rmse_trimmed_noise,"
+         "rmse_vs_pathtrace,relmse_vs_pathtrace,mae_vs_pathtrace,rmse_trimmed_vs_pathtrace\n";
   for (const auto& m : kMethods) {
     render::Curve curve{.method = m.name, .points = {}};
     std::uint32_t maxSpp = m.pathTrace ? o.pathMaxSpp : o.obscuranceMaxSpp;
     for (std::uint32_t spp = 1; spp <= maxSpp; spp *= 2) {
       Rendered r = study.render(m, spp, o.seed + spp);
-      render::ImageError noise = render::imageError(r.image, references.at(m.name));
-      render::ImageError total = render::imageError(r.image, ptReference);
-      render::CurvePoint p{.spp = spp, .raysPerPixel = r.rays, .gpuMs = r.gpuMs, .rmseNoise = noise.rmse,
-                           .relMseNoise = noise.relMse, .rmseReference = total.rmse, .relMseReference = total.relMse};
+      render::CurvePoint p{.spp = spp, .raysPerPixel = r.rays, .gpuMs = r.gpuMs,
+                           .noise = render::imageError(r.image, m.pathTrace ? ptReference : obscuranceReference),
+                           .total = render::imageError(r.image, ptReference)};
+      if (spp == m.budgetSpp) atBudget[m.name] = r.image;
       curve.points.push_back(p);
-      csv << fmt::format("{},{},{:.2f},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g}\n", m.name, spp, p.raysPerPixel, p.gpuMs,
-                         p.rmseNoise, p.relMseNoise, p.rmseReference, p.relMseReference);
-      fmt::print("{:28s} spp {:4d}  {:8.1f} rays/px  {:9.1f} ms  noise RMSE {:.5f}  vs PT RMSE {:.5f}\n", m.name, spp,
-                 p.raysPerPixel, p.gpuMs, p.rmseNoise, p.rmseReference);
+      csv << fmt::format("{},{},{:.2f},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", m.name, spp,
+                         p.raysPerPixel, p.gpuMs, p.noise.rmse, p.noise.relMse, p.noise.mae, p.noise.rmseTrimmed,
+                         p.total.rmse, p.total.relMse, p.total.mae, p.total.rmseTrimmed);
+      fmt::print("{:20s} spp {:4d}  {:7.1f} rays/px  {:9.1f} ms  noise RMSE {:.5f} (trimmed {:.5f}, MAE {:.5f})  "
+                 "vs PT RMSE {:.5f}\n",
+                 m.name, spp, p.raysPerPixel, p.gpuMs, p.noise.rmse, p.noise.rmseTrimmed, p.noise.mae, p.total.rmse);
       std::fflush(stdout);
     }
     curves.push_back(curve);
   }
   csv.close();
 
-  // Summary at the paper's budget: 8 spp x (5 + 5) rays = 40 + 40 rays per pixel [RTO §4.1].
-  const render::Curve& obs = curves.front();
   const render::Curve& pt = curves.back();
-  const render::CurvePoint* budget = nullptr;
-  for (const auto& p : obs.points)
-    if (p.spp == kPaperSpp) budget = &p;
   nlohmann::json summary = {{"scene", o.scenePath}, {"width", study.width()}, {"height", study.height()},
-                            {"device", context.info().name}};
-  if (budget) {
-    render::TimeAt ptTime = render::timeToReach(pt, budget->rmseNoise, render::ErrorKind::Noise);
-    double speedUp = ptTime.valid ? ptTime.ms / budget->gpuMs : 0.0;
-    fmt::print("\nequal-noise speed-up at the paper's budget (8 spp, 5+5 rays per hit): obscurance noise RMSE {:.5f} "
-               "in {:.1f} ms; path tracing reaches it in {:.1f} ms{} -> {:.1f}x\n",
-               budget->rmseNoise, budget->gpuMs, ptTime.ms, ptTime.extrapolated ? " (extrapolated, RMSE ~ t^-1/2)" : "",
-               speedUp);
-    summary["obscurance_noise_rmse_at_budget"] = budget->rmseNoise;
-    summary["obscurance_ms_at_budget"] = budget->gpuMs;
-    summary["pathtrace_ms_to_equal_noise"] = ptTime.ms;
-    summary["pathtrace_equal_noise_extrapolated"] = ptTime.extrapolated;
-    summary["equal_noise_speedup"] = speedUp;
+                            {"device", context.info().name}, {"command", o.commandLine}};
+  const render::ImageError bias = render::imageError(obscuranceReference, ptReference);
+  const render::TimeAt ptBelowFloor = render::timeToReach(pt, bias.rmse, render::ErrorKind::AgainstReference);
+  fmt::print("\nbias floor (converged obscurance vs converged path tracing): RMSE {:.5f}, relMSE {:.5f}, MAE {:.5f}, "
+             "trimmed RMSE {:.5f}, mean ratio {:.4f}\n",
+             bias.rmse, bias.relMse, bias.mae, bias.rmseTrimmed, bias.meanRatio);
+  fmt::print("crossover: path tracing's error falls below that floor after {:.1f} ms{}\n", ptBelowFloor.ms,
+             ptBelowFloor.extrapolated ? " (extrapolated)" : "");
+  summary["bias_floor"] = {{"rmse", bias.rmse}, {"relmse", bias.relMse}, {"mae", bias.mae},
+                           {"rmse_trimmed", bias.rmseTrimmed}, {"mean_ratio", bias.meanRatio}};
+  summary["crossover_ms"] = ptBelowFloor.ms;
+  summary["crossover_extrapolated"] = ptBelowFloor.extrapolated;
+
+  // Per obscurance method at its budget: equal-noise speed-up in each measure, and the time path
+  // tracing needs to reach the same total error (bias included).
+  const std::pair<const char*, render::Metric> metrics[] = {
+      {"rmse", render::Metric::Rmse}, {"rmse_trimmed", render::Metric::RmseTrimmed}, {"mae", render::Metric::Mae}};
+  for (std::size_t i = 0; i + 1 < kMethods.size(); ++i) {
+    const Method& m = kMethods[i];
+    const render::CurvePoint* point = nullptr;
+    for (const auto& p : curves[i].points)
+      if (p.spp == m.budgetSpp) point = &p;
+    if (!point) continue;
+    nlohmann::json entry = {{"what", m.what}, {"spp", point->spp}, {"gpu_ms", point->gpuMs},
+                            {"rays_per_pixel", point->raysPerPixel}};
+    fmt::print("\n{} ({}): {:.1f} ms, {:.1f} rays per pixel\n", m.name, m.what, point->gpuMs, point->raysPerPixel);
+    for (const auto& [key, metric] : metrics) {
+      const double noise = render::errorOf(*point, render::ErrorKind::Noise, metric);
+      const double total = render::errorOf(*point, render::ErrorKind::AgainstReference, metric);
+      const render::TimeAt equalNoise = render::timeToReach(pt, noise, render::ErrorKind::Noise, metric);
+      const render::TimeAt equalTotal = render::timeToReach(pt, total, render::ErrorKind::AgainstReference, metric);
+      const double speedUp = equalNoise.valid ? equalNoise.ms / point->gpuMs : 0.0;
+      fmt::print("  {:13s} noise {:.5f}: path tracing reaches it in {:9.1f} ms{} -> equal-noise speed-up {:.2f}x; "
+                 "total error {:.5f}: path tracing reaches it in {:.1f} ms{}\n",
+                 key, noise, equalNoise.ms, equalNoise.extrapolated ? " (extrap.)" : "", speedUp, total, equalTotal.ms,
+                 equalTotal.extrapolated ? " (extrap.)" : "");
+      entry[key] = {{"noise", noise}, {"pathtrace_ms_to_equal_noise", equalNoise.ms},
+                    {"equal_noise_extrapolated", equalNoise.extrapolated}, {"equal_noise_speedup", speedUp},
+                    {"total_error", total}, {"pathtrace_ms_to_equal_total_error", equalTotal.ms},
+                    {"equal_total_extrapolated", equalTotal.extrapolated}};
+    }
+    summary["methods"][m.name] = entry;
   }
-  render::ImageError bias = render::imageError(references.at(obs.method), ptReference);
-  render::TimeAt ptBelow = render::timeToReach(pt, bias.rmse, render::ErrorKind::AgainstReference);
-  fmt::print("obscurance bias floor (converged obscurance vs converged path tracing): RMSE {:.5f}, relMSE {:.5f}\n",
-             bias.rmse, bias.relMse);
-  fmt::print("path tracing's error falls below that floor after {:.1f} ms{}\n", ptBelow.ms,
-             ptBelow.extrapolated ? " (extrapolated)" : "");
-  summary["bias_floor_rmse"] = bias.rmse;
-  summary["bias_floor_relmse"] = bias.relMse;
-  summary["pathtrace_ms_below_bias_floor"] = ptBelow.ms;
-  summary["pathtrace_below_bias_floor_extrapolated"] = ptBelow.extrapolated;
+
+  // What a user sees: the obscurance image at the paper's budget and path tracing at equal GPU time.
+  if (atBudget.contains(best.name)) {
+    const render::CurvePoint* point = nullptr;
+    for (const auto& p : curves.front().points)
+      if (p.spp == best.budgetSpp) point = &p;
+    const double msPerPath = pt.points.back().gpuMs / pt.points.back().spp;
+    const auto ptSpp = static_cast<std::uint32_t>(std::max(1.0, std::round(point->gpuMs / msPerPath)));
+    Rendered equalTime = study.render(pathMethod, ptSpp, o.seed + 104729);
+    const fs::path obsPng = fs::path(o.outputDir) / (study.stem() + ".obscurance-budget.png");
+    const fs::path ptPng = fs::path(o.outputDir) / (study.stem() + ".pathtrace-equal-time.png");
+    io::writePng(obsPng.string(), atBudget.at(best.name), atBudget.at(best.name).channelIndex("combined.R"));
+    io::writePng(ptPng.string(), equalTime.image, equalTime.image.channelIndex("combined.R"));
+    fmt::print("\nequal time: obscurance {} spp in {:.1f} ms -> {}; path tracing {} spp in {:.1f} ms -> {}\n",
+               best.budgetSpp, point->gpuMs, obsPng.string(), ptSpp, equalTime.gpuMs, ptPng.string());
+    summary["equal_time_pngs"] = {{"obscurance", obsPng.string()}, {"pathtrace", ptPng.string()},
+                                  {"pathtrace_spp", ptSpp}, {"pathtrace_gpu_ms", equalTime.gpuMs}};
+  }
   const fs::path jsonPath = fs::path(o.outputDir) / (study.stem() + ".convergence.json");
   std::ofstream(jsonPath) << summary.dump(2) << "\n";
 

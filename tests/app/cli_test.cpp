@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -39,6 +40,39 @@ TEST_F(Cli, RendersTheDefaultSceneToPngAndExrWithMetrics) {
                  " --width 32 --spp 1 --aov albedo");
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_TRUE(fs::exists(path("c.png")));
+}
+
+// A small study end to end: every method's curve in the CSV, each obscurance method's speed-up in
+// three error measures and the bias floor in the summary, the equal-time PNGs, and a second run
+// that takes both references from the cache.
+TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
+  const std::string args = "converge " + cornellBox() + " -o " + path("study") +
+                           " --width 16 --max-spp 8 --pt-max-spp 8 --reference-factor 4";
+  auto r = runObscura(args);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  for (const char* part : {"equal-noise speed-up", "bias floor", "crossover", "rmse_trimmed", "equal time"})
+    EXPECT_CONTAINS(r.output, part);
+  std::ifstream csv(path("study/cornell-box.convergence.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_CONTAINS(line, "mae_noise");
+  std::map<std::string, int> rows;
+  while (std::getline(csv, line)) ++rows[line.substr(0, line.find(','))];
+  const std::map<std::string, int> expected = {
+      {"obscurance", 4}, {"obscurance-paper", 4}, {"obscurance-realtime", 4}, {"pathtrace", 4}}; // 1, 2, 4, 8 spp
+  EXPECT_EQ(rows, expected);
+  std::ifstream json(path("study/cornell-box.convergence.json"));
+  std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  for (const char* key : {"\"obscurance-paper\"", "\"obscurance-realtime\"", "\"equal_noise_speedup\"",
+                          "\"mean_ratio\"", "\"crossover_ms\"", "\"rmse_trimmed\""})
+    EXPECT_CONTAINS(text, key);
+  for (const char* png : {"study/cornell-box.obscurance-budget.png", "study/cornell-box.pathtrace-equal-time.png",
+                          "study/cornell-box.convergence.png"})
+    EXPECT_TRUE(fs::exists(path(png))) << png;
+  r = runObscura(args);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "reference obscurance: cached");
+  EXPECT_CONTAINS(r.output, "reference pathtrace: cached");
 }
 
 TEST_F(Cli, MissingSceneNamesTheFile) {
