@@ -144,6 +144,7 @@ void runRender(RenderOptions& o) {
   scene::Camera camera = chooseCamera(loaded.scene, o.camera);
   chooseSize(o, camera);
   fmt::print(stderr, "{}\n", sceneSummary(loaded));
+  warnIfUnlit(loaded);
 
   gpu::Context context(o.device.contextOptions());
   fmt::print(stderr, "device: {} ({})\n", context.info().name, context.info().driver);
@@ -187,16 +188,21 @@ void runRender(RenderOptions& o) {
   if (io::extensionOf(o.output) == "exr" && o.aovs.empty()) appendChannels(image, renderer.lightLayers());
   const std::vector<std::uint32_t> display = renderer.display();
   const glm::vec3 ia = renderer.ambientIntensity(), rAve = renderer.ambient().averageReflectance;
+  const glm::vec3 iaGlobal = renderer.ambient().globalIntensity(renderer.emissions());
   fmt::print(stderr, "obscurance: dmax {:.4g}, rho {}, {} sampling, {}; R_ave ({:.4f}, {:.4f}, {:.4f}), "
-                     "I_a ({:.4g}, {:.4g}, {:.4g}); {} lights; frame in {} band(s)\n",
+                     "I_a ({:.4g}, {:.4g}, {:.4g}) from {} (the paper's whole-scene formula: ({:.4g}, {:.4g}, {:.4g})); "
+                     "{} lights; frame in {} band(s)\n",
              renderer.dMax(), o.rho, o.sampling, o.noBleed ? "grey" : "colour bleeding", rAve.x, rAve.y, rAve.z,
-             ia.x, ia.y, ia.z, renderer.lights().size(), renderer.layout().bandCount());
+             ia.x, ia.y, ia.z, o.ambient == "global" ? "the whole scene" : "the surfaces the lights reach",
+             iaGlobal.x, iaGlobal.y, iaGlobal.z, renderer.lights().size(), renderer.layout().bandCount());
   if (renderer.ambient().reflectanceClamped)
     fmt::print(stderr, "note: the average reflectance reaches 1; it was clamped to 0.999 (I_a would be infinite)\n");
   if (!o.saveState.empty()) relight::saveState(o.saveState, renderer, o.scenePath);
   writeOutputs(o, image, stats, context, loaded,
                {{"method", o.method}, {"dmax", renderer.dMax()}, {"rho", o.rho}, {"tau", settings.tau},
                 {"sampling", o.sampling}, {"colour_bleeding", !o.noBleed}, {"max_depth", settings.maxDepth},
+                {"light_sampling", o.lightSampling}, {"ambient", o.ambient},
+                {"i_a", {ia.x, ia.y, ia.z}}, {"i_a_global", {iaGlobal.x, iaGlobal.y, iaGlobal.z}},
                 {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
                 {"r_ave", {rAve.x, rAve.y, rAve.z}}, {"ambient_intensity", {ia.x, ia.y, ia.z}},
                 {"lights", renderer.lights().names}, {"bands", renderer.layout().bandCount()}},

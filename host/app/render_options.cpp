@@ -62,6 +62,10 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
                  "how shadow rays pick lights (both methods): spatial (default: by importance at the point, "
                  "triangles by solid angle, MIS on glossy lobes) or area (the paper's: by power, uniform by area)")
       ->check(CLI::IsMember({"spatial", "area"}));
+  cmd.add_option("--ambient", o.ambient,
+                 "which surfaces share a light's flux in I_a: reached (default: those its light reaches, directly or "
+                 "after one bounce) or global (the paper's: the whole scene)")
+      ->check(CLI::IsMember({"reached", "global"}));
   cmd.add_option("--light-groups", o.lightGroups,
                  "lights edited as one: node (one per emissive mesh node, default), material (one per emissive "
                  "material), or a JSON file {\"group\": [\"node\", ...]}");
@@ -86,7 +90,19 @@ render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scen
   settings.shadowSampling = o.shadowSampling == "per-light" ? render::ShadowSampling::PerLight
                                                             : render::ShadowSampling::Selection;
   settings.lightSampling = lightSampling(o);
+  settings.ambient = o.ambient == "global" ? render::AmbientModel::Global : render::AmbientModel::Reached;
   return settings;
+}
+
+void warnIfUnlit(const LoadedScene& loaded) {
+  const render::LightSet lights = render::buildLightSet(loaded.scene);
+  if (lights.anySampled()) return;
+  fmt::print(stderr,
+             "warning: {} has no light that emits (no emissive material with emission > 0, no KHR_lights_punctual "
+             "light): direct light and the obscurance term's I_a are 0, so the image is black but for what emits. "
+             "Add a light to the scene, or relight it: obscura relight SCENE --edits EDITS.json with an add_light "
+             "edit\n",
+             loaded.scene.sourcePath);
 }
 
 render::LightSampling lightSampling(const RenderOptions& o) {

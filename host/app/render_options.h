@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
+#include "app/scene_setup.h"
 #include "render/obscurance_renderer.h"
 #include "scene/scene.h"
 
@@ -34,6 +35,7 @@ struct RenderOptions {
   std::string lightGroups = "node";
   std::string shadowSampling = "selection";
   std::string lightSampling = "spatial";
+  std::string ambient = "reached";
   DeviceOptions device;
 };
 
@@ -47,6 +49,9 @@ scene::Camera chooseCamera(const scene::Scene& scene, int index);
 void chooseSize(RenderOptions& o, const scene::Camera& camera);
 // The obscurance renderer's settings from the options, for `camera` at the chosen size.
 render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scene::Camera& camera);
+// Warns (stderr) when no light of the scene emits anything: the image would be black but for
+// seen emission, and a user deserves to know why.
+void warnIfUnlit(const LoadedScene& loaded);
 // The light sampling --light-sampling names.
 render::LightSampling lightSampling(const RenderOptions& o);
 

@@ -62,9 +62,20 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
       stream_(context), timestamps_(context) {
   for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
+  if (settings.ambient == AmbientModel::Reached) measureReach(scene, bvh);
   emissions_ = lights_.emission;
   configure(settings);
   uploadLights();
+}
+
+void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh& bvh) {
+  std::vector<glm::vec3> meanAlbedo; // of `scene`'s materials (an insert brings its own)
+  for (const auto& m : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(m));
+  reached_ = std::make_unique<ReachedSurfaces>(scene, bvh, triangleReflectances(scene, meanAlbedo));
+  ambient_.model = AmbientModel::Reached;
+  ambient_.reach.clear();
+  for (std::size_t s = 0; s < lights_.size(); ++s) ambient_.reach.push_back(reached_->measure(lights_, s));
+  updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
 }
 
 void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
@@ -72,6 +83,8 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
       settings.primaryAovs != frame_.contents().primaryAovs ||
       (settings.composedAovs ? gpu::kComposeSlots : 1u) != frame_.contents().composedSlots)
     throw std::logic_error("ObscuranceRenderer::configure: resolution and AOVs are the frame's; make a new renderer");
+  if (settings.ambient != settings_.ambient)
+    throw std::logic_error("ObscuranceRenderer::configure: the ambient model is the scene's; make a new renderer");
   const bool bleedChanged = settings.colourBleeding != settings_.colourBleeding;
   settings_ = settings;
   dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax(scene_->bounds);
@@ -234,6 +247,8 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   const bool sameSurfaces = edited.materials.size() == scene_->materials.size() &&
                             edited.textures.size() == scene_->textures.size();
   scene_ = &edited;
+  // Moved occluders change what every light reaches.
+  if (reached_) measureReach(edited, bvh);
   bool rebind = true;
   if (sameSurfaces) rebind = sceneBuffers_.updateGeometry(edited, bvh);
   else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
@@ -447,6 +462,7 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
   markResolveStale(static_cast<std::uint32_t>(index), false);
   appendPunctual(lights_, light, scene_->bounds);
   updateSelection(lights_);
+  if (reached_) ambient_.reach.push_back(reached_->measure(lights_, index));
   emissions_.push_back(lights_.emission.back());
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   uploadLights();
@@ -494,6 +510,7 @@ void ObscuranceRenderer::removeLight(std::size_t index) {
   frame_.removeLightSlot(stream_, static_cast<std::uint32_t>(index));
   markResolveStale(static_cast<std::uint32_t>(index), false);
   removePunctual(lights_, index);
+  if (reached_) ambient_.reach.erase(ambient_.reach.begin() + static_cast<std::ptrdiff_t>(index));
   emissions_.erase(emissions_.begin() + static_cast<std::ptrdiff_t>(index));
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   uploadLights();

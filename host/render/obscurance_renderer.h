@@ -77,6 +77,7 @@ struct ObscuranceSettings {
   std::uint32_t spareLightSlots = 0;
   ShadowSampling shadowSampling = ShadowSampling::Selection;
   LightSampling lightSampling = LightSampling::Spatial;
+  AmbientModel ambient = AmbientModel::Reached; // which surfaces share a light's flux in I_a
 };
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.
@@ -159,6 +160,8 @@ public:
 
 private:
   void uploadLights();
+  // The Reached ambient model: what every light reaches in `scene` (after a geometry edit too).
+  void measureReach(const scene::Scene& scene, const bvh::Bvh& bvh);
   void bindAll();
   gpu::ShadePush shadePush(std::uint32_t sample) const;
   std::vector<glm::vec4> downloadBand(const gpu::Buffer& buffer) const;
@@ -174,6 +177,7 @@ private:
   SceneBuffers sceneBuffers_;
   LightSet lights_;
   AmbientTerm ambient_;
+  std::unique_ptr<ReachedSurfaces> reached_; // the Reached ambient model's light rays (CPU)
   LightBuffers lightBuffers_;
   std::vector<glm::vec3> emissions_; // what compose uses
   gpu::Buffer emissionBuffer_;

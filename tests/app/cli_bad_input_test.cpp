@@ -175,6 +175,19 @@ TEST_P(CliMalformedGltf, RenderRefusesItWithoutOutput) {
   EXPECT_EQ(strayFiles(inputs), std::vector<std::string>{});
 }
 
+// A well-formed scene without any light renders (exit 0) but says why its image is black.
+TEST_F(CliBadInput, SceneWithoutLightsRendersWithAWarningThatSaysWhy) {
+  QuadFile().write(dir_);
+  const auto r = runObscura("render " + path("bad.gltf") + " -o " + path("out.png") + " --width 16 --spp 1");
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "warning: " + path("bad.gltf") + " has no light that emits");
+  EXPECT_CONTAINS(r.output, "add_light");
+  EXPECT_TRUE(fs::exists(path("out.png")));
+  const auto lit = runObscura("render " + scene() + " -o " + path("lit.png") + " --width 16 --spp 1");
+  EXPECT_EQ(lit.exitCode, 0) << lit.output;
+  EXPECT_EQ(lit.output.find("warning:"), std::string::npos) << lit.output;
+}
+
 INSTANTIATE_TEST_SUITE_P(GlbDefects, CliMalformedGltf, ::testing::Range<std::size_t>(0, malformedCases().size()),
                          [](const ::testing::TestParamInfo<std::size_t>& param) {
                            return malformedCases()[param.param].name;

@@ -20,38 +20,60 @@ glm::vec3 meanTextureColour(const scene::Texture& texture) {
   return n ? glm::vec3(sum / static_cast<double>(n)) : glm::vec3(1.0f);
 }
 
-glm::vec3 AmbientTerm::intensity(const std::vector<glm::vec3>& emission) const {
+namespace {
+glm::vec3 weighted(const std::vector<glm::vec3>& weight, const std::vector<glm::vec3>& emission) {
   glm::vec3 ia(0.0f);
   for (std::size_t s = 0; s < weight.size() && s < emission.size(); ++s) ia += emission[s] * weight[s];
   return ia;
 }
+} // namespace
+
+glm::vec3 AmbientTerm::intensity(const std::vector<glm::vec3>& emission) const { return weighted(weight, emission); }
+glm::vec3 AmbientTerm::globalIntensity(const std::vector<glm::vec3>& emission) const {
+  return weighted(globalWeight, emission);
+}
+
+std::vector<glm::vec3> triangleReflectances(const scene::Scene& scene, const std::vector<glm::vec3>& meanAlbedo) {
+  std::vector<glm::vec3> textureMean(scene.textures.size());
+  for (std::size_t t = 0; t < scene.textures.size(); ++t) textureMean[t] = meanTextureColour(scene.textures[t]);
+  std::vector<glm::vec3> material(scene.materials.size());
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    material[m] = meanAlbedo[m];
+    int tex = scene.materials[m].baseColorTexture;
+    if (tex >= 0 && tex < static_cast<int>(textureMean.size())) material[m] *= textureMean[tex];
+  }
+  std::vector<glm::vec3> out(scene.triangles.size());
+  for (std::size_t i = 0; i < scene.triangles.size(); ++i) out[i] = material[scene.triangleMaterial[i]];
+  return out;
+}
+
+namespace {
+
+glm::vec3 clampReflectance(glm::vec3 r, bool& clamped) {
+  for (int c = 0; c < 3; ++c)
+    if (r[c] > kMaxAverageReflectance) {
+      r[c] = kMaxAverageReflectance;
+      clamped = true;
+    }
+  return r;
+}
+
+} // namespace
 
 AmbientTerm computeAmbient(const scene::Scene& scene, const LightSet& lights,
                            const std::vector<glm::vec3>& meanAlbedo, bool colourBleeding) {
   AmbientTerm term;
-  std::vector<glm::vec3> textureMean(scene.textures.size());
-  for (std::size_t t = 0; t < scene.textures.size(); ++t) textureMean[t] = meanTextureColour(scene.textures[t]);
-  std::vector<glm::vec3> reflectance(scene.materials.size());
-  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
-    reflectance[m] = meanAlbedo[m];
-    int tex = scene.materials[m].baseColorTexture;
-    if (tex >= 0 && tex < static_cast<int>(textureMean.size())) reflectance[m] *= textureMean[tex];
-  }
+  const std::vector<glm::vec3> reflectance = triangleReflectances(scene, meanAlbedo);
   glm::dvec3 weighted(0.0);
   for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
     const glm::uvec3 t = scene.triangles[i];
     double area = 0.5 * glm::length(glm::cross(glm::dvec3(scene.positions[t.y] - scene.positions[t.x]),
                                                glm::dvec3(scene.positions[t.z] - scene.positions[t.x])));
     term.totalArea += area;
-    weighted += area * glm::dvec3(reflectance[scene.triangleMaterial[i]]);
+    weighted += area * glm::dvec3(reflectance[i]);
   }
   glm::vec3 rAve = term.totalArea > 0.0 ? glm::vec3(weighted / term.totalArea) : glm::vec3(0.0f);
-  for (int c = 0; c < 3; ++c)
-    if (rAve[c] > kMaxAverageReflectance) {
-      rAve[c] = kMaxAverageReflectance;
-      term.reflectanceClamped = true;
-    }
-  term.averageReflectance = rAve;
+  term.averageReflectance = term.reachedReflectance = clampReflectance(rAve, term.reflectanceClamped);
   updateAmbientWeights(term, lights, colourBleeding);
   return term;
 }
@@ -60,16 +82,30 @@ void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colour
   // [RTO eq. 4] (grey) or [RTO eq. 12] (colour bleeding), per unit E_s. The paper's I_a is a
   // radiosity (E_i = pi L_e); our images are radiance, so I_a is divided by pi: for a Lambertian
   // reflector the indirect radiance is R(P) I_a W / pi. OURS [SPEC §5: no hidden scale].
-  const glm::vec3 rAve = term.averageReflectance;
+  // Reached: light s's flux over the area A_s it reaches, with that area's reflectance R_s.
+  const bool reached = term.model == AmbientModel::Reached && term.reach.size() == lights.size();
+  auto weightFor = [&](std::size_t s, glm::vec3 r, double area) {
+    if (!(area > 0.0)) return glm::vec3(0.0f);
+    glm::vec3 perArea = lights.unitFlux[s] / static_cast<float>(area * std::numbers::pi);
+    return (colourBleeding ? glm::vec3(1.0f) : r) / (glm::vec3(1.0f) - r) * perArea;
+  };
   term.weight.clear();
+  term.globalWeight.clear();
+  glm::dvec3 byPower(0.0);
+  double power = 0.0;
   for (std::size_t s = 0; s < lights.size(); ++s) {
-    glm::vec3 w(0.0f);
-    if (term.totalArea > 0.0) {
-      glm::vec3 perArea = lights.unitFlux[s] / static_cast<float>(term.totalArea * std::numbers::pi);
-      w = (colourBleeding ? glm::vec3(1.0f) : rAve) / (glm::vec3(1.0f) - rAve) * perArea;
+    glm::vec3 r = term.averageReflectance;
+    double area = term.totalArea;
+    term.globalWeight.push_back(weightFor(s, r, area));
+    if (reached && term.reach[s].area > 0.0) {
+      r = clampReflectance(term.reach[s].reflectance, term.reflectanceClamped);
+      area = term.reach[s].area;
+      byPower += lights.power[s] * glm::dvec3(r);
+      power += lights.power[s];
     }
-    term.weight.push_back(w);
+    term.weight.push_back(weightFor(s, r, area));
   }
+  term.reachedReflectance = power > 0.0 ? glm::vec3(byPower / power) : term.averageReflectance;
 }
 
 } // namespace obscura::render

@@ -13,17 +13,31 @@
 #include <glm/glm.hpp>
 
 #include "render/scene/light_set.h"
+#include "render/scene/reached_surfaces.h"
 #include "scene/scene.h"
 
 namespace obscura::render {
 
+// Which surfaces share a light's flux in I_a: Reached (default, OURS after the paper's §6: those
+// the light reaches, reached_surfaces.h) or Global (the paper's: the whole scene).
+enum class AmbientModel { Reached, Global };
+
 struct AmbientTerm {
-  glm::vec3 averageReflectance{0.0f}; // R_ave (clamped below 1, see clampedReflectance)
+  AmbientModel model = AmbientModel::Global;
+  glm::vec3 averageReflectance{0.0f}; // R_ave of the whole scene [RTO eq. 3]: R(Q) of a miss within
+                                      // dmax in W_c (a render-time constant, so edits stay exact)
+  glm::vec3 reachedReflectance{0.0f}; // the lights' R_s weighted by power (Reached; reported)
   bool reflectanceClamped = false;    // R_ave reached 1 in a channel: I_a would be infinite
   double totalArea = 0.0;             // A_t
+  std::vector<LightReach> reach;      // per light (Reached); an entry of zero area falls back to A_t
   std::vector<glm::vec3> weight;      // per light: I_a per unit E_s
-  glm::vec3 intensity(const std::vector<glm::vec3>& emission) const; // I_a(E)
+  std::vector<glm::vec3> globalWeight; // the same by the paper's formula (whole scene), for reports
+  glm::vec3 intensity(const std::vector<glm::vec3>& emission) const;       // I_a(E)
+  glm::vec3 globalIntensity(const std::vector<glm::vec3>& emission) const; // the paper's I_a(E)
 };
+
+// Mean reflectance of every triangle: a-bar of its material times its texture's mean colour.
+std::vector<glm::vec3> triangleReflectances(const scene::Scene& scene, const std::vector<glm::vec3>& meanAlbedo);
 
 // `meanAlbedo[m]` is a-bar of material m with its base colour factor; textured materials are
 // scaled by their texture's mean (linear) colour. OURS: a texture modulates a-bar linearly.
@@ -31,7 +45,8 @@ AmbientTerm computeAmbient(const scene::Scene& scene, const LightSet& lights,
                            const std::vector<glm::vec3>& meanAlbedo, bool colourBleeding);
 
 // The weights w_s of `term` (whose R_ave and A_t stay) for another set of lights: what adding or
-// removing a light changes, without summing the scene's areas and textures again.
+// removing a light changes, without summing the scene's areas and textures again. With the
+// Reached model, term.reach must hold one entry per light (the renderer measures them).
 void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colourBleeding);
 
 // Mean linear colour of a texture (sRGB decoded when the texture is sRGB).

@@ -1,0 +1,209 @@
+#include "render/scene/reached_surfaces.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+
+namespace obscura::render {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+struct Frame {
+  glm::vec3 t, b, n;
+};
+
+Frame frameAround(glm::vec3 n) {
+  glm::vec3 a = std::abs(n.x) > 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+  glm::vec3 t = glm::normalize(glm::cross(a, n));
+  return {t, glm::cross(n, t), n};
+}
+
+glm::vec3 cosineDirection(glm::vec3 n, float u1, float u2) {
+  Frame f = frameAround(n);
+  float r = std::sqrt(u1), phi = 2.0f * kPi * u2;
+  return r * std::cos(phi) * f.t + r * std::sin(phi) * f.b + std::sqrt(std::max(0.0f, 1.0f - u1)) * f.n;
+}
+
+glm::vec3 sphereDirection(float u1, float u2) {
+  float z = 1.0f - 2.0f * u1, r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 2.0f * kPi * u2;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+// A point that emits, with the side it emits to (area lights), or a punctual light's position.
+struct LightPoint {
+  glm::vec3 position;
+  glm::vec3 normal{0.0f}; // 0: punctual
+  bool twoSided = false;
+  bool directional = false;
+  glm::vec3 direction{0.0f}; // directional: the way the light travels
+};
+
+LightPoint samplePoint(const LightSet& lights, std::size_t s, std::mt19937& rng, const scene::Bounds& bounds) {
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  const gpu::GpuLight& l = lights.lights[s];
+  LightPoint p;
+  if (l.info.x == gpu::kLightArea) {
+    float u = uni(rng);
+    std::uint32_t first = l.info.y, count = l.info.z, e = first;
+    while (e + 1 < first + count && lights.emitters[e].v0.w <= u) ++e;
+    const auto& em = lights.emitters[e];
+    float r = std::sqrt(uni(rng)), v = uni(rng);
+    glm::vec3 a(em.v0), b(em.v1), c(em.v2);
+    p.position = (1.0f - r) * a + r * (1.0f - v) * b + r * v * c;
+    glm::vec3 n = glm::cross(b - a, c - a);
+    float len = glm::length(n);
+    p.normal = len > 0.0f ? n / len : glm::vec3(0, 0, 1);
+    p.twoSided = em.v2.w != 0.0f;
+  } else if (l.info.x == gpu::kLightDirectional) {
+    // From a disk as wide as the scene's bounding sphere, outside it, towards the scene.
+    glm::vec3 dir = glm::normalize(glm::vec3(l.direction));
+    glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
+    float radius = 0.5f * glm::length(bounds.hi - bounds.lo) + 1e-3f;
+    Frame f = frameAround(dir);
+    float r = radius * std::sqrt(uni(rng)), phi = 2.0f * kPi * uni(rng);
+    p.position = centre - 2.0f * radius * dir + r * std::cos(phi) * f.t + r * std::sin(phi) * f.b;
+    p.directional = true;
+    p.direction = dir;
+  } else {
+    p.position = glm::vec3(l.position);
+  }
+  return p;
+}
+
+// A direction the light at `p` emits into (cosine for area lights, uniform or within the cone for
+// punctual ones); false when a spot gave none.
+bool emitDirection(const LightSet& lights, std::size_t s, const LightPoint& p, std::mt19937& rng, glm::vec3& d) {
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  const gpu::GpuLight& l = lights.lights[s];
+  if (p.directional) {
+    d = p.direction;
+    return true;
+  }
+  if (l.info.x == gpu::kLightArea) {
+    glm::vec3 n = p.twoSided && uni(rng) < 0.5f ? -p.normal : p.normal;
+    d = cosineDirection(n, uni(rng), uni(rng));
+    return true;
+  }
+  for (int tries = 0; tries < 64; ++tries) {
+    d = sphereDirection(uni(rng), uni(rng));
+    if (l.info.x != gpu::kLightSpot || glm::dot(d, glm::vec3(l.direction)) >= l.params.w) return true;
+  }
+  return false;
+}
+
+float largestExtent(const scene::Bounds& bounds) {
+  glm::vec3 e = bounds.extent();
+  float largest = std::max(e.x, std::max(e.y, e.z));
+  return largest > 0.0f && std::isfinite(largest) ? largest : 1.0f;
+}
+
+// At least ~32 ulps of the point's largest coordinate: a scene far from the origin, or scaled by
+// 1e4, keeps its rays off their own surfaces.
+float offsetAt(glm::vec3 p, float offset) {
+  return std::max(offset, 4e-6f * std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z))));
+}
+
+} // namespace
+
+ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<glm::vec3>& reflectance)
+    : scene_(&scene), bvh_(bvh), offset_(1e-5f * largestExtent(scene.bounds)) {
+  std::vector<double> cdf;
+  cdf.reserve(scene.triangles.size());
+  for (const auto& t : scene.triangles) {
+    glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
+    totalArea_ += 0.5 * glm::length(glm::cross(b - a, c - a));
+    cdf.push_back(totalArea_);
+  }
+  if (!(totalArea_ > 0.0)) return;
+  std::mt19937 rng(0x5eed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  for (std::uint32_t i = 0; i < kSurfaceSamples; ++i) {
+    auto it = std::upper_bound(cdf.begin(), cdf.end(), uni(rng) * totalArea_);
+    std::size_t t = std::min<std::size_t>(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
+    const glm::uvec3 tri = scene.triangles[t];
+    glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
+    float r = static_cast<float>(std::sqrt(uni(rng))), v = static_cast<float>(uni(rng));
+    glm::vec3 n = glm::cross(b - a, c - a);
+    float len = glm::length(n);
+    if (!(len > 0.0f)) continue;
+    samples_.push_back({(1.0f - r) * a + r * (1.0f - v) * b + r * v * c, n / len, reflectance[t]});
+  }
+}
+
+LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) const {
+  LightReach reach;
+  if (samples_.empty() || !(lights.power[light] > 0.0)) return reach;
+  std::mt19937 rng(0x11a7u + static_cast<std::uint32_t>(light));
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  const scene::Scene& scene = *scene_;
+  auto offsetToward = [&](glm::vec3 p, glm::vec3 n, glm::vec3 towards) {
+    const float o = offsetAt(p, offset_);
+    return p + (glm::dot(n, towards - p) >= 0.0f ? o : -o) * n;
+  };
+
+  // 1. Where the light lands: first hits of rays leaving it (the position and the lit side's normal).
+  struct Landing {
+    glm::vec3 position, normal;
+  };
+  std::vector<Landing> landings;
+  for (std::uint32_t i = 0; i < kLightRays; ++i) {
+    LightPoint p = samplePoint(lights, light, rng, scene.bounds);
+    glm::vec3 d;
+    if (!emitDirection(lights, light, p, rng, d)) continue;
+    bvh::Ray ray{.origin = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, p.position + d),
+                 .direction = d};
+    bvh::Hit hit = bvh::closestHit(bvh_, ray);
+    if (!hit.hit()) continue;
+    const glm::uvec3 tri = scene.triangles[hit.primitive];
+    glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
+    glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+    if (glm::dot(n, d) > 0.0f) n = -n; // the side the light arrives on
+    landings.push_back({ray.origin + hit.t * d, n});
+  }
+
+  // 2. Surface samples that see the light or a landing point.
+  auto visible = [&](glm::vec3 from, glm::vec3 to) {
+    bvh::Ray ray{.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f};
+    return !bvh::anyHit(bvh_, ray);
+  };
+  std::size_t reached = 0;
+  glm::dvec3 reflectance(0.0);
+  for (const SurfacePoint& s : samples_) {
+    bool seen = false;
+    for (std::uint32_t k = 0; k < kVisibilityTries && !seen; ++k) {
+      LightPoint p = samplePoint(lights, light, rng, scene.bounds);
+      if (p.directional) {
+        glm::vec3 to = s.position - 4.0f * largestExtent(scene.bounds) * p.direction;
+        seen = visible(offsetToward(s.position, s.normal, to), to);
+        continue;
+      }
+      if (p.normal != glm::vec3(0.0f) && !p.twoSided && glm::dot(p.normal, s.position - p.position) <= 0.0f) continue;
+      const gpu::GpuLight& l = lights.lights[light];
+      if (l.info.x == gpu::kLightSpot &&
+          glm::dot(glm::normalize(s.position - p.position), glm::vec3(l.direction)) < l.params.w)
+        continue;
+      glm::vec3 target = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, s.position);
+      seen = visible(offsetToward(s.position, s.normal, target), target);
+    }
+    for (std::uint32_t k = 0; k < kVisibilityTries && !seen && !landings.empty(); ++k) {
+      const Landing& h = landings[std::uniform_int_distribution<std::size_t>(0, landings.size() - 1)(rng)];
+      if (glm::dot(h.normal, s.position - h.position) <= 0.0f) continue; // behind the lit side
+      glm::vec3 target = h.position + offsetAt(h.position, offset_) * h.normal;
+      seen = visible(offsetToward(s.position, s.normal, target), target);
+    }
+    if (seen) {
+      ++reached;
+      reflectance += glm::dvec3(s.reflectance);
+    }
+  }
+  if (reached == 0) return reach;
+  reach.fraction = static_cast<double>(reached) / static_cast<double>(samples_.size());
+  reach.area = totalArea_ * reach.fraction;
+  reach.reflectance = glm::vec3(reflectance / static_cast<double>(reached));
+  return reach;
+}
+
+} // namespace obscura::render
