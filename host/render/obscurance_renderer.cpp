@@ -301,6 +301,13 @@ void ObscuranceRenderer::setEmissions(const std::vector<glm::vec3>& emissions) {
   emissionBuffer_.upload(*context_, emissionRows(emissions_));
 }
 
+void ObscuranceRenderer::setAmbientModel(AmbientModel model) {
+  if (model == AmbientModel::Reached && !reached_)
+    throw std::logic_error("setAmbientModel: this renderer did not measure what the lights reach");
+  ambient_.model = model;
+  updateAmbientWeights(ambient_, lights_, settings_.colourBleeding); // the resolved A_t stays: I_a is a push
+}
+
 void ObscuranceRenderer::compose(float exposureStops) {
   const auto start = Clock::now();
   const FrameLayout& layout = frame_.layout();

@@ -107,6 +107,9 @@ public:
 
   // The emission scales E_s compose uses (default: the scene's own). I_a follows them [SPEC §3].
   void setEmissions(const std::vector<glm::vec3>& emissions);
+  // Which I_a compose uses (no ray: I_a only weighs the ambient sums). Reached needs a renderer
+  // made with AmbientModel::Reached (its reach was measured); Global is always there.
+  void setAmbientModel(AmbientModel model);
   const std::vector<glm::vec3>& emissions() const { return emissions_; }
   // Composes the AOVs on the GPU with the current emissions, then tonemaps `combined` to the
   // display bytes with `exposureStops`.

@@ -4,6 +4,7 @@
 // where the paper's formula spreads it over both rooms with their mean reflectance. In the lit
 // room, the reached I_a brings the obscurance image close to path tracing; the global one does not.
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -57,6 +58,8 @@ TEST(ReachedSurfaces, LampReachesItsOwnRoomOnlyWithThatRoomsReflectance) {
   EXPECT_NEAR(r.fraction, litShare, 0.03);
   EXPECT_NEAR(r.area, reached.totalArea() * r.fraction, 1e-9);
   EXPECT_NEAR(r.reflectance.x, 0.5, 0.01) << "the dark room's 0.9 must not count";
+  EXPECT_EQ(r.escapeDirect, 0.0) << "a closed room keeps all of its lamp's light";
+  EXPECT_EQ(r.escapeBounce, 0.0);
 
   render::AmbientTerm global = render::computeAmbient(s, lights, albedos(s), true);
   render::AmbientTerm term = global;
@@ -67,6 +70,31 @@ TEST(ReachedSurfaces, LampReachesItsOwnRoomOnlyWithThatRoomsReflectance) {
   const double expectedRatio = (1.0 / r.fraction) * (1.0 - global.averageReflectance.x) / (1.0 - r.reflectance.x);
   EXPECT_NEAR(term.weight[0].x / global.weight[0].x, expectedRatio, 1e-4 * expectedRatio);
   EXPECT_NEAR(term.globalWeight[0].x, global.weight[0].x, 1e-6 * global.weight[0].x);
+}
+
+TEST(ReachedSurfaces, OpenBoxLosesWhatLeavesThroughItsOpening) {
+  // A floor under a lamp facing down, nothing else: every light ray lands (e_0 = 0) and nearly
+  // every reflected ray leaves (e_1 ~ 1: only the lamp's back is there to hit), so I_a is about the
+  // direct flux over the floor alone, with almost no bounces.
+  SceneBuilder b;
+  auto floor = b.lambertian(glm::vec3(0.5f));
+  auto lamp = b.lambertian(glm::vec3(0.0f), glm::vec3(1.0f));
+  b.quad({-50, 0, -50}, {0, 0, 100}, {100, 0, 0}, floor);
+  b.quad({-0.1f, 1, -0.1f}, {0.2f, 0, 0}, {0, 0, 0.2f}, lamp, "lamp");
+  scene::Scene s = b.build();
+  bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+  render::LightSet lights = render::buildLightSet(s);
+  render::ReachedSurfaces reached(s, tree, render::triangleReflectances(s, albedos(s)));
+  render::LightReach r = reached.measure(lights, 0);
+  EXPECT_LT(r.escapeDirect, 0.01) << "the lamp faces the 100 m floor from 1 m";
+  EXPECT_GT(r.escapeBounce, 0.99);
+  render::AmbientTerm term = render::computeAmbient(s, lights, albedos(s), true);
+  term.model = render::AmbientModel::Reached;
+  term.reach = {r};
+  render::updateAmbientWeights(term, lights, true);
+  const double expected = lights.unitFlux[0].x * (1.0 - r.escapeDirect) / (r.area * std::numbers::pi) /
+                          (1.0 - r.reflectance.x * (1.0 - r.escapeBounce));
+  EXPECT_NEAR(term.weight[0].x, expected, 1e-5 * expected);
 }
 
 TEST(ReachedSurfaces, ZeroPowerLightReachesNothingAndFallsBackToTheWholeScene) {

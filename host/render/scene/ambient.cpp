@@ -82,12 +82,13 @@ void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colour
   // [RTO eq. 4] (grey) or [RTO eq. 12] (colour bleeding), per unit E_s. The paper's I_a is a
   // radiosity (E_i = pi L_e); our images are radiance, so I_a is divided by pi: for a Lambertian
   // reflector the indirect radiance is R(P) I_a W / pi. OURS [SPEC §5: no hidden scale].
-  // Reached: light s's flux over the area A_s it reaches, with that area's reflectance R_s.
+  // Reached: light s's kept flux over the area A_s it reaches, with that area's reflectance R_s and escapes.
   const bool reached = term.model == AmbientModel::Reached && term.reach.size() == lights.size();
-  auto weightFor = [&](std::size_t s, glm::vec3 r, double area) {
+  // Flux kept (1 - e_0) over the area, and a series of bounces each keeping R (1 - e_1).
+  auto weightFor = [&](std::size_t s, glm::vec3 r, double area, double escapeDirect, double escapeBounce) {
     if (!(area > 0.0)) return glm::vec3(0.0f);
-    glm::vec3 perArea = lights.unitFlux[s] / static_cast<float>(area * std::numbers::pi);
-    return (colourBleeding ? glm::vec3(1.0f) : r) / (glm::vec3(1.0f) - r) * perArea;
+    glm::vec3 perArea = lights.unitFlux[s] * static_cast<float>((1.0 - escapeDirect) / (area * std::numbers::pi));
+    return (colourBleeding ? glm::vec3(1.0f) : r) / (glm::vec3(1.0f) - r * static_cast<float>(1.0 - escapeBounce)) * perArea;
   };
   term.weight.clear();
   term.globalWeight.clear();
@@ -96,14 +97,17 @@ void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colour
   for (std::size_t s = 0; s < lights.size(); ++s) {
     glm::vec3 r = term.averageReflectance;
     double area = term.totalArea;
-    term.globalWeight.push_back(weightFor(s, r, area));
+    term.globalWeight.push_back(weightFor(s, r, area, 0.0, 0.0));
+    double escapeDirect = 0.0, escapeBounce = 0.0;
     if (reached && term.reach[s].area > 0.0) {
       r = clampReflectance(term.reach[s].reflectance, term.reflectanceClamped);
       area = term.reach[s].area;
+      escapeDirect = term.reach[s].escapeDirect;
+      escapeBounce = term.reach[s].escapeBounce;
       byPower += lights.power[s] * glm::dvec3(r);
       power += lights.power[s];
     }
-    term.weight.push_back(weightFor(s, r, area));
+    term.weight.push_back(weightFor(s, r, area, escapeDirect, escapeBounce));
   }
   term.reachedReflectance = power > 0.0 ? glm::vec3(byPower / power) : term.averageReflectance;
 }

@@ -149,6 +149,7 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
     glm::vec3 position, normal;
   };
   std::vector<Landing> landings;
+  std::uint32_t emitted = 0;
   for (std::uint32_t i = 0; i < kLightRays; ++i) {
     LightPoint p = samplePoint(lights, light, rng, scene.bounds);
     glm::vec3 d;
@@ -156,6 +157,7 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
     bvh::Ray ray{.origin = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, p.position + d),
                  .direction = d};
     bvh::Hit hit = bvh::closestHit(bvh_, ray);
+    ++emitted;
     if (!hit.hit()) continue;
     const glm::uvec3 tri = scene.triangles[hit.primitive];
     glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
@@ -163,6 +165,18 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
     if (glm::dot(n, d) > 0.0f) n = -n; // the side the light arrives on
     landings.push_back({ray.origin + hit.t * d, n});
   }
+
+  // What leaves the scene: directly (not for a directional light, whose flux counts only what
+  // crosses the scene's box already), and after one diffuse reflection where the light lands.
+  const bool directional = lights.lights[light].info.x == gpu::kLightDirectional;
+  reach.escapeDirect = directional || emitted == 0 ? 0.0 : 1.0 - static_cast<double>(landings.size()) / emitted;
+  std::size_t escapedBounce = 0;
+  for (const Landing& h : landings) {
+    glm::vec3 d = cosineDirection(h.normal, uni(rng), uni(rng));
+    bvh::Ray ray{.origin = h.position + offsetAt(h.position, offset_) * h.normal, .direction = d};
+    if (!bvh::anyHit(bvh_, ray)) ++escapedBounce;
+  }
+  reach.escapeBounce = landings.empty() ? 0.0 : static_cast<double>(escapedBounce) / static_cast<double>(landings.size());
 
   // 2. Surface samples that see the light or a landing point.
   auto visible = [&](glm::vec3 from, glm::vec3 to) {

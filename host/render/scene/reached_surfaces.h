@@ -10,9 +10,13 @@
 //   2. surface samples: points uniform by area over the whole scene (shared by all lights); a
 //      point is reached when it sees a point of the light or one of the first hits (so what the
 //      light reaches after one bounce counts too), tested with a few shadow rays;
-//   3. A_s = A_t x (fraction of surface samples reached), R_s = mean reflectance of those.
-// I_a's weight for light s then uses A_s and R_s in place of A_t and R_ave (ambient.h), which
-// keeps I_a linear in every emission. The rays run on the CPU (bvh::closestHit / anyHit): a few
+//   3. A_s = A_t x (fraction of surface samples reached), R_s = mean reflectance of those;
+//   4. what leaves: e_0, the share of light rays that hit nothing, and e_1, the share of cosine
+//      rays from the landing points that hit nothing (an open scene, a window, the Cornell box's
+//      open front lose that light; the paper's I_a assumes a closed scene).
+// I_a's weight for light s then uses A_s, R_s and the escapes in place of A_t and R_ave
+// (ambient.h): flux (1 - e_0) / (pi A_s) / (1 - R_s (1 - e_1)), which keeps I_a linear in every
+// emission. The rays run on the CPU (bvh::closestHit / anyHit): a few
 // thousand per light, deterministic for a given scene (fixed seeds), so an incremental edit and a
 // fresh render agree.
 #pragma once
@@ -31,6 +35,8 @@ struct LightReach {
   double area = 0.0;              // A_s: area the light reaches (directly or after one bounce)
   glm::vec3 reflectance{0.0f};    // R_s: mean reflectance of that area
   double fraction = 0.0;          // A_s / A_t
+  double escapeDirect = 0.0;      // e_0: share of the light's rays that leave the scene unhit
+  double escapeBounce = 0.0;      // e_1: share of rays diffusely reflected where it lands that leave
 };
 
 class ReachedSurfaces {
