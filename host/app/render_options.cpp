@@ -49,7 +49,8 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
       ->check(CLI::Range(0u, 1024u));
   cmd.add_option("--rho", o.rho, "rho(d): sqrt (the paper's), exp, ao")->check(CLI::IsMember({"sqrt", "exp", "ao"}));
   cmd.add_option("--tau", o.obscurance.tau, "tau of --rho exp")->check(CLI::PositiveNumber);
-  cmd.add_option("--dmax", o.dMax, "dmax in scene units (default: 1/4 of the largest bounding-box extent)")
+  cmd.add_option("--dmax", o.dMax, "dmax in scene units (default: half the median distance between the surfaces the camera sees and "
+                 "the next ones; 'obscura info' prints it)")
       ->each([&o](const std::string&) { o.dMaxGiven = true; });
   cmd.add_option("--sampling", o.sampling, "obscurance rays: systematic (default) or random")
       ->check(CLI::IsMember({"systematic", "random"}));

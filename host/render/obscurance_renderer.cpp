@@ -23,12 +23,6 @@ const std::vector<std::string> kComposeAovs = {"combined", "direct", "indirect",
 
 } // namespace
 
-float defaultDMax(const scene::Bounds& bounds) {
-  glm::vec3 e = bounds.extent();
-  float largest = std::max({e.x, e.y, e.z});
-  return largest > 0.0f ? 0.25f * largest : 1.0f;
-}
-
 const std::vector<std::string>& obscuranceAovNames() {
   static const std::vector<std::string> names = {"combined", "direct", "indirect", "specular", "obscurance",
                                                  "albedo", "emission", "normal", "depth", "position",
@@ -63,6 +57,7 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
   for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
   if (settings.ambient == AmbientModel::Reached) measureReach(scene, bvh);
+  defaultDMax_ = defaultDMax(scene, bvh, settings.camera);
   emissions_ = lights_.emission;
   configure(settings);
   uploadLights();
@@ -87,7 +82,7 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
     throw std::logic_error("ObscuranceRenderer::configure: the ambient model is the scene's; make a new renderer");
   const bool bleedChanged = settings.colourBleeding != settings_.colourBleeding;
   settings_ = settings;
-  dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax(scene_->bounds);
+  dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax_;
   if (bleedChanged) updateAmbientWeights(ambient_, lights_, settings.colourBleeding);
   reset();
 }

@@ -37,6 +37,7 @@
 #include "render/passes/specular_pass.h"
 #include "render/passes/tonemap_pass.h"
 #include "render/scene/ambient.h"
+#include "render/scene/free_path.h"
 #include "render/scene/light_set.h"
 #include "render/scene/scene_buffers.h"
 #include "render/transport.h"
@@ -63,7 +64,8 @@ struct ObscuranceSettings {
   std::uint32_t obscuranceRays = 5;  // N_obs per hit
   RhoKind rho = RhoKind::Sqrt;
   float tau = 3.0f;                  // for RhoKind::Exp
-  float dMax = 0.0f;                 // 0 = a quarter of the largest bounding-box extent [SPEC §1.3]
+  float dMax = 0.0f;                 // 0 = half the median free path seen from the camera the
+                                     // renderer was made with (render/scene/free_path.h)
   bool systematic = true;            // [RTO §4.2]
   bool colourBleeding = true;        // W_c [RTO eq. 6]; false: grey W [RTO eq. 2]
   std::uint32_t maxDepth = 6;        // specular paths: scattering vertices, the primary hit is 1
@@ -173,6 +175,7 @@ private:
   const scene::Scene* scene_;
   ObscuranceSettings settings_;
   float dMax_ = 0.0f;
+  float defaultDMax_ = 0.0f; // measured once, at construction (stable across camera and geometry edits)
   bool runSpecular_ = false;
   std::vector<glm::vec3> meanAlbedo_;
 

@@ -210,7 +210,7 @@ ImageDifference scaledCornellDifference(HardRender& test, float scale,
   // The paper's I_a: the reached one is a Monte Carlo estimate on the CPU whose visibility tests
   // can flip with rounding (checked apart below, to its own tolerance).
   settings.ambient = render::AmbientModel::Global;
-  const float dMax = render::defaultDMax(base.bounds);
+  const float dMax = render::boundsDMax(base.bounds);
   settings.dMax = dMax;
   auto reference = renderFn(base, settings);
   scene::Scene s = transformed(base, scale, glm::vec3(0.0f));

@@ -1,5 +1,5 @@
 // The surfaces a light reaches (render/scene/reached_surfaces.h) and the ambient term built on
-// them [RTO §6 future work]: two closed rooms of equal area, a lamp in one. The lamp reaches its
+// them [RTO §6 future work], and the default dmax: two closed rooms of equal area, a lamp in one. The lamp reaches its
 // own room only, so its flux is shared by half the scene's area with that room's reflectance,
 // where the paper's formula spreads it over both rooms with their mean reflectance. In the lit
 // room, the reached I_a brings the obscurance image close to path tracing; the global one does not.
@@ -12,9 +12,11 @@
 #include "gpu_test.h"
 #include "render/one_shot.h"
 #include "render/scene/ambient.h"
+#include "render/scene/free_path.h"
 #include "render/scene/reached_surfaces.h"
 #include "render/scene/scene_buffers.h"
 #include "render/test_scenes.h"
+#include "scene/gltf_loader.h"
 #include "shading/bsdf.h"
 
 namespace obscura::test {
@@ -104,6 +106,27 @@ TEST(ReachedSurfaces, ZeroPowerLightReachesNothingAndFallsBackToTheWholeScene) {
   render::LightSet lights = render::buildLightSet(s);
   render::ReachedSurfaces reached(s, tree, render::triangleReflectances(s, albedos(s)));
   EXPECT_EQ(reached.measure(lights, 0).area, 0.0);
+}
+
+// The default dmax (render/scene/free_path.h), on the same rooms: from inside a closed cube of side
+// 2, half the median free path lies in the paper's 1/4 .. 1/2 of the side; classroom, whose 221 m
+// ground plane makes the paper's 1/4 of the box 55 m, gets a room-sized dmax.
+TEST(DefaultDMax, RoomSizedInsideARoomAndInClassroom) {
+  scene::Scene s = twoRooms();
+  bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+  const scene::Camera inside = lookCamera({1.0f, 1.0f, 1.9f}, {0, 0, -1}, {0, 1, 0}, 1.2f);
+  render::FreePath f = render::measureFreePath(s, tree, inside);
+  EXPECT_EQ(f.escaped, 0.0) << "a closed room";
+  const float dMax = render::defaultDMax(s, tree, inside);
+  EXPECT_GE(dMax, 0.5f);
+  EXPECT_LE(dMax, 1.0f);
+  const scene::Scene classroom = scene::loadGltf(sharedScene("classroom/classroom.gltf"));
+  bvh::Bvh classroomTree = bvh::build(render::triangleSoup(classroom));
+  const float classroomDMax = render::defaultDMax(classroom, classroomTree, classroom.cameras.at(0));
+  std::printf("[ figure   ] default dmax: cube room of side 2 %.3f; classroom %.3f m (the paper's 1/4 of the box: %.1f m)\n",
+              dMax, classroomDMax, render::boundsDMax(classroom.bounds));
+  EXPECT_LT(classroomDMax, 5.0f);
+  EXPECT_GT(classroomDMax, 0.5f);
 }
 
 class ReachedAmbient : public GpuTest {};

@@ -136,7 +136,11 @@ ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh,
 LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) const {
   LightReach reach;
   if (samples_.empty() || !(lights.power[light] > 0.0)) return reach;
-  std::mt19937 rng(0x11a7u + static_cast<std::uint32_t>(light));
+  // Seeded by the light's name, not its index: the same light gets the same estimate in a scene
+  // with other lights added or removed.
+  std::uint32_t seed = 2166136261u; // FNV-1a
+  for (unsigned char c : lights.names[light]) seed = (seed ^ c) * 16777619u;
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
   const scene::Scene& scene = *scene_;
   auto offsetToward = [&](glm::vec3 p, glm::vec3 n, glm::vec3 towards) {

@@ -1,0 +1,73 @@
+#include "render/scene/free_path.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <vector>
+
+namespace obscura::render {
+
+float boundsDMax(const scene::Bounds& bounds) {
+  glm::vec3 e = bounds.extent();
+  float largest = std::max(e.x, std::max(e.y, e.z));
+  return largest > 0.0f && std::isfinite(largest) ? 0.25f * largest : 1.0f;
+}
+
+FreePath measureFreePath(const scene::Scene& scene, const bvh::Bvh& bvh, const scene::Camera& camera) {
+  constexpr int kGrid = 48;
+  FreePath out;
+  const float aspect = camera.aspectRatio > 0.0f ? camera.aspectRatio : 4.0f / 3.0f;
+  const float tanHalf = std::tan(0.5f * camera.yfov);
+  const glm::vec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
+  const float extent = 4.0f * boundsDMax(scene.bounds); // the largest side
+  std::mt19937 rng(0xd15ca1u);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  std::vector<float> distances;
+  std::size_t escaped = 0;
+  for (int y = 0; y < kGrid; ++y)
+    for (int x = 0; x < kGrid; ++x) {
+      float sx = (2.0f * (static_cast<float>(x) + 0.5f) / kGrid - 1.0f) * tanHalf * aspect;
+      float sy = (1.0f - 2.0f * (static_cast<float>(y) + 0.5f) / kGrid) * tanHalf;
+      glm::vec3 d = glm::normalize(camera.forward + sx * right + sy * camera.up);
+      bvh::Hit hit = bvh::closestHit(bvh, {.origin = camera.position, .direction = d});
+      if (!hit.hit()) continue;
+      const glm::uvec3 t = scene.triangles[hit.primitive];
+      glm::vec3 a = scene.positions[t.x], b = scene.positions[t.y], c = scene.positions[t.z];
+      glm::vec3 n = glm::cross(b - a, c - a);
+      if (!(glm::length(n) > 0.0f)) continue;
+      n = glm::normalize(n);
+      if (glm::dot(n, d) > 0.0f) n = -n; // the side the camera sees
+      glm::vec3 p = camera.position + hit.t * d;
+      float offset = std::max(1e-5f * extent, 4e-6f * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}));
+      // Cosine direction about n.
+      glm::vec3 helper = std::abs(n.x) > 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+      glm::vec3 tx = glm::normalize(glm::cross(helper, n)), ty = glm::cross(n, tx);
+      float u1 = uni(rng), u2 = uni(rng), r = std::sqrt(u1), phi = 2.0f * std::numbers::pi_v<float> * u2;
+      glm::vec3 w = r * std::cos(phi) * tx + r * std::sin(phi) * ty + std::sqrt(std::max(0.0f, 1.0f - u1)) * n;
+      bvh::Hit next = bvh::closestHit(bvh, {.origin = p + offset * n, .direction = w});
+      ++out.rays;
+      if (next.hit()) distances.push_back(next.t);
+      else ++escaped;
+    }
+  if (out.rays == 0) return out;
+  out.escaped = static_cast<double>(escaped) / out.rays;
+  // Escaped rays are longer than any hit: the median is among the hits only while fewer than half left.
+  const std::size_t middle = out.rays / 2;
+  if (middle < distances.size()) {
+    std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(middle), distances.end());
+    out.median = distances[middle];
+  } else {
+    out.median = std::numeric_limits<float>::infinity();
+  }
+  return out;
+}
+
+float defaultDMax(const scene::Scene& scene, const bvh::Bvh& bvh, const scene::Camera& camera) {
+  FreePath f = measureFreePath(scene, bvh, camera);
+  if (f.rays == 0 || !std::isfinite(f.median) || !(f.median > 0.0f)) return boundsDMax(scene.bounds);
+  return 0.5f * f.median;
+}
+
+} // namespace obscura::render
