@@ -38,6 +38,7 @@ void main() {
   ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);
   uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x5bd1e995u);
   StepBudget budget = newStepBudget();
+  const vec4 lightShift = rngNext4(rng); // the hit's light samples: one shifted low-discrepancy set
   if ((pc.band.z & kShadeFlagPerLight) != 0u) {
     // The paper's visibility sampling [IVR §3.1]: kPerLightRays rays to this light; where they
     // disagree (a penumbra) more, up to kPerLightMaxRays, all averaged.
@@ -46,7 +47,7 @@ void main() {
     uint taken = 0u, seen = 0u;
     for (uint k = 0u; k < kPerLightMaxRays; ++k) {
       if (k == kPerLightRays && (seen == 0u || seen == kPerLightRays)) break;
-      vec4 u = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
+      vec4 u = kroneckerPoint4(k, lightShift);
       vec3 contribution;
       bool visible;
       directLightFrom(sp, sampleChosenLight(sp.position, u, light, 1.0), 0.0, budget, contribution, visible);
@@ -63,7 +64,7 @@ void main() {
   float invCount = 1.0 / float(count);
   float misSamples = (pc.counts.w & kFlagGlossyMis) != 0u ? float(count) : 0.0;
   for (uint k = 0u; k < count; ++k) {
-    vec4 u = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
+    vec4 u = kroneckerPoint4(k, lightShift);
     vec3 contribution;
     uint light;
     directLightSample(sp, u, pc.counts.x, misSamples, budget, contribution, light);

@@ -111,8 +111,9 @@ void main() {
     // Gather as at P [RTO §4.1 step 4]: direct light, then obscurance.
     // MIS only where a lobe sample follows from this vertex (the loop goes on past it).
     float misSamples = glossyMis && depth + 1u < maxDepth ? float(shadowRays) : 0.0;
+    const vec4 lightShift = rngNext4(rng); // this vertex's light samples: one shifted low-discrepancy set
     for (uint k = 0u; k < shadowRays; ++k) {
-      vec4 u = vec4(rngNext(rng), rngNext(rng), rngNext(rng), rngNext(rng));
+      vec4 u = kroneckerPoint4(k, lightShift);
       vec3 contribution;
       uint light;
       directLightSample(sp, u, lightCount, misSamples, budget, contribution, light);
