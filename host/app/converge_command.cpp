@@ -45,6 +45,7 @@ struct ConvergeOptions {
   std::uint32_t referenceFactor = 64;   // a reference has this many times the largest curve's spp
   std::uint32_t pathReferenceSpp = 0;   // 0: referenceFactor x pathMaxSpp
   std::uint32_t seed = 1;
+  float dMax = 0.0f; // 0: the renderer's default
   std::string commandLine;
   DeviceOptions device;
 };
@@ -113,6 +114,7 @@ public:
       s.obscuranceRays = m.raysPerHit;
       s.lightSampling = m.lightSampling;
       s.ambient = render::AmbientModel::Reached;
+      s.dMax = o_.dMax;
       if (!obscurance_)
         obscurance_ = std::make_unique<render::ObscuranceRenderer>(context_, loaded_.scene, loaded_.bvh, s);
       obscurance_->configure(s);
@@ -140,7 +142,7 @@ public:
     std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} light_sampling={}{}",
                                           o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
                                           m.lightSampling == render::LightSampling::Area ? "area" : "spatial",
-                                          m.pathTrace ? "" : " ambient=reached+global");
+                                          m.pathTrace ? "" : fmt::format(" ambient=reached+global dmax={}", o_.dMax));
     if (fs::exists(exr) && fs::exists(txt)) {
       std::ifstream in(txt);
       std::string first;
@@ -340,6 +342,8 @@ void addConvergeCommand(CLI::App& app) {
       ->check(CLI::Range(1u, 4096u));
   cmd->add_option("--pt-reference-spp", o->pathReferenceSpp, "path-tracing reference spp (default: factor x --pt-max-spp)");
   cmd->add_option("--seed", o->seed, "seed");
+  cmd->add_option("--dmax", o->dMax, "obscurance dmax (default: the renderer's, half the median free path)")
+      ->check(CLI::PositiveNumber);
   addDeviceOptions(*cmd, o->device);
   cmd->callback([o, cmd] {
     o->commandLine = "obscura converge";

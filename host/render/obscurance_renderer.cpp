@@ -68,6 +68,7 @@ void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh&
   for (const auto& m : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(m));
   reached_ = std::make_unique<ReachedSurfaces>(scene, bvh, triangleReflectances(scene, meanAlbedo));
   ambient_.model = AmbientModel::Reached;
+  ambient_.depth = settings_.maxDepth;
   ambient_.reach.clear();
   for (std::size_t s = 0; s < lights_.size(); ++s) ambient_.reach.push_back(reached_->measure(lights_, s));
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
@@ -83,7 +84,10 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
   const bool bleedChanged = settings.colourBleeding != settings_.colourBleeding;
   settings_ = settings;
   dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax_;
-  if (bleedChanged) updateAmbientWeights(ambient_, lights_, settings.colourBleeding);
+  if (bleedChanged || ambient_.depth != (reached_ ? settings.maxDepth : 0u)) {
+    ambient_.depth = reached_ ? settings.maxDepth : 0u;
+    updateAmbientWeights(ambient_, lights_, settings.colourBleeding);
+  }
   reset();
 }
 

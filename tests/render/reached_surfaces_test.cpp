@@ -72,6 +72,12 @@ TEST(ReachedSurfaces, LampReachesItsOwnRoomOnlyWithThatRoomsReflectance) {
   const double expectedRatio = (1.0 / r.fraction) * (1.0 - global.averageReflectance.x) / (1.0 - r.reflectance.x);
   EXPECT_NEAR(term.weight[0].x / global.weight[0].x, expectedRatio, 1e-4 * expectedRatio);
   EXPECT_NEAR(term.globalWeight[0].x, global.weight[0].x, 1e-6 * global.weight[0].x);
+  // A render of depth d sums the d - 1 bounces a path holds: (1 - q^(d-1)) of the full series.
+  const float all = term.weight[0].x;
+  term.depth = 6;
+  render::updateAmbientWeights(term, lights, true);
+  const double q = r.reflectance.x * (1.0 - r.escapeBounce);
+  EXPECT_NEAR(term.weight[0].x, all * (1.0 - std::pow(q, 5.0)), 1e-5 * all);
 }
 
 TEST(ReachedSurfaces, OpenBoxLosesWhatLeavesThroughItsOpening) {
@@ -161,6 +167,7 @@ TEST_F(ReachedAmbient, LitRoomMatchesPathTracingWithReachedAndNotWithGlobal) {
     o.camera = camera;
     o.ambient = model;
     o.dMax = 1.0f;
+    o.maxDepth = pt.maxDepth; // the same bounces as the path tracer (I_a sums d - 1 of them)
     byModel[int(model)] = mean(test::renderObscurances(context(), s, tree, o).image);
   }
   const double reached = byModel[int(render::AmbientModel::Reached)], global = byModel[int(render::AmbientModel::Global)];

@@ -30,6 +30,10 @@ struct AmbientTerm {
   bool reflectanceClamped = false;    // R_ave reached 1 in a channel: I_a would be infinite
   double totalArea = 0.0;             // A_t
   std::vector<LightReach> reach;      // per light (Reached); an entry of zero area falls back to A_t
+  // Reached: the bounces I_a sums, as the render's path depth d (paths of at most d scattering
+  // vertices, like the path tracer): sum_{j=1}^{d-1} q^(j-1) instead of 1 / (1 - q), q = R_s (1 - e_1).
+  // 0: all of them (the paper's series).
+  std::uint32_t depth = 0;
   std::vector<glm::vec3> weight;      // per light: I_a per unit E_s
   std::vector<glm::vec3> globalWeight; // the same by the paper's formula (whole scene), for reports
   glm::vec3 intensity(const std::vector<glm::vec3>& emission) const;       // I_a(E)
