@@ -1,6 +1,9 @@
 #include "render/obscurance_renderer.h"
 
 #include <algorithm>
+#include <atomic>
+#include <future>
+#include <thread>
 #include <chrono>
 #include <cstring>
 
@@ -69,8 +72,18 @@ void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh&
   reached_ = std::make_unique<ReachedSurfaces>(scene, bvh, triangleReflectances(scene, meanAlbedo));
   ambient_.model = AmbientModel::Reached;
   ambient_.depth = settings_.maxDepth;
-  ambient_.reach.clear();
-  for (std::size_t s = 0; s < lights_.size(); ++s) ambient_.reach.push_back(reached_->measure(lights_, s));
+  // Lights spread over the cores (measure is const and seeds its own generator): the CPU rays of
+  // modern-hall's 13 lights take ~0.3 s on one core.
+  ambient_.reach.assign(lights_.size(), LightReach{});
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t s = next++; s < lights_.size(); s = next++) ambient_.reach[s] = reached_->measure(lights_, s);
+  };
+  std::vector<std::future<void>> workers;
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  for (unsigned w = 1; w < std::min<std::size_t>(cores, lights_.size()); ++w) workers.push_back(std::async(std::launch::async, worker));
+  worker();
+  for (auto& w : workers) w.get();
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
 }
 
