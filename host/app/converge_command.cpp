@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/render_options.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
 #include "io/image_io.h"
@@ -212,6 +213,7 @@ void runConverge(const ConvergeOptions& o) {
     throw InputError(fmt::format("{}: cannot create the output folder{}", o.outputDir, ec ? ": " + ec.message() : ""));
   gpu::Context context(o.device.contextOptions());
   fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
+  warnIfUnlit(loaded);
   Study study(o, loaded, context);
 
   const Method& best = kMethods.front();
