@@ -110,7 +110,19 @@ void main() {
   // Vertex `depth` (1 = the camera ray's hit): its emission ends a path of depth - 1 scattering
   // vertices, its scattering (light sample, BSDF sample) makes depth of them.
   for (uint depth = 1u; depth <= maxDepth + 1u; ++depth) {
-    if (hit.primitive == kInvalidIndex || !rayHitValid(hit)) break; // miss (black) or truncated
+    if (hit.primitive == kInvalidIndex || !rayHitValid(hit)) {
+      // A miss sees the sky, when there is one (camera.up.w: its slot); a truncated ray nothing.
+      uint sky = floatBitsToUint(pc.camera.up.w);
+      if (hit.primitive != kTruncatedHit && sky < lightCount) { // a miss, not a truncation
+        float w = 1.0;
+        if (!specularBounce && strategy != kPathStrategyBsdfOnly) {
+          float lightPdf = backgroundLightPdf(sky, previous, previousNormal, lightCount, direction);
+          w = strategy == kPathStrategyLightOnly ? (lightPdf > 0.0 ? 0.0 : 1.0) : powerHeuristic(bsdfPdfPrev, lightPdf);
+        }
+        L += beta * w * emissionScale[sky].rgb;
+      }
+      break;
+    }
     Surface s = surfaceAt(hit, origin, direction);
     GpuMaterial m = materials[s.material];
 
@@ -145,7 +157,7 @@ void main() {
       // sampleLight is deterministic in (p, u): this is the sample directLightSample draws below;
       // drawing it first gives its pdf for the MIS weight and skips shadow rays of weight 0.
       LightSample ls = sampleLight(sp.position, sp.ng, uLight, lightCount);
-      bool area = lights[ls.light].info.x == kLightArea;
+      bool area = ls.hittable; // an area light or the sky: BSDF sampling reaches it too
       float w = 1.0;
       if (area && strategy == kPathStrategyBsdfOnly) {
         w = 0.0;

@@ -69,6 +69,12 @@ void main() {
     // A light at the eye: enough to see shapes before any lighting pass runs.
     preview = albedo * abs(dot(s.shadingNormal, direction)) + emission;
   } else {
+    // The sky, when there is one: unit radiance in the background light's M_s.
+    uint sky = floatBitsToUint(pc.camera.up.w);
+    if (hit.primitive != kTruncatedHit && sky < lightCount) { // a miss, not a truncation
+      lightGroup = sky;
+      unitSeen = vec3(1.0);
+    }
     g.position = vec4(0.0);
     g.geometricNormal = vec4(0.0, 0.0, 0.0, uintBitsToFloat(kInvalidIndex));
     g.shadingNormal = vec4(0.0, 0.0, 0.0, uintBitsToFloat(kInvalidIndex));

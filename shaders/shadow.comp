@@ -50,7 +50,7 @@ void main() {
       vec4 u = kroneckerPoint4(k, lightShift);
       vec3 contribution;
       bool visible;
-      directLightFrom(sp, sampleChosenLight(sp.position, u, light, 1.0), 0.0, budget, contribution, visible);
+      directLightFrom(sp, sampleChosenLight(sp.position, sp.ng, u, light, 1.0), 0.0, budget, contribution, visible);
       sum += contribution;
       seen += visible ? 1u : 0u;
       ++taken;

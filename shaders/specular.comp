@@ -90,6 +90,12 @@ void main() {
     ++rays;
     if (!rayHitValid(h) || h.primitive == kInvalidIndex) {
       escaped = true;
+      // The sky along the lobe: whole after a mirror, MIS-weighted after a glossy bounce.
+      uint sky = findBackgroundLight(lightCount);
+      if (h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || glossyMis)) { // a miss, not a truncation
+        float w = delta ? 1.0 : powerHeuristic(lobePdf, float(shadowRays) * backgroundLightPdf(sky, previous, previousNormal, lightCount, wi));
+        OBS_ACCUMULATE(specularBasis, sky * pixelCount + pixel, vec4(w * throughput, 0.0))
+      }
       break;
     }
     Surface s = surfaceAt(h, origin, wi);

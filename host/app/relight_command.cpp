@@ -124,6 +124,7 @@ void relightScene(RelightOptions& o) {
     throw InputError("--method: relighting keeps per-light transport, which only the obscurance method has");
   checkRenderOptions(o.render);
   LoadedScene loaded = loadScene(o.input, o.render.lightGroups);
+  applyBackground(o.render, loaded);
   const render::LightSet sceneLights = render::buildLightSet(loaded.scene);
   std::vector<bool> area;
   for (const auto& l : sceneLights.lights) area.push_back(l.info.x == gpu::kLightArea);

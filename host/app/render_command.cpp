@@ -141,6 +141,7 @@ void runRender(RenderOptions& o) {
   if (!o.metrics.empty()) checkWritable(o.metrics);
 
   LoadedScene loaded = loadScene(o.scenePath, o.lightGroups);
+  applyBackground(o, loaded);
   scene::Camera camera = chooseCamera(loaded.scene, o.camera);
   chooseSize(o, camera);
   fmt::print(stderr, "{}\n", sceneSummary(loaded));

@@ -67,12 +67,25 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
                  "which surfaces share a light's flux in I_a: reached (default: those its light reaches, directly or "
                  "after one bounce) or global (the paper's: the whole scene)")
       ->check(CLI::IsMember({"reached", "global"}));
+  cmd.add_option("--background", o.background,
+                 "R,G,B: a constant sky radiance that rays leaving the scene see, one more light ('background') "
+                 "that relighting can scale (default: none, black)")
+      ->delimiter(',')
+      ->expected(3);
   cmd.add_option("--light-groups", o.lightGroups,
                  "lights edited as one: node (one per emissive mesh node, default), material (one per emissive "
                  "material), or a JSON file {\"group\": [\"node\", ...]}");
 }
 
+void applyBackground(const RenderOptions& o, LoadedScene& loaded) {
+  if (o.background.empty()) return;
+  loaded.scene.background = glm::vec3(o.background[0], o.background[1], o.background[2]);
+}
+
 void checkRenderOptions(const RenderOptions& o) {
+  for (float c : o.background)
+    if (!(std::isfinite(c) && c >= 0.0f))
+      throw InputError(fmt::format("--background {}: each of R, G, B must be a finite radiance >= 0", c));
   if (o.dMaxGiven && !(std::isfinite(o.dMax) && o.dMax > 0.0f))
     throw InputError(fmt::format("--dmax {}: must be a finite positive distance in scene units", o.dMax));
 }
@@ -100,9 +113,9 @@ void warnIfUnlit(const LoadedScene& loaded) {
   if (lights.anySampled()) return;
   fmt::print(stderr,
              "warning: {} has no light that emits (no emissive material with emission > 0, no KHR_lights_punctual "
-             "light): direct light and the obscurance term's I_a are 0, so the image is black but for what emits. "
-             "Add a light to the scene, or relight it: obscura relight SCENE --edits EDITS.json with an add_light "
-             "edit\n",
+             "light, no --background): direct light and the obscurance term's I_a are 0, so the image is black but for "
+             "what emits. Give it a sky with --background R,G,B, add a light to the scene, or relight it: obscura "
+             "relight SCENE --edits EDITS.json with an add_light edit\n",
              loaded.scene.sourcePath);
 }
 

@@ -36,6 +36,7 @@ struct RenderOptions {
   std::string shadowSampling = "selection";
   std::string lightSampling = "spatial";
   std::string ambient = "reached";
+  std::vector<float> background; // R,G,B radiance of the sky; empty: none
   DeviceOptions device;
 };
 
@@ -49,6 +50,8 @@ scene::Camera chooseCamera(const scene::Scene& scene, int index);
 void chooseSize(RenderOptions& o, const scene::Camera& camera);
 // The obscurance renderer's settings from the options, for `camera` at the chosen size.
 render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scene::Camera& camera);
+// Gives the loaded scene the --background sky (after loadScene, before the lights are built).
+void applyBackground(const RenderOptions& o, LoadedScene& loaded);
 // Warns (stderr) when no light of the scene emits anything: the image would be black but for
 // seen emission, and a user deserves to know why.
 void warnIfUnlit(const LoadedScene& loaded);

@@ -51,6 +51,7 @@ std::string lightTypeName(std::uint32_t gpuType) {
     case gpu::kLightArea: return "area";
     case gpu::kLightPoint: return "point";
     case gpu::kLightSpot: return "spot";
+    case gpu::kLightBackground: return "background";
     default: return "directional";
   }
 }

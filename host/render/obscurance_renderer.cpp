@@ -66,6 +66,12 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
   uploadLights();
 }
 
+gpu::GpuCamera ObscuranceRenderer::primaryCamera() const {
+  const std::size_t sky = backgroundLight(lights_);
+  return gpuCamera(settings_.camera, settings_.width, settings_.height,
+                   sky < lights_.size() ? static_cast<std::uint32_t>(sky) : gpu::kInvalidIndex);
+}
+
 void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh& bvh) {
   std::vector<glm::vec3> meanAlbedo; // of `scene`'s materials (an insert brings its own)
   for (const auto& m : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(m));
@@ -198,7 +204,7 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   const FrameLayout& layout = frame_.layout();
   const std::uint32_t bands = layout.bandCount();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
-  const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
+  const gpu::GpuCamera camera = primaryCamera();
   gpu::ShadePush push = shadePush(s);
   push.band.z = shadeFlags;
   timestamps_.begin(cmd, "primary");
@@ -267,10 +273,12 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   if (rebind || emittersMoved) uploadLights();
 
   const FrameLayout& layout = frame_.layout();
-  const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
+  const gpu::GpuCamera camera = primaryCamera();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
   for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
-    dirty_.prepare(b, layout, camera, changed, dMax_, lightCount, emittersMoved);
+    // The sky lights every pixel from every direction: any edit may change any pixel.
+    dirty_.prepare(b, layout, camera, changed, dMax_, lightCount,
+                   emittersMoved || backgroundLight(lights_) < lights_.size());
   const std::uint32_t dirtyBefore = frame_.statusWords()[gpu::kStatusDirtyPixels];
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
@@ -492,7 +500,7 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
   const auto start = Clock::now();
   const double wallBefore = wallSeconds_;
   const FrameLayout& layout = frame_.layout();
-  const gpu::GpuCamera camera = gpuCamera(settings_.camera, settings_.width, settings_.height);
+  const gpu::GpuCamera camera = primaryCamera();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
   for (std::uint32_t first = 0; first < samples_; first += kSamplesPerSubmission) {
     const std::uint32_t last = std::min(samples_, first + kSamplesPerSubmission);

@@ -169,6 +169,7 @@ private:
   void measureReach(const scene::Scene& scene, const bvh::Bvh& bvh);
   void bindAll();
   gpu::ShadePush shadePush(std::uint32_t sample) const;
+  gpu::GpuCamera primaryCamera() const; // with the background's slot
   std::vector<glm::vec4> downloadBand(const gpu::Buffer& buffer) const;
 
   const gpu::Context* context_;

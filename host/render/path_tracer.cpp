@@ -92,7 +92,10 @@ void PathTracer::iterate(std::uint32_t samples, const ProgressFn& progress) {
   // No light with power: no light sampling at all (sampleLight needs a light it can pick), so the
   // shader traces no shadow ray; emitters of zero power still show where a ray sees them.
   const auto lightCount = lights_.anySampled() ? static_cast<std::uint32_t>(lights_.size()) : 0u;
-  gpu::PathPush push{.camera = gpuCamera(settings_.camera, settings_.width, settings_.height),
+  const std::size_t sky = backgroundLight(lights_);
+  gpu::PathPush push{.camera = gpuCamera(settings_.camera, settings_.width, settings_.height,
+                                         sky < lights_.size() && lightCount > 0 ? static_cast<std::uint32_t>(sky)
+                                                                                : gpu::kInvalidIndex),
                      .frame = glm::uvec4(settings_.width, settings_.height, 0u, settings_.seed),
                      .params = glm::uvec4(lightCount, settings_.maxDepth, settings_.rrDepth,
                                           static_cast<std::uint32_t>(settings_.strategy)),

@@ -105,6 +105,9 @@ struct Scene {
   std::vector<LightGroup> lightGroups;
   std::vector<SceneObject> objects;  // in glTF node order; together they hold every triangle
   std::vector<Camera> cameras;       // in glTF node order
+  // Constant radiance of the sky that rays leaving the scene see (`--background`; glTF has none):
+  // one more light, "background", whose basis buffer relighting scales like any other.
+  glm::vec3 background{0.0f};
   Bounds bounds;
   LoadStats stats;
   std::vector<std::string> warnings; // "<element>: <what was ignored or assumed>", for the log

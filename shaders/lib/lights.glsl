@@ -30,7 +30,8 @@ struct LightSample {
   vec3 wi;          // unit direction from the shading point to the light
   vec3 target;      // the point the shadow ray must reach (tmax = its distance)
   vec3 targetNormal;// for area lights: the light's geometric normal facing the shading point
-  bool infinite;    // directional light: no target point
+  bool infinite;    // directional light or background: no target point
+  bool hittable;    // a BSDF-sampled ray can reach it too (area light, background): MIS applies
   vec3 weight;      // unit-emission radiance x geometry / pdf: multiply by the BRDF and cos(P)
   float pdf;        // solid-angle pdf (area lights), or the selection probability (punctual)
 };
@@ -108,8 +109,11 @@ float lightImportance(uint i, vec3 p, vec3 n) {
   return importance;
 }
 
-// Directional lights get an equal share of the selection among themselves and the bounded lights
-// as one (pbrt-v4's BVHLightSampler does the same for infinite lights).
+// Lights without bounds: directional lights and the background. They get an equal share of the
+// selection among themselves and the bounded lights as one (pbrt-v4's BVHLightSampler does the
+// same for infinite lights).
+bool isUnbounded(uint type) { return type == kLightDirectional || type == kLightBackground; }
+
 bool useSpatialSelection(uint count) {
   return gLightSampling == kLightSamplingSpatial && count <= kMaxSpatialLights;
 }
@@ -120,7 +124,7 @@ float lightSelectionPdf(uint chosen, vec3 p, vec3 n, uint count) {
   float total = 0.0, mine = 0.0;
   uint directional = 0u;
   for (uint i = 0u; i < count; ++i) {
-    if (lights[i].info.x == kLightDirectional) {
+    if (isUnbounded(lights[i].info.x)) {
       directional += lights[i].params.y > 0.0 ? 1u : 0u;
       continue;
     }
@@ -130,7 +134,7 @@ float lightSelectionPdf(uint chosen, vec3 p, vec3 n, uint count) {
   }
   float shares = float(directional) + (total > 0.0 ? 1.0 : 0.0);
   if (shares == 0.0) return 0.0;
-  if (lights[chosen].info.x == kLightDirectional) return lights[chosen].params.y > 0.0 ? 1.0 / shares : 0.0;
+  if (isUnbounded(lights[chosen].info.x)) return lights[chosen].params.y > 0.0 ? 1.0 / shares : 0.0;
   return total > 0.0 ? mine / total / shares : 0.0;
 }
 
@@ -144,7 +148,7 @@ uint selectLight(float u, vec3 p, vec3 n, uint count, out float selection) {
   float total = 0.0;
   uint directional = 0u;
   for (uint i = 0u; i < count; ++i) {
-    if (lights[i].info.x == kLightDirectional) directional += lights[i].params.y > 0.0 ? 1u : 0u;
+    if (isUnbounded(lights[i].info.x)) directional += lights[i].params.y > 0.0 ? 1u : 0u;
     else total += lightImportance(i, p, n);
   }
   float shares = float(directional) + (total > 0.0 ? 1.0 : 0.0);
@@ -155,7 +159,7 @@ uint selectLight(float u, vec3 p, vec3 n, uint count, out float selection) {
   if (scaled < float(directional)) {
     uint k = min(uint(scaled), directional - 1u);
     for (uint i = 0u; i < count; ++i) {
-      if (lights[i].info.x != kLightDirectional || !(lights[i].params.y > 0.0)) continue;
+      if (!isUnbounded(lights[i].info.x) || !(lights[i].params.y > 0.0)) continue;
       if (k == 0u) {
         selection = 1.0 / shares;
         return i;
@@ -169,7 +173,7 @@ uint selectLight(float u, vec3 p, vec3 n, uint count, out float selection) {
   uint last = 0u;
   float lastWeight = 0.0;
   for (uint i = 0u; i < count; ++i) {
-    if (lights[i].info.x == kLightDirectional) continue;
+    if (isUnbounded(lights[i].info.x)) continue;
     float w = lightImportance(i, p, n);
     if (w <= 0.0) continue;
     running += w;
@@ -211,9 +215,10 @@ bool sampleBySolidAngle(vec3 p, vec3 v0, vec3 v1, vec3 v2, out vec3 a, out vec3 
          solidAngle <= kMaxSphericalSampleArea;
 }
 
-// A point on light `chosen`, picked with probability `selection` (1 when it is sampled alone);
-// u.yzw: the triangle (by area) and the point on it.
-LightSample sampleChosenLight(vec3 p, vec4 u, uint chosen, float selection) {
+// A point on light `chosen` seen from p with normal n, picked with probability `selection` (1 when
+// it is sampled alone); u.yzw: the triangle (by area) and the point on it; for the background, u.zw
+// a direction by the cosine about n.
+LightSample sampleChosenLight(vec3 p, vec3 n, vec4 u, uint chosen, float selection) {
   LightSample s;
   s.light = chosen;
   GpuLight light = lights[s.light];
@@ -223,8 +228,21 @@ LightSample sampleChosenLight(vec3 p, vec4 u, uint chosen, float selection) {
   s.targetNormal = vec3(0.0);
   s.wi = vec3(0.0, 0.0, 1.0);
   s.target = p;
+  s.hittable = light.info.x == kLightArea || light.info.x == kLightBackground;
   if (!(selection > 0.0)) return s;
   uint type = light.info.x;
+  if (type == kLightBackground) {
+    // Unit radiance from every direction: cosine-distributed about n (pdf cos / pi), so an open
+    // Lambertian surface's estimate has no variance at all.
+    vec3 t, b;
+    orthonormalBasis(n, t, b);
+    vec3 local = sampleCosineHemisphere(u.zw);
+    s.wi = toWorld(local, t, b, n);
+    s.infinite = true;
+    s.pdf = selection * cosineHemispherePdf(local.z);
+    s.weight = s.pdf > 0.0 ? vec3(1.0 / s.pdf) : vec3(0.0);
+    return s;
+  }
   if (type == kLightArea) {
     uint e = selectEmitter(u.y, light.info.y, light.info.z);
     GpuEmitter em = emitters[e];
@@ -282,7 +300,7 @@ LightSample sampleChosenLight(vec3 p, vec4 u, uint chosen, float selection) {
 LightSample sampleLight(vec3 p, vec3 n, vec4 u, uint lightCount) {
   float selection;
   uint chosen = selectLight(u.x, p, n, lightCount, selection);
-  return sampleChosenLight(p, u, chosen, selection);
+  return sampleChosenLight(p, n, u, chosen, selection);
 }
 
 // The solid-angle density with which sampleLight(p, n, ...) picks the point y on triangle
@@ -300,6 +318,19 @@ float areaLightPdf(uint light, vec3 p, vec3 n, uint count, vec3 v0, vec3 v1, vec
   if (sampleBySolidAngle(p, v0, v1, v2, a, b, c, solidAngle))
     return selection * triangleArea(v0, v1, v2) / groupArea / solidAngle;
   return selection / groupArea * dist2 / cosL;
+}
+
+// The background's slot among the first `count` lights, or kInvalidIndex.
+uint findBackgroundLight(uint count) {
+  for (uint i = 0u; i < count; ++i)
+    if (lights[i].info.x == kLightBackground) return i;
+  return kInvalidIndex;
+}
+
+// The solid-angle density with which sampleLight(p, n, ...) picks direction `dir` towards the
+// background light `light` (for MIS with a BSDF-sampled ray that left the scene).
+float backgroundLightPdf(uint light, vec3 p, vec3 n, uint count, vec3 dir) {
+  return lightSelectionPdf(light, p, n, count) * max(dot(n, dir), 0.0) * (1.0 / kPi);
 }
 
 #endif

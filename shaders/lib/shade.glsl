@@ -118,7 +118,7 @@ void directLightFrom(ShadingPoint sp, LightSample ls, float lightSamples, inout 
   // The BSDF sees the light mirrored above the shading normal when it lies below it.
   vec3 wiShading = dot(sp.ns, ls.wi) < 0.0 ? reflect(ls.wi, sp.ns) : ls.wi;
   vec3 f = shadingBsdf(sp, wiShading);
-  if (lightSamples > 0.0 && ls.targetNormal != vec3(0.0)) { // an area light: the lobe can hit it
+  if (lightSamples > 0.0 && ls.hittable) { // an area light or the sky: the lobe can reach it too
     float lobePdf = specularLobePdf(sp, ls.wi);
     if (lobePdf > 0.0) {
       vec3 woLocal, wiLocal;

@@ -98,6 +98,7 @@ OBS_CONST uint kLightArea = 0u;
 OBS_CONST uint kLightPoint = 1u;
 OBS_CONST uint kLightSpot = 2u;
 OBS_CONST uint kLightDirectional = 3u;
+OBS_CONST uint kLightBackground = 4u; // a constant sky around the scene (unit radiance x E_s)
 
 // How a shadow ray picks its light and its point (lights.glsl) [SPEC §1.3]:
 // - Spatial (the default): the light by its importance at the shading point (power, distance and
@@ -157,7 +158,8 @@ struct GpuCamera {
   vec4 origin;  // 0:  xyz, w = tan(yfov / 2)
   vec4 forward; // 16: xyz, w = aspect (width / height)
   vec4 right;   // 32: xyz, w = unused
-  vec4 up;      // 48: xyz, w = unused
+  vec4 up;      // 48: xyz, w = the light slot of the background (uint bits; kInvalidIndex: none),
+                //     which a camera ray that leaves the scene sees (primary.comp, pathtrace.comp)
 };              // 64 bytes
 
 // ---- G-buffer texel written by primary.comp, one per pixel per sample.

@@ -181,8 +181,12 @@ TEST_F(CliBadInput, SceneWithoutLightsRendersWithAWarningThatSaysWhy) {
   const auto r = runObscura("render " + path("bad.gltf") + " -o " + path("out.png") + " --width 16 --spp 1");
   EXPECT_EQ(r.exitCode, 0) << r.output;
   EXPECT_CONTAINS(r.output, "warning: " + path("bad.gltf") + " has no light that emits");
-  EXPECT_CONTAINS(r.output, "add_light");
+  EXPECT_CONTAINS(r.output, "--background");
   EXPECT_TRUE(fs::exists(path("out.png")));
+  // With a sky it is lit: no warning.
+  const auto sky = runObscura("render " + path("bad.gltf") + " -o " + path("sky.png") + " --width 16 --spp 1 --background 1,1,1");
+  EXPECT_EQ(sky.exitCode, 0) << sky.output;
+  EXPECT_EQ(sky.output.find("warning:"), std::string::npos) << sky.output;
   const auto lit = runObscura("render " + scene() + " -o " + path("lit.png") + " --width 16 --spp 1");
   EXPECT_EQ(lit.exitCode, 0) << lit.output;
   EXPECT_EQ(lit.output.find("warning:"), std::string::npos) << lit.output;
@@ -201,6 +205,15 @@ TEST_F(CliBadInput, DmaxZeroOrNegativeIsRefused) {
     EXPECT_EQ(r.exitCode, 2) << flags << "\n" << r.output;
     EXPECT_CONTAINS(r.output, "--dmax");
     EXPECT_CONTAINS(r.output, "positive distance");
+    EXPECT_EQ(strayFiles(), std::vector<std::string>{}) << flags;
+  }
+}
+
+TEST_F(CliBadInput, BackgroundNeedsThreeFiniteNonNegativeRadiances) {
+  for (const std::string flags : {"--background 1,2", "--background -1,0,0", "--background 1,nan,1"}) {
+    const auto r = runObscura("render " + scene() + " -o " + path("out.png") + " --width 16 --spp 1 " + flags);
+    EXPECT_NE(r.exitCode, 0) << flags << "\n" << r.output; // CLI11's own code for a count, 2 for a value
+    EXPECT_CONTAINS(r.output, "--background");
     EXPECT_EQ(strayFiles(), std::vector<std::string>{}) << flags;
   }
 }

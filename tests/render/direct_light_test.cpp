@@ -164,5 +164,40 @@ TEST_F(DirectLight, DimLampNearbyAndBrightLampFarAwayAgreeAndSpatialSelectionIsL
   EXPECT_LT(spatial.spread, 0.1 * area.spread) << "spatial " << spatial.spread << " area " << area.spread;
 }
 
+TEST_F(DirectLight, SkyOverAnOpenFloorIsExactInBothMethods) {
+  // A uniform sky of radiance L over an infinite Lambertian floor of albedo a: the floor's
+  // radiance is a L (irradiance pi L). Cosine-distributed sky samples make every shadow ray's
+  // estimate exactly a L, in the obscurance renderer and in the path tracer's NEE, whose MIS with
+  // the equally cosine-distributed BSDF sample splits it in two exact halves. A camera ray that
+  // leaves the scene sees L.
+  SceneBuilder b;
+  auto floor = b.lambertian(glm::vec3(0.5f));
+  b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, floor);
+  scene::Scene s = b.build();
+  const glm::vec3 sky(0.5f, 1.0f, 2.0f);
+  s.background = sky;
+  auto settings = atTheOrigin(render::LightSampling::Spatial, 2);
+  auto r = render(s, settings);
+  ASSERT_EQ(r.lights.size(), 1u);
+  EXPECT_EQ(r.lights.names[0], "background");
+  for (int c = 0; c < 3; ++c) {
+    Estimate e = estimate(r.image, {std::string("direct.") + "RGB"[c]});
+    EXPECT_NEAR(e.mean, 0.5 * sky[c], 1e-5 * sky[c]) << c;
+    EXPECT_LT(e.spread, 1e-5 * sky[c]) << c;
+  }
+  // Looking up: every pixel is sky.
+  settings.camera = lookCamera({0, 1, 0}, {0, 1, 0}, {0, 0, -1}, 0.5f);
+  auto up = render(s, settings);
+  EXPECT_NEAR(estimate(up.image, {"combined.B"}).mean, sky.z, 1e-6);
+  EXPECT_NEAR(estimate(up.image, {"emission.G"}).mean, sky.y, 1e-6);
+  render::PathTraceSettings pt;
+  pt.width = pt.height = 32;
+  pt.spp = 4;
+  pt.maxDepth = 1;
+  pt.camera = atTheOrigin(render::LightSampling::Spatial, 1).camera;
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(estimate(pathTrace(s, pt).image, {std::string("combined.") + "RGB"[c]}).mean, 0.5 * sky[c], 1e-4 * sky[c]) << c;
+}
+
 } // namespace
 } // namespace obscura::test

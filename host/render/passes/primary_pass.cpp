@@ -1,12 +1,14 @@
 #include "render/passes/primary_pass.h"
 
+#include <bit>
 #include <cmath>
 
 #include "primary.spv.h"
 
 namespace obscura::render {
 
-gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::uint32_t height) {
+gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::uint32_t height,
+                         std::uint32_t backgroundLight) {
   glm::vec3 forward = glm::normalize(camera.forward);
   glm::vec3 right = glm::normalize(glm::cross(forward, camera.up));
   glm::vec3 up = glm::cross(right, forward);
@@ -14,7 +16,7 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
   return {.origin = glm::vec4(camera.position, std::tan(camera.yfov * 0.5f)),
           .forward = glm::vec4(forward, aspect),
           .right = glm::vec4(right, 0.0f),
-          .up = glm::vec4(up, 0.0f)};
+          .up = glm::vec4(up, std::bit_cast<float>(backgroundLight))};
 }
 
 namespace {

@@ -12,7 +12,9 @@ namespace obscura::render {
 
 // Pinhole camera for an image of width x height. The image's aspect ratio wins over the camera's
 // (the caller chooses the image size from the camera's aspect when the user gave none).
-gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::uint32_t height);
+// backgroundLight: the slot of the sky a camera ray that leaves the scene sees (kInvalidIndex: none).
+gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::uint32_t height,
+                         std::uint32_t backgroundLight = gpu::kInvalidIndex);
 
 class PrimaryPass {
 public:

@@ -83,6 +83,12 @@ std::vector<glm::vec4> emissionRows(const std::vector<glm::vec3>& emissions) {
 
 float luminanceWeight(const glm::vec3& rgb) { return (rgb.x + rgb.y + rgb.z) / 3.0f; }
 
+std::size_t backgroundLight(const LightSet& set) {
+  for (std::size_t i = 0; i < set.size(); ++i)
+    if (set.lights[i].info.x == gpu::kLightBackground) return i;
+  return set.size();
+}
+
 bool LightSet::anySampled() const {
   return std::any_of(power.begin(), power.end(), [](double p) { return p > 0.0; });
 }
@@ -124,6 +130,20 @@ LightSet buildLightSet(const scene::Scene& scene) {
   }
   // Punctual lights (KHR_lights_punctual): E_s = colour x intensity, unit transport per light.
   for (const auto& p : scene.punctualLights) appendPunctual(set, p, scene.bounds);
+  if (luminanceWeight(scene.background) > 0.0f) {
+    // The sky: unit radiance from every direction, E_s = the background colour. Its "flux" for
+    // selection and the paper's I_a is what a sphere around the scene receives from it,
+    // pi L x 4 pi R^2 (OURS; the reached I_a measures what lands, reached_surfaces.h).
+    gpu::GpuLight light{};
+    light.info = glm::uvec4(gpu::kLightBackground, 0u, 0u, 0u);
+    const float radius = 0.5f * glm::length(scene.bounds.extent());
+    const float unit = kPi * 4.0f * kPi * radius * radius;
+    set.lights.push_back(light);
+    set.names.push_back("background");
+    set.emission.push_back(scene.background);
+    set.unitFlux.push_back(glm::vec3(unit));
+    set.power.push_back(static_cast<double>(unit * luminanceWeight(scene.background)));
+  }
   updateSelection(set);
   return set;
 }

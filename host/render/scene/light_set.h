@@ -36,6 +36,9 @@ struct LightSet {
 // buffer is simply 0) but are never sampled.
 LightSet buildLightSet(const scene::Scene& scene);
 
+// The background light's slot, or size() when the scene has none.
+std::size_t backgroundLight(const LightSet& set);
+
 // Appends a punctual light (glTF KHR_lights_punctual units); call updateSelection after.
 void appendPunctual(LightSet& set, const scene::PunctualLight& light, const scene::Bounds& bounds);
 // Removes punctual light `index` and updates the selection. Area lights are never removed from a

@@ -57,6 +57,13 @@ LightPoint samplePoint(const LightSet& lights, std::size_t s, std::mt19937& rng,
     float len = glm::length(n);
     p.normal = len > 0.0f ? n / len : glm::vec3(0, 0, 1);
     p.twoSided = em.v2.w != 0.0f;
+  } else if (l.info.x == gpu::kLightBackground) {
+    // A point of the sky: on the scene's bounding sphere, emitting inwards.
+    glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
+    float radius = 0.5f * glm::length(bounds.hi - bounds.lo) + 1e-3f;
+    glm::vec3 d = sphereDirection(uni(rng), uni(rng));
+    p.position = centre + radius * d;
+    p.normal = -d;
   } else if (l.info.x == gpu::kLightDirectional) {
     // From a disk as wide as the scene's bounding sphere, outside it, towards the scene.
     glm::vec3 dir = glm::normalize(glm::vec3(l.direction));
@@ -82,7 +89,7 @@ bool emitDirection(const LightSet& lights, std::size_t s, const LightPoint& p, s
     d = p.direction;
     return true;
   }
-  if (l.info.x == gpu::kLightArea) {
+  if (l.info.x == gpu::kLightArea || l.info.x == gpu::kLightBackground) {
     glm::vec3 n = p.twoSided && uni(rng) < 0.5f ? -p.normal : p.normal;
     d = cosineDirection(n, uni(rng), uni(rng));
     return true;
