@@ -1,6 +1,7 @@
 #version 460
 // obscurance.comp — N_obs obscurance rays per primary hit [RTO §4.1 step 3]; accumulates
-// A = R(P) W_c (colour bleeding) or R(P) W (grey) and W itself (gatherObscurance, obscurance.glsl).
+// A = R(P) W_c (colour bleeding) or R(P) W (grey) and W itself (gatherObscurance, obscurance.glsl);
+// with secondary reflectors, the direct light that marked surfaces reflect to P into D_s.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -16,8 +17,8 @@
 #include "lib/lights.glsl"
 #include "lib/mis.glsl"
 #include "lib/shade.glsl"
-#include "lib/obscurance.glsl"
 #include "lib/accumulate.glsl"
+#include "lib/obscurance.glsl"
 #include "lib/band.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
@@ -34,8 +35,9 @@ void main() {
 
   ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);
   uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x9e3779b9u);
+  gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
   StepBudget budget = newStepBudget();
-  OBS_ACCUMULATE(ambient, pixel, gatherObscurance(sp, rng, budget))
+  OBS_ACCUMULATE(ambient, pixel, gatherObscurance(sp, rng, budget, pixel, bp.count))
   atomicAdd(status[kStatusObscuranceRays], pc.counts.z);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

@@ -26,8 +26,8 @@
 #include "lib/lights.glsl"
 #include "lib/mis.glsl"
 #include "lib/shade.glsl"
-#include "lib/obscurance.glsl"
 #include "lib/accumulate.glsl"
+#include "lib/obscurance.glsl"
 #include "lib/band.glsl"
 
 layout(local_size_x = kWorkgroupSize1D) in;
@@ -125,7 +125,8 @@ void main() {
       directLightSample(sp, u, lightCount, misSamples, budget, contribution, light);
       OBS_ACCUMULATE(specularBasis, light * pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
     }
-    vec4 aw = gatherObscurance(sp, rng, budget);
+    // Secondary reflectors only at primary hits: here the ambient keeps its whole I_a.
+    vec4 aw = gatherObscurance(sp, rng, budget, kInvalidIndex, pixelCount);
     OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
     rays += shadowRays + pc.counts.z;
   }

@@ -47,6 +47,8 @@ struct ConvergeOptions {
   std::uint32_t pathReferenceSpp = 0;   // 0: referenceFactor x pathMaxSpp
   std::uint32_t seed = 1;
   float dMax = 0.0f; // 0: the renderer's default
+  float secondaryReflectors = 0.0f; // > 0: one more method, obscurances with secondary reflectors
+  std::vector<float> background;    // R,G,B of a sky (render --background); empty: none
   std::string commandLine;
   DeviceOptions device;
 };
@@ -58,6 +60,7 @@ struct Method {
   std::uint32_t raysPerHit = 5;   // shadow and obscurance rays per hit (obscurance methods)
   std::uint32_t budgetSpp = 8;    // the budget its summary is read at
   std::string what;
+  float secondaryReflectors = 0.0f; // their marking threshold, 0 = off
 };
 
 // The paper's budget [RTO §4.1]: 8 primary samples x (5 obscurance + 5 shadow rays) per hit.
@@ -73,6 +76,21 @@ const std::vector<Method> kMethods = {
     {"obscurance-realtime", false, render::LightSampling::Spatial, 1, 1, "spatial, 1+1 rays per hit, 1 spp"},
     {"pathtrace", true, render::LightSampling::Spatial, 0, 1, "path tracing, NEE with spatial light sampling + MIS"},
 };
+
+// The methods a study runs: kMethods, and with --secondary-reflectors the best obscurance method
+// with them too (before path tracing, which stays last).
+std::vector<Method> studyMethods(const ConvergeOptions& o) {
+  std::vector<Method> methods = kMethods;
+  if (o.secondaryReflectors > 0.0f) {
+    Method m = methods.front();
+    m.name = "obscurance-reflectors";
+    m.what = fmt::format("as obscurance, with secondary reflectors marked at {:g} x mean direct irradiance",
+                         o.secondaryReflectors);
+    m.secondaryReflectors = o.secondaryReflectors;
+    methods.insert(methods.end() - 1, m);
+  }
+  return methods;
+}
 
 struct Rendered {
   io::Image image;
@@ -116,6 +134,7 @@ public:
       s.lightSampling = m.lightSampling;
       s.ambient = render::AmbientModel::Reached;
       s.dMax = o_.dMax;
+      s.secondaryReflectors = m.secondaryReflectors;
       if (!obscurance_)
         obscurance_ = std::make_unique<render::ObscuranceRenderer>(context_, loaded_.scene, loaded_.bvh, s);
       obscurance_->configure(s);
@@ -140,17 +159,19 @@ public:
     fs::path exr = fs::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
     fs::path txt = exr;
     txt.replace_extension(".txt");
-    std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} light_sampling={}{}",
+    std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} light_sampling={}{}{}",
                                           o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
                                           m.lightSampling == render::LightSampling::Area ? "area" : "spatial",
-                                          m.pathTrace ? "" : fmt::format(" ambient=reached+global dmax={}", o_.dMax));
+                                          m.pathTrace ? "" : fmt::format(" ambient=reached+global dmax={} secondary_reflectors={}",
+                                                                         o_.dMax, m.secondaryReflectors),
+                                          o_.background.empty() ? "" : fmt::format(" background={}", fmt::join(o_.background, ",")));
     if (fs::exists(exr) && fs::exists(txt)) {
       std::ifstream in(txt);
       std::string first;
       std::getline(in, first);
       if (first == description && (m.pathTrace || fs::exists(globalPath(exr)))) {
         fmt::print("reference {}: cached ({})\n", m.name, exr.string());
-        if (!m.pathTrace) globalReference_ = io::readImage(globalPath(exr).string());
+        if (!m.pathTrace) globalReferences_[m.name] = io::readImage(globalPath(exr).string());
         return io::readImage(exr.string());
       }
     }
@@ -163,9 +184,9 @@ public:
       // The same samples composed with the paper's whole-scene I_a (compose only, no ray).
       obscurance_->setAmbientModel(render::AmbientModel::Global);
       obscurance_->compose();
-      globalReference_ = combinedOnly(obscurance_->image());
+      globalReferences_[m.name] = combinedOnly(obscurance_->image());
       obscurance_->setAmbientModel(render::AmbientModel::Reached);
-      io::writeExr(globalPath(exr).string(), globalReference_);
+      io::writeExr(globalPath(exr).string(), globalReferences_[m.name]);
     }
     std::ofstream(txt) << description << "\nmade by: " << o_.commandLine << "\ngpu_ms: " << r.gpuMs << "\n";
     return combined;
@@ -184,8 +205,8 @@ public:
     return out;
   }
 
-  // The obscurance reference composed with the paper's I_a (after reference() of an obscurance method).
-  const io::Image& globalReference() const { return globalReference_; }
+  // Obscurance method `name`'s reference composed with the paper's I_a (after reference() of it).
+  const io::Image& globalReference(const std::string& name) const { return globalReferences_.at(name); }
   static fs::path globalPath(fs::path exr) { return exr.replace_extension(".global-ia.exr"); }
 
   std::uint32_t width() const { return width_; }
@@ -202,11 +223,13 @@ private:
   std::uint32_t width_ = 0, height_ = 0;
   std::string stem_;
   mutable render::RenderStats statsCopy_;
-  io::Image globalReference_;
+  std::map<std::string, io::Image> globalReferences_;
 };
 
 void runConverge(const ConvergeOptions& o) {
+  checkBackground(o.background);
   LoadedScene loaded = loadScene(o.scenePath); // first: a bad scene leaves no folder behind
+  if (!o.background.empty()) loaded.scene.background = glm::vec3(o.background[0], o.background[1], o.background[2]);
   std::error_code ec;
   fs::create_directories(o.outputDir, ec);
   if (ec || !fs::is_directory(o.outputDir))
@@ -216,10 +239,19 @@ void runConverge(const ConvergeOptions& o) {
   warnIfUnlit(loaded);
   Study study(o, loaded, context);
 
-  const Method& best = kMethods.front();
-  const Method& pathMethod = kMethods.back();
+  const std::vector<Method> methods = studyMethods(o);
+  const Method& best = methods.front();
+  const Method& pathMethod = methods.back();
   const io::Image obscuranceReference = study.reference(best);
   const io::Image ptReference = study.reference(pathMethod);
+  // Secondary reflectors converge to an image of their own: their noise is measured against it.
+  std::map<std::string, io::Image> reflectorReferences;
+  for (const Method& m : methods)
+    if (m.secondaryReflectors > 0.0f) reflectorReferences[m.name] = study.reference(m);
+  auto noiseReference = [&](const Method& m) -> const io::Image& {
+    if (m.pathTrace) return ptReference;
+    return m.secondaryReflectors > 0.0f ? reflectorReferences.at(m.name) : obscuranceReference;
+  };
 
   std::vector<render::Curve> curves;
   std::map<std::string, io::Image> atBudget; // each method's image at its budget
@@ -227,13 +259,13 @@ void runConverge(const ConvergeOptions& o) {
   std::ofstream csv(csvPath);
   csv << "method,spp,rays_per_pixel,gpu_ms,rmse_noise,relmse_noise,mae_noise,rmse_trimmed_noise,"
          "rmse_vs_pathtrace,relmse_vs_pathtrace,mae_vs_pathtrace,rmse_trimmed_vs_pathtrace\n";
-  for (const auto& m : kMethods) {
+  for (const auto& m : methods) {
     render::Curve curve{.method = m.name, .points = {}};
     std::uint32_t maxSpp = m.pathTrace ? o.pathMaxSpp : o.obscuranceMaxSpp;
     for (std::uint32_t spp = 1; spp <= maxSpp; spp *= 2) {
       Rendered r = study.render(m, spp, o.seed + spp);
       render::CurvePoint p{.spp = spp, .raysPerPixel = r.rays, .gpuMs = r.gpuMs,
-                           .noise = render::imageError(r.image, m.pathTrace ? ptReference : obscuranceReference),
+                           .noise = render::imageError(r.image, noiseReference(m)),
                            .total = render::imageError(r.image, ptReference)};
       if (spp == m.budgetSpp) atBudget[m.name] = r.image;
       curve.points.push_back(p);
@@ -261,12 +293,26 @@ void runConverge(const ConvergeOptions& o) {
              ptBelowFloor.extrapolated ? " (extrapolated)" : "");
   summary["bias_floor"] = {{"rmse", bias.rmse}, {"relmse", bias.relMse}, {"mae", bias.mae},
                            {"rmse_trimmed", bias.rmseTrimmed}, {"mean_ratio", bias.meanRatio}};
-  const render::ImageError globalBias = render::imageError(study.globalReference(), ptReference);
+  const render::ImageError globalBias = render::imageError(study.globalReference(best.name), ptReference);
   fmt::print("bias floor with the paper's whole-scene I_a: RMSE {:.5f}, relMSE {:.5f}, MAE {:.5f}, trimmed RMSE {:.5f}, "
              "mean ratio {:.4f}\n",
              globalBias.rmse, globalBias.relMse, globalBias.mae, globalBias.rmseTrimmed, globalBias.meanRatio);
   summary["bias_floor_global_ia"] = {{"rmse", globalBias.rmse}, {"relmse", globalBias.relMse}, {"mae", globalBias.mae},
                                      {"rmse_trimmed", globalBias.rmseTrimmed}, {"mean_ratio", globalBias.meanRatio}};
+  for (const auto& [name, reference] : reflectorReferences) {
+    const render::ImageError reached = render::imageError(reference, ptReference);
+    const render::ImageError global = render::imageError(study.globalReference(name), ptReference);
+    for (const auto& [which, e] : {std::pair{"reached I_a", reached}, std::pair{"the paper's I_a", global}})
+      fmt::print("bias floor with secondary reflectors ({}), {}: RMSE {:.5f}, relMSE {:.5f}, MAE {:.5f}, trimmed RMSE "
+                 "{:.5f}, mean ratio {:.4f}\n",
+                 name, which, e.rmse, e.relMse, e.mae, e.rmseTrimmed, e.meanRatio);
+    auto json = [](const render::ImageError& e) {
+      return nlohmann::json{{"rmse", e.rmse}, {"relmse", e.relMse}, {"mae", e.mae}, {"rmse_trimmed", e.rmseTrimmed},
+                            {"mean_ratio", e.meanRatio}};
+    };
+    summary["bias_floor_" + name] = json(reached);
+    summary["bias_floor_" + name + "_global_ia"] = json(global);
+  }
   summary["crossover_ms"] = ptBelowFloor.ms;
   summary["crossover_extrapolated"] = ptBelowFloor.extrapolated;
 
@@ -274,8 +320,8 @@ void runConverge(const ConvergeOptions& o) {
   // tracing needs to reach the same total error (bias included).
   const std::pair<const char*, render::Metric> metrics[] = {
       {"rmse", render::Metric::Rmse}, {"rmse_trimmed", render::Metric::RmseTrimmed}, {"mae", render::Metric::Mae}};
-  for (std::size_t i = 0; i + 1 < kMethods.size(); ++i) {
-    const Method& m = kMethods[i];
+  for (std::size_t i = 0; i + 1 < methods.size(); ++i) {
+    const Method& m = methods[i];
     const render::CurvePoint* point = nullptr;
     for (const auto& p : curves[i].points)
       if (p.spp == m.budgetSpp) point = &p;
@@ -345,6 +391,13 @@ void addConvergeCommand(CLI::App& app) {
   cmd->add_option("--pt-reference-spp", o->pathReferenceSpp, "path-tracing reference spp (default: factor x --pt-max-spp)");
   cmd->add_option("--seed", o->seed, "seed");
   cmd->add_option("--dmax", o->dMax, "obscurance dmax (default: the renderer's, half the median free path)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--background", o->background, "R,G,B: a constant sky for both methods (as render --background)")
+      ->delimiter(',')
+      ->expected(3);
+  cmd->add_option("--secondary-reflectors", o->secondaryReflectors,
+                  "T: study obscurances with secondary reflectors marked at T x mean direct irradiance too "
+                  "(method obscurance-reflectors, with its own reference and bias floor)")
       ->check(CLI::PositiveNumber);
   addDeviceOptions(*cmd, o->device);
   cmd->callback([o, cmd] {

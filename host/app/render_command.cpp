@@ -196,6 +196,10 @@ void runRender(RenderOptions& o) {
              renderer.dMax(), o.rho, o.sampling, o.noBleed ? "grey" : "colour bleeding", rAve.x, rAve.y, rAve.z,
              ia.x, ia.y, ia.z, o.ambient == "global" ? "the whole scene" : "the surfaces the lights reach",
              iaGlobal.x, iaGlobal.y, iaGlobal.z, renderer.lights().size(), renderer.layout().bandCount());
+  if (settings.secondaryReflectors > 0.0f)
+    fmt::print(stderr, "secondary reflectors: {} of {} triangles marked (threshold {:g} x each light's mean direct "
+                       "irradiance)\n",
+               renderer.secondaryReflectors(), loaded.scene.triangles.size(), settings.secondaryReflectors);
   if (renderer.ambient().reflectanceClamped)
     fmt::print(stderr, "note: the average reflectance reaches 1; it was clamped to 0.999 (I_a would be infinite)\n");
   if (!o.saveState.empty()) relight::saveState(o.saveState, renderer, o.scenePath);
@@ -203,6 +207,8 @@ void runRender(RenderOptions& o) {
                {{"method", o.method}, {"dmax", renderer.dMax()}, {"rho", o.rho}, {"tau", settings.tau},
                 {"sampling", o.sampling}, {"colour_bleeding", !o.noBleed}, {"max_depth", settings.maxDepth},
                 {"light_sampling", o.lightSampling}, {"ambient", o.ambient},
+                {"secondary_reflectors", settings.secondaryReflectors},
+                {"secondary_reflector_triangles", renderer.secondaryReflectors()},
                 {"i_a", {ia.x, ia.y, ia.z}}, {"i_a_global", {iaGlobal.x, iaGlobal.y, iaGlobal.z}},
                 {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
                 {"r_ave", {rAve.x, rAve.y, rAve.z}}, {"ambient_intensity", {ia.x, ia.y, ia.z}},

@@ -67,6 +67,11 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
                  "which surfaces share a light's flux in I_a: reached (default: those its light reaches, directly or "
                  "after one bounce) or global (the paper's: the whole scene)")
       ->check(CLI::IsMember({"reached", "global"}));
+  cmd.add_option("--secondary-reflectors", o.obscurance.secondaryReflectors,
+                 "T: important secondary reflectors (the paper's future work): surfaces a light lights at least T "
+                 "times its mean direct irradiance are marked, and an obscurance ray that lands on one traces the "
+                 "direct light it reflects (default 0: off; 1 marks what is lit more than average)")
+      ->check(CLI::NonNegativeNumber);
   cmd.add_option("--background", o.background,
                  "R,G,B: a constant sky radiance that rays leaving the scene see, one more light ('background') "
                  "that relighting can scale (default: none, black)")
@@ -82,10 +87,20 @@ void applyBackground(const RenderOptions& o, LoadedScene& loaded) {
   loaded.scene.background = glm::vec3(o.background[0], o.background[1], o.background[2]);
 }
 
-void checkRenderOptions(const RenderOptions& o) {
-  for (float c : o.background)
+void checkBackground(const std::vector<float>& background) {
+  for (float c : background)
     if (!(std::isfinite(c) && c >= 0.0f))
       throw InputError(fmt::format("--background {}: each of R, G, B must be a finite radiance >= 0", c));
+}
+
+void checkRenderOptions(const RenderOptions& o) {
+  checkBackground(o.background);
+  if (!(std::isfinite(o.obscurance.secondaryReflectors) && o.obscurance.secondaryReflectors >= 0.0f))
+    throw InputError(fmt::format("--secondary-reflectors {}: must be a finite threshold >= 0 (0: off)",
+                                 o.obscurance.secondaryReflectors));
+  if (o.obscurance.secondaryReflectors > 0.0f && o.shadowSampling == "per-light")
+    throw InputError("--secondary-reflectors with --shadow-sampling per-light: the reflectors choose among all lights "
+                     "by importance, so each light's transport would depend on the others' power; use one or the other");
   if (o.dMaxGiven && !(std::isfinite(o.dMax) && o.dMax > 0.0f))
     throw InputError(fmt::format("--dmax {}: must be a finite positive distance in scene units", o.dMax));
 }

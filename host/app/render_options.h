@@ -52,6 +52,8 @@ void chooseSize(RenderOptions& o, const scene::Camera& camera);
 render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scene::Camera& camera);
 // Gives the loaded scene the --background sky (after loadScene, before the lights are built).
 void applyBackground(const RenderOptions& o, LoadedScene& loaded);
+// InputError unless --background's R, G, B are finite and >= 0.
+void checkBackground(const std::vector<float>& background);
 // Warns (stderr) when no light of the scene emits anything: the image would be black but for
 // seen emission, and a user deserves to know why.
 void warnIfUnlit(const LoadedScene& loaded);

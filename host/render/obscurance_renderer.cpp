@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "render/scene/secondary_reflectors.h"
 #include "shading/bsdf.h"
 
 namespace obscura::render {
@@ -59,10 +60,12 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
       stream_(context), timestamps_(context) {
   for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
-  if (settings.ambient == AmbientModel::Reached) measureReach(scene, bvh);
+  if (settings.ambient == AmbientModel::Reached) ambient_.model = AmbientModel::Reached;
+  if (settings.ambient == AmbientModel::Reached || settings.secondaryReflectors > 0.0f) measureReach(scene, bvh);
   defaultDMax_ = defaultDMax(scene, bvh, settings.camera);
   emissions_ = lights_.emission;
   configure(settings);
+  if (reflectorsOn()) markReflectors();
   uploadLights();
 }
 
@@ -76,7 +79,6 @@ void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh&
   std::vector<glm::vec3> meanAlbedo; // of `scene`'s materials (an insert brings its own)
   for (const auto& m : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(m));
   reached_ = std::make_unique<ReachedSurfaces>(scene, bvh, triangleReflectances(scene, meanAlbedo));
-  ambient_.model = AmbientModel::Reached;
   ambient_.depth = settings_.maxDepth;
   // Lights spread over the cores (measure is const and seeds its own generator): the CPU rays of
   // modern-hall's 13 lights take ~0.3 s on one core.
@@ -93,6 +95,24 @@ void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh&
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
 }
 
+void ObscuranceRenderer::markReflectors() {
+  SecondaryReflectorMarks marks;
+  if (reflectorsOn())
+    marks = markSecondaryReflectors(*scene_, ambient_.reach, settings_.secondaryReflectors, reached_->totalArea(),
+                                    ambient_.model == AmbientModel::Reached);
+  reflectorsMarked_ = marks.count;
+  unmarkedFirstBounce_ = marks.unmarkedFirstBounce;
+  sceneBuffers_.setSecondaryReflectors(*scene_, std::move(marks.marked));
+}
+
+void ObscuranceRenderer::retraceAll() {
+  const std::uint32_t samples = samples_;
+  const double wall = wallSeconds_;
+  reset();
+  wallSeconds_ = wall;
+  iterate(samples);
+}
+
 void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
   if (settings.width != frame_.layout().width || settings.height != frame_.layout().height ||
       settings.primaryAovs != frame_.contents().primaryAovs ||
@@ -100,8 +120,16 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
     throw std::logic_error("ObscuranceRenderer::configure: resolution and AOVs are the frame's; make a new renderer");
   if (settings.ambient != settings_.ambient)
     throw std::logic_error("ObscuranceRenderer::configure: the ambient model is the scene's; make a new renderer");
+  if (settings.secondaryReflectors > 0.0f && settings.shadowSampling == ShadowSampling::PerLight)
+    throw InputError("secondary reflectors choose among all lights by importance, which per-light shadow sampling "
+                     "(each light's transport independent of the others' power) does not allow");
   const bool bleedChanged = settings.colourBleeding != settings_.colourBleeding;
+  if (settings.secondaryReflectors > 0.0f && !reached_)
+    throw std::logic_error("ObscuranceRenderer::configure: secondary reflectors need the lights' reach; make the "
+                           "renderer with them or with the Reached ambient model");
+  const bool remark = settings.secondaryReflectors != settings_.secondaryReflectors;
   settings_ = settings;
+  if (remark) markReflectors();
   dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax_;
   if (bleedChanged || ambient_.depth != (reached_ ? settings.maxDepth : 0u)) {
     ambient_.depth = reached_ ? settings.maxDepth : 0u;
@@ -165,7 +193,8 @@ gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
   const std::uint32_t flags = (settings_.systematic ? gpu::kFlagSystematic : 0u) |
                               (settings_.colourBleeding ? gpu::kFlagBleed : 0u) |
                               (settings_.lightSampling == LightSampling::Area ? gpu::kFlagAreaLightSampling : 0u) |
-                              (glossyMis ? gpu::kFlagGlossyMis : 0u);
+                              (glossyMis ? gpu::kFlagGlossyMis : 0u) |
+                              (reflectorsOn() ? gpu::kFlagSecondaryReflectors : 0u);
   return {.frame = glm::uvec4(settings_.width, settings_.height, sample, settings_.seed),
           .counts = glm::uvec4(static_cast<std::uint32_t>(lights_.size()), settings_.shadowRays,
                                settings_.obscuranceRays, flags),
@@ -173,7 +202,10 @@ gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
                               static_cast<float>(settings_.maxDepth)),
           .rAve = glm::vec4(ambient_.averageReflectance, 0.0f),
           .eye = glm::vec4(settings_.camera.position, sceneScale_),
-          .band = glm::uvec4(0u)};
+          .band = glm::uvec4(0u),
+          .reflectors = glm::vec4(ambientShareBeyondFirstBounce(ambient_.averageReflectance,
+                                                                ambient_.model == AmbientModel::Reached ? ambient_.depth : 0u),
+                                  unmarkedFirstBounce_)};
 }
 
 void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progress) {
@@ -270,6 +302,7 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   bool rebind = true;
   if (sameSurfaces) rebind = sceneBuffers_.updateGeometry(edited, bvh);
   else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
+  if (reflectorsOn()) markReflectors();
   if (rebind || emittersMoved) uploadLights();
 
   const FrameLayout& layout = frame_.layout();
@@ -277,8 +310,9 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
   for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
     // The sky lights every pixel from every direction: any edit may change any pixel.
+    // So do secondary reflectors: what the edit lights or shades anew is marked anew.
     dirty_.prepare(b, layout, camera, changed, dMax_, lightCount,
-                   emittersMoved || backgroundLight(lights_) < lights_.size());
+                   emittersMoved || backgroundLight(lights_) < lights_.size() || reflectorsOn());
   const std::uint32_t dirtyBefore = frame_.statusWords()[gpu::kStatusDirtyPixels];
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
@@ -493,6 +527,12 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
   emissions_.push_back(lights_.emission.back());
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   uploadLights();
+  if (reflectorsOn()) {
+    // What the new light marks reflects every light's light: all of it again.
+    markReflectors();
+    retraceAll();
+    return index;
+  }
 
   // The new light's shadow rays from the frame's own primary hits: the G-buffer of every sample
   // so far is made again (same seed, same sub-pixel position, no accumulation) and the shadow
@@ -541,6 +581,10 @@ void ObscuranceRenderer::removeLight(std::size_t index) {
   emissions_.erase(emissions_.begin() + static_cast<std::ptrdiff_t>(index));
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   uploadLights();
+  if (reflectorsOn()) {
+    markReflectors();
+    retraceAll();
+  }
 }
 
 RenderStats ObscuranceRenderer::stats() const {

@@ -80,6 +80,11 @@ struct ObscuranceSettings {
   ShadowSampling shadowSampling = ShadowSampling::Selection;
   LightSampling lightSampling = LightSampling::Spatial;
   AmbientModel ambient = AmbientModel::Reached; // which surfaces share a light's flux in I_a
+  // Important secondary reflectors [RTO §2.2, §6] (render/scene/secondary_reflectors.h): 0 = off;
+  // > 0 = the marking threshold (a triangle lit at least this many times its light's mean direct
+  // irradiance is marked). Needs ShadowSampling::Selection. With them on, adding or removing a
+  // light and a geometry edit mark anew and retrace every pixel.
+  float secondaryReflectors = 0.0f;
 };
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.
@@ -160,6 +165,8 @@ public:
   bool specular() const { return runSpecular_; }
   // Per-pass GPU ms and rays since the last reset, wall time, memory, truncations, notes.
   RenderStats stats() const;
+  // Triangles marked as important secondary reflectors (0 when they are off).
+  std::uint32_t secondaryReflectors() const { return reflectorsMarked_; }
   // Bytes of device memory held: scene, lights and frame (the real allocations).
   std::uint64_t deviceBytes() const;
 
@@ -167,6 +174,11 @@ private:
   void uploadLights();
   // The Reached ambient model: what every light reaches in `scene` (after a geometry edit too).
   void measureReach(const scene::Scene& scene, const bvh::Bvh& bvh);
+  // Marks the secondary reflectors from the measured reach (settings_.secondaryReflectors > 0).
+  void markReflectors();
+  bool reflectorsOn() const { return settings_.secondaryReflectors > 0.0f; }
+  // Every sample so far again, every pixel (an edit that changed what the reflectors are).
+  void retraceAll();
   void bindAll();
   gpu::ShadePush shadePush(std::uint32_t sample) const;
   gpu::GpuCamera primaryCamera() const; // with the background's slot
@@ -184,7 +196,9 @@ private:
   SceneBuffers sceneBuffers_;
   LightSet lights_;
   AmbientTerm ambient_;
-  std::unique_ptr<ReachedSurfaces> reached_; // the Reached ambient model's light rays (CPU)
+  std::unique_ptr<ReachedSurfaces> reached_; // the light rays of the Reached model and the reflectors (CPU)
+  std::uint32_t reflectorsMarked_ = 0;       // triangles marked as secondary reflectors
+  float unmarkedFirstBounce_ = 1.0f;         // r of secondary_reflectors.h
   LightBuffers lightBuffers_;
   std::vector<glm::vec3> emissions_; // what compose uses
   gpu::Buffer emissionBuffer_;

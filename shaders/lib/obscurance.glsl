@@ -1,7 +1,7 @@
 // obscurance.glsl — rho(d) and the obscurance estimate at a shading point [RTO §3, eqs. 2 and
 // 6; SPEC §1.1-1.2], shared by obscurance.comp (primary hits) and specular.comp (path vertices).
 // Needs the scene and shading bindings, bvh.glsl, surface.glsl, material.glsl, ray.glsl,
-// rng.glsl, sampling.glsl and shade.glsl.
+// rng.glsl, sampling.glsl, shade.glsl and accumulate.glsl (reflectors write D_s).
 #ifndef OBSCURA_OBSCURANCE_GLSL
 #define OBSCURA_OBSCURANCE_GLSL
 
@@ -15,12 +15,24 @@ float rho(float d, float dMax, uint kind, float tau) {
 }
 
 // R(Q): the mean albedo a-bar of the surface hit, times its base-colour texture.
-vec3 reflectanceAt(RayHit hit, vec3 origin, vec3 direction) {
-  Surface s = surfaceAt(hit, origin, direction);
+vec3 reflectanceAt(Surface s) {
   GpuMaterial m = materials[s.material];
   vec3 r = m.meanAlbedo.rgb;
   if (m.textures.x >= 0) r *= sampleTexture(m.textures.x, s.uv).rgb;
   return r;
+}
+
+// An important secondary reflector [RTO §2.2 and §6; SPEC §1.6]: the light that Q, hit by an
+// obscurance ray from P, reflects of its own direct light, one light sample and one shadow ray
+// (the shared estimator, shade.glsl), at unit emission of the light it chose:
+//   L(P <- Q) = f(Q, -w, wi) L_e cos / pdf, and with P's cosine-distributed ray, R(P) L / N_obs.
+void reflectedDirectLight(Surface s, vec3 direction, vec4 u, inout StepBudget budget, out vec3 contribution,
+                          out uint light) {
+  vec3 wo = -direction;
+  vec3 ns = dot(s.shadingNormal, wo) < 0.0 ? -s.shadingNormal : s.shadingNormal;
+  GpuMaterial m = materials[s.material];
+  ShadingPoint q = shadingPoint(s.position, s.geometricNormal, ns, wo, materialBaseColor(m, s.uv).rgb, s.material);
+  directLightSample(q, u, pc.counts.x, 0.0, budget, contribution, light);
 }
 
 // N_obs cosine-distributed rays around the shading normal with tmax = dMax, by systematic
@@ -29,42 +41,79 @@ vec3 reflectanceAt(RayHit hit, vec3 origin, vec3 direction) {
 //   W_c = 1/pi  int R(Q) rho(d) cos dw ~ mean of R(Q_i) rho(d_i)        [RTO eq. 6]
 // (the cosine pdf cancels the 1/pi cos factor), R(Q) := R_ave on a miss [SPEC §1.2].
 // Returns (A, W) with A = R(P) W_c (colour bleeding) or R(P) W (grey).
-vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget) {
+//
+// With secondary reflectors (`reflectorPixel` a pixel, not kInvalidIndex, and the flag set), a
+// ray that lands on a marked triangle adds R(P) x Q's reflected direct light to D_s of the light
+// sampled there (the basis buffer, [light][pixel] of `pixelCount`), and Q's ambient keeps the
+// share kappa of I_a that lies beyond the first bounce; an unmarked Q within dmax keeps
+// kappa + r (1 - kappa) (OURS: the paper adds a ray to the light without saying how the two
+// combine; these shares keep the first bounce from being counted twice and are constants of the
+// render, so I_a stays linear in every emission; secondary_reflectors.h).
+vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, uint reflectorPixel, uint pixelCount) {
   vec3 t, b;
   orthonormalBasis(sp.ns, t, b);
   const uint n = pc.counts.z;
   const bool systematic = (pc.counts.w & kFlagSystematic) != 0u;
   const bool bleed = (pc.counts.w & kFlagBleed) != 0u;
+  const bool reflectors = reflectorPixel != kInvalidIndex && (pc.counts.w & kFlagSecondaryReflectors) != 0u;
   const float dMax = pc.params.x;
   const uint rhoKind = uint(pc.params.z);
   uvec2 grid = systematicGrid(n);
   vec2 offset = vec2(rngNext(rng), rngNext(rng)); // systematic: ONE random pair per hit
+  // The reflectors' light samples come from a stream of their own, so the obscurance rays are
+  // the same with and without them.
+  uint reflectorRng = pcgHash(rng ^ 0x2545f491u);
   vec3 origin = offsetRayOrigin(sp.position, sp.ng);
+  const vec3 rP = obscuranceReflectance(sp);
+  const float invN = 1.0 / float(max(n, 1u));
   float w = 0.0;
+  vec3 wGrey = vec3(0.0); // W with kappa on reflectors (grey obscurance)
   vec3 wc = vec3(0.0);
+  uint reflectorRays = 0u;
   for (uint i = 0u; i < n; ++i) {
     vec2 u = systematic ? offset : vec2(rngNext(rng), rngNext(rng));
     vec3 local = systematic ? sampleSystematic(i, grid, offset) : sampleCosineHemisphere(u);
     vec3 direction = toWorld(local, t, b, sp.ns);
     float r = 0.0; // a direction into the surface is blocked at d = 0 (rho(0) = 0)
     vec3 reflectance = vec3(0.0);
+    vec3 share = vec3(1.0);
     if (dot(direction, sp.ng) > 0.0) {
       RayHit h = traceWithBudget(budget, origin, direction, 0.0, dMax, false);
       if (rayHitValid(h) && h.primitive != kInvalidIndex) {
         r = rho(h.t, dMax, rhoKind, pc.params.y);
-        reflectance = bleed ? reflectanceAt(h, origin, direction) : vec3(0.0);
+        bool reflector = reflectors && triangleShading[h.primitive].n2.w != 0.0;
+        // An unmarked surface keeps the later bounces and the first scaled by r (the marked
+        // ones hold more than the mean direct light, the rest less; secondary_reflectors.h).
+        if (reflectors && !reflector && pc.reflectors.w != 1.0) share = pc.reflectors.rgb + pc.reflectors.w * (1.0 - pc.reflectors.rgb);
+        if (bleed || reflector) {
+          Surface s = surfaceAt(h, origin, direction);
+          reflectance = bleed ? reflectanceAt(s) : vec3(0.0);
+          if (reflector) {
+            share = pc.reflectors.rgb;
+            vec3 contribution;
+            uint light;
+            uint tracedBefore = budget.traced;
+            vec4 uLight = rngNext4(reflectorRng);
+            reflectedDirectLight(s, direction, uLight, budget, contribution, light);
+            if (budget.traced != tracedBefore) ++reflectorRays;
+            if (light != kInvalidIndex && any(greaterThan(contribution, vec3(0.0))))
+              OBS_ACCUMULATE(basis, light * pixelCount + reflectorPixel, vec4(rP * contribution * invN, 0.0))
+          }
+        }
       } else {
         r = 1.0;
         reflectance = pc.rAve.rgb;
       }
     }
     w += r;
-    wc += reflectance * r;
+    wGrey += share * r;
+    wc += share * reflectance * r;
   }
-  float invN = 1.0 / float(max(n, 1u));
+  if (reflectorRays > 0u) atomicAdd(status[kStatusShadowRays], reflectorRays);
   w *= invN;
+  wGrey *= invN;
   wc *= invN;
-  return vec4(obscuranceReflectance(sp) * (bleed ? wc : vec3(w)), w);
+  return vec4(rP * (bleed ? wc : wGrey), w);
 }
 
 #endif

@@ -76,7 +76,7 @@ struct BvhTriangle {
 struct TriangleShading {
   vec4 n0;   // 0:  vertex normal 0 xyz, w = material index (uintBitsToFloat)
   vec4 n1;   // 16: vertex normal 1 xyz, w = light group index or kInvalidIndex (uintBitsToFloat)
-  vec4 n2;   // 32: vertex normal 2 xyz, w = unused
+  vec4 n2;   // 32: vertex normal 2 xyz, w = 1 on an important secondary reflector (kFlagSecondaryReflectors)
   vec4 uv01; // 48: uv0.xy, uv1.xy
   vec4 uv2;  // 64: uv2.xy, unused
 };           // 80 bytes
@@ -224,6 +224,10 @@ OBS_CONST uint kFlagAreaLightSampling = 4u; // the paper's light sampling (kLigh
 // specular pass's lobe sample, weighted by the power heuristic; set when the specular pass runs
 // and the light sampling is spatial with selection over all lights.
 OBS_CONST uint kFlagGlossyMis = 8u;
+// Important secondary reflectors [RTO §2.2, §6]: an obscurance ray from a primary hit that lands
+// on a marked triangle (TriangleShading.n2.w) traces that point's direct light too, into D_s, and
+// keeps only the share kappa (ShadePush.reflectors) of the ambient there.
+OBS_CONST uint kFlagSecondaryReflectors = 16u;
 OBS_CONST uint kRhoSqrt = 0u;        // rho(d) = sqrt(d / dmax)          [RTO §3, SPEC §1.1]
 OBS_CONST uint kRhoExp = 1u;         // rho(d) = (1 - e^(-tau d/dmax)) / (1 - e^(-tau))
 OBS_CONST uint kRhoAo = 2u;          // rho(d) = 0 below dmax (ambient occlusion)
@@ -236,7 +240,9 @@ struct ShadePush {
   vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = scene size
                 //     (largest bounding-box extent: scales the ray-origin offset, ray.glsl)
   uvec4 band;   // 80: first row, rows, flags (kShadeFlag*), the light of a per-light dispatch
-};              // 96 bytes
+  vec4 reflectors; // 96: kappa rgb, the share of I_a beyond the first bounce, w = r, the unmarked
+                   //     surfaces' first bounce against the mean (kFlagSecondaryReflectors)
+};              // 112 bytes
 OBS_CONST uint kShadeFlagDirtyOnly = 1u; // only pixels the dirty mask marks run
 // shadow.comp samples light band.w alone, the paper's way [IVR §3.1]: kPerLightRays rays per
 // sample, up to kPerLightMaxRays where they disagree (a penumbra); one dispatch per light, so each

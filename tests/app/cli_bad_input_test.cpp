@@ -218,6 +218,16 @@ TEST_F(CliBadInput, BackgroundNeedsThreeFiniteNonNegativeRadiances) {
   }
 }
 
+TEST_F(CliBadInput, SecondaryReflectorsNeedAFiniteThresholdAndSelectionSampling) {
+  for (const std::string flags : {"--secondary-reflectors -1", "--secondary-reflectors nan",
+                                  "--secondary-reflectors 1 --shadow-sampling per-light"}) {
+    const auto r = runObscura("render " + scene() + " -o " + path("out.png") + " --width 16 --spp 1 " + flags);
+    EXPECT_NE(r.exitCode, 0) << flags << "\n" << r.output;
+    EXPECT_CONTAINS(r.output, "--secondary-reflectors");
+    EXPECT_EQ(strayFiles(), std::vector<std::string>{}) << flags;
+  }
+}
+
 TEST_F(CliBadInput, DmaxNotFiniteIsRefused) {
     for (const std::string flags : {"--dmax nan", "--dmax inf", "--dmax 1e40"}) {
     const auto r = runObscura("render " + scene() + " -o " + path("out.png") + " --width 16 --spp 1 " + flags);

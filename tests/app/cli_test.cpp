@@ -47,10 +47,11 @@ TEST_F(Cli, RendersTheDefaultSceneToPngAndExrWithMetrics) {
 // that takes both references from the cache.
 TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   const std::string args = "converge " + cornellBox() + " -o " + path("study") +
-                           " --width 16 --max-spp 8 --pt-max-spp 8 --reference-factor 4";
+                           " --width 16 --max-spp 8 --pt-max-spp 8 --reference-factor 4 --secondary-reflectors 1";
   auto r = runObscura(args);
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  for (const char* part : {"equal-noise speed-up", "bias floor", "crossover", "rmse_trimmed", "equal time"})
+  for (const char* part : {"equal-noise speed-up", "bias floor", "crossover", "rmse_trimmed", "equal time",
+                           "bias floor with secondary reflectors"})
     EXPECT_CONTAINS(r.output, part);
   std::ifstream csv(path("study/cornell-box.convergence.csv"));
   std::string line;
@@ -59,11 +60,13 @@ TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   std::map<std::string, int> rows;
   while (std::getline(csv, line)) ++rows[line.substr(0, line.find(','))];
   const std::map<std::string, int> expected = {
-      {"obscurance", 4}, {"obscurance-paper", 4}, {"obscurance-realtime", 4}, {"pathtrace", 4}}; // 1, 2, 4, 8 spp
+      {"obscurance", 4}, {"obscurance-paper", 4}, {"obscurance-realtime", 4}, {"obscurance-reflectors", 4},
+      {"pathtrace", 4}}; // 1, 2, 4, 8 spp
   EXPECT_EQ(rows, expected);
   std::ifstream json(path("study/cornell-box.convergence.json"));
   std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
-  for (const char* key : {"\"obscurance-paper\"", "\"obscurance-realtime\"", "\"equal_noise_speedup\"",
+  for (const char* key : {"\"obscurance-paper\"", "\"obscurance-realtime\"", "\"obscurance-reflectors\"",
+                          "\"bias_floor_obscurance-reflectors\"", "\"equal_noise_speedup\"",
                           "\"mean_ratio\"", "\"crossover_ms\"", "\"rmse_trimmed\""})
     EXPECT_CONTAINS(text, key);
   for (const char* png : {"study/cornell-box.obscurance-budget.png", "study/cornell-box.pathtrace-equal-time.png",
@@ -73,6 +76,7 @@ TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_CONTAINS(r.output, "reference obscurance: cached");
   EXPECT_CONTAINS(r.output, "reference pathtrace: cached");
+  EXPECT_CONTAINS(r.output, "reference obscurance-reflectors: cached");
 }
 
 TEST_F(Cli, MissingSceneNamesTheFile) {

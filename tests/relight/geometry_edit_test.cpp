@@ -43,8 +43,9 @@ scene::Bounds objectBox(glm::vec3 object, float size) {
   return box;
 }
 
-render::ObscuranceSettings editSettings() {
+render::ObscuranceSettings editSettings(float secondaryReflectors = 0.0f) {
   render::ObscuranceSettings s;
+  s.secondaryReflectors = secondaryReflectors;
   s.width = 48;
   s.height = 36;
   s.spp = 4;
@@ -61,21 +62,22 @@ protected:
   // Renders with the object at `from`, moves it to `to` incrementally, and compares with a full
   // render of the moved scene. Returns the pixels retraced.
   std::uint64_t moveAndCompare(glm::vec3 from, glm::vec3 to, float size, bool lamp = true,
-                               bool glossyFloor = false) {
+                               bool glossyFloor = false, float secondaryReflectors = 0.0f) {
     const scene::Scene before = roomWithObject(from, size, lamp, glossyFloor);
     const bvh::Bvh beforeBvh = bvh::build(render::triangleSoup(before));
     edited_ = roomWithObject(to, size, lamp, glossyFloor);
     // As `relight --edits` does for a move: the BVH refitted, not rebuilt.
     editedBvh_ = beforeBvh;
     bvh::refit(editedBvh_, render::triangleSoup(edited_));
-    render::ObscuranceRenderer r(context(), before, beforeBvh, editSettings());
+    render::ObscuranceRenderer r(context(), before, beforeBvh, editSettings(secondaryReflectors));
     r.render();
     const io::Image old = r.image();
     const std::uint64_t retraced = r.updateGeometry(edited_, editedBvh_, {objectBox(from, size), objectBox(to, size)});
     r.compose();
     const io::Image moved = r.image();
     const io::Image fresh =
-        renderObscurances(context(), edited_, bvh::build(render::triangleSoup(edited_)), editSettings()).image;
+        renderObscurances(context(), edited_, bvh::build(render::triangleSoup(edited_)), editSettings(secondaryReflectors))
+            .image;
     EXPECT_EQ(r.stats().truncatedTraversals, 0u);
     // The sums are the full render's bit for bit; composed values may differ in the last bits
     // because I_a's areas are summed from the moved vertices.
@@ -125,6 +127,13 @@ TEST_F(GeometryEdit, ObjectSeenInAMirrorFloorIsRetracedWhereItsReflectionIs) {
   // reflection on the floor changes far from its screen footprint.
   const std::uint64_t retraced = moveAndCompare({-0.8f, 1.2f, -1.0f}, {0.8f, 1.2f, -1.0f}, 0.5f, true, true);
   EXPECT_LT(retraced, 48u * 36u) << "glossy pixels whose paths stay away are kept";
+}
+
+TEST_F(GeometryEdit, WithSecondaryReflectorsEveryPixelIsRetracedAndMatchesAFullRender) {
+  // What is marked follows the light, which the move changes anywhere: every pixel is retraced,
+  // with the marks of the edited scene, and the sums are the full render's bit for bit.
+  const std::uint64_t retraced = moveAndCompare({-0.8f, 2.5f, 0.0f}, {0.8f, 2.5f, 0.0f}, 0.5f, true, false, 1.0f);
+  EXPECT_EQ(retraced, 48u * 36u);
 }
 
 } // namespace

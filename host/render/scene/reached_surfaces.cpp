@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <random>
 
@@ -160,6 +161,7 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
     glm::vec3 position, normal;
   };
   std::vector<Landing> landings;
+  std::map<std::uint32_t, std::uint32_t> landedOn; // triangle -> rays
   std::uint32_t emitted = 0;
   for (std::uint32_t i = 0; i < kLightRays; ++i) {
     LightPoint p = samplePoint(lights, light, rng, scene.bounds);
@@ -175,7 +177,10 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
     glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
     if (glm::dot(n, d) > 0.0f) n = -n; // the side the light arrives on
     landings.push_back({ray.origin + hit.t * d, n});
+    ++landedOn[hit.primitive];
   }
+  reach.landedTriangles.assign(landedOn.begin(), landedOn.end());
+  reach.landings = static_cast<std::uint32_t>(landings.size());
 
   // What leaves the scene: directly (not for a directional light, whose flux counts only what
   // crosses the scene's box already), and after one diffuse reflection where the light lands.

@@ -21,6 +21,7 @@
 // fresh render agree.
 #pragma once
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -37,6 +38,10 @@ struct LightReach {
   double fraction = 0.0;          // A_s / A_t
   double escapeDirect = 0.0;      // e_0: share of the light's rays that leave the scene unhit
   double escapeBounce = 0.0;      // e_1: share of rays diffusely reflected where it lands that leave
+  // Where the light rays landed: (triangle, rays) for every triangle hit, by triangle, of
+  // `landings` rays that hit something (secondary_reflectors.h marks the strongly lit ones).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> landedTriangles;
+  std::uint32_t landings = 0;
 };
 
 class ReachedSurfaces {

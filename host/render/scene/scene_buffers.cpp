@@ -76,7 +76,8 @@ std::vector<gpu::BvhNode> bvhItems(const bvh::Bvh& bvh) {
 
 namespace {
 
-std::vector<gpu::TriangleShading> shadingData(const scene::Scene& scene) {
+// `reflectors[t]` 1: triangle t is an important secondary reflector (n2.w = 1).
+std::vector<gpu::TriangleShading> shadingData(const scene::Scene& scene, const std::vector<std::uint8_t>& reflectors) {
   std::vector<gpu::TriangleShading> out(scene.triangles.size());
   for (std::size_t i = 0; i < out.size(); ++i) {
     const glm::uvec3& t = scene.triangles[i];
@@ -84,7 +85,7 @@ std::vector<gpu::TriangleShading> shadingData(const scene::Scene& scene) {
     std::uint32_t group = i < scene.triangleLightGroup.size() ? scene.triangleLightGroup[i] : gpu::kInvalidIndex;
     out[i].n0 = glm::vec4(scene.normals[t.x], std::bit_cast<float>(material));
     out[i].n1 = glm::vec4(scene.normals[t.y], std::bit_cast<float>(group));
-    out[i].n2 = glm::vec4(scene.normals[t.z], 0.0f);
+    out[i].n2 = glm::vec4(scene.normals[t.z], i < reflectors.size() && reflectors[i] ? 1.0f : 0.0f);
     out[i].uv01 = glm::vec4(scene.uvs[t.x], scene.uvs[t.y]);
     out[i].uv2 = glm::vec4(scene.uvs[t.z], 0.0f, 0.0f);
   }
@@ -127,7 +128,7 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
   checkTexelLimit(context, items.size() * gpu::kTexelsPerItem, "BVH nodes and triangles");
   items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::BvhNode), "scene.bvhItems");
 
-  auto shading = shadingData(scene);
+  auto shading = shadingData(scene, reflectors_);
   shading_ = gpu::Buffer(context, shading.size() * sizeof(gpu::TriangleShading), Usage::eStorageBuffer, "scene.shading");
   shading_.upload(context, shading);
 
@@ -158,9 +159,14 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
            textures_.size() + texels_.size() + status_.buffer().size();
 }
 
+void SceneBuffers::setSecondaryReflectors(const scene::Scene& scene, std::vector<std::uint8_t> marked) {
+  reflectors_ = std::move(marked);
+  shading_.upload(*context_, shadingData(scene, reflectors_));
+}
+
 bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh) {
   auto items = bvhItems(bvh);
-  auto shading = shadingData(scene);
+  auto shading = shadingData(scene, reflectors_);
   const std::size_t itemBytes = items.size() * sizeof(gpu::BvhNode);
   const std::size_t shadingBytes = shading.size() * sizeof(gpu::TriangleShading);
   if (itemBytes == items_.buffer().size() && shadingBytes == shading_.size()) {

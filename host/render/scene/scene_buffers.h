@@ -2,6 +2,7 @@
 // pass; see shaders/lib/scene_bindings.glsl). Uploaded once; lives as long as the scene.
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "bvh/bvh.h"
 #include "gpu/buffer.h"
@@ -46,6 +47,10 @@ public:
   // Returns true when the buffers were re-created.
   bool updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh);
 
+  // Marks the important secondary reflectors (one flag per triangle of `scene`, whose triangles
+  // these buffers hold; secondary_reflectors.h). updateGeometry keeps the marks.
+  void setSecondaryReflectors(const scene::Scene& scene, std::vector<std::uint8_t> marked);
+
   // Traversals cut off by kMaxTraversalSteps since the last reset (must stay 0).
   std::uint32_t truncatedTraversals() const;
   // All status words (kStatus*: truncations, rays per pass) since the last reset.
@@ -66,6 +71,7 @@ private:
   StatusCounters status_;
   std::uint64_t bytes_ = 0;
   std::vector<std::string> notes_;
+  std::vector<std::uint8_t> reflectors_; // per triangle (empty: none marked)
 };
 
 // Every kernel that traces rays starts its binding list with the scene's.
