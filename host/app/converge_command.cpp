@@ -284,6 +284,10 @@ void runConverge(const ConvergeOptions& o) {
   const render::Curve& pt = curves.back();
   nlohmann::json summary = {{"scene", o.scenePath}, {"width", study.width()}, {"height", study.height()},
                             {"device", context.info().name}, {"command", o.commandLine}};
+  auto errorJson = [](const render::ImageError& e) {
+    return nlohmann::json{{"rmse", e.rmse}, {"relmse", e.relMse}, {"mae", e.mae}, {"rmse_trimmed", e.rmseTrimmed},
+                          {"mean_ratio", e.meanRatio}};
+  };
   const render::ImageError bias = render::imageError(obscuranceReference, ptReference);
   const render::TimeAt ptBelowFloor = render::timeToReach(pt, bias.rmse, render::ErrorKind::AgainstReference);
   fmt::print("\nbias floor (converged obscurance vs converged path tracing): RMSE {:.5f}, relMSE {:.5f}, MAE {:.5f}, "
@@ -291,14 +295,12 @@ void runConverge(const ConvergeOptions& o) {
              bias.rmse, bias.relMse, bias.mae, bias.rmseTrimmed, bias.meanRatio);
   fmt::print("crossover: path tracing's error falls below that floor after {:.1f} ms{}\n", ptBelowFloor.ms,
              ptBelowFloor.extrapolated ? " (extrapolated)" : "");
-  summary["bias_floor"] = {{"rmse", bias.rmse}, {"relmse", bias.relMse}, {"mae", bias.mae},
-                           {"rmse_trimmed", bias.rmseTrimmed}, {"mean_ratio", bias.meanRatio}};
+  summary["bias_floor"] = errorJson(bias);
   const render::ImageError globalBias = render::imageError(study.globalReference(best.name), ptReference);
   fmt::print("bias floor with the paper's whole-scene I_a: RMSE {:.5f}, relMSE {:.5f}, MAE {:.5f}, trimmed RMSE {:.5f}, "
              "mean ratio {:.4f}\n",
              globalBias.rmse, globalBias.relMse, globalBias.mae, globalBias.rmseTrimmed, globalBias.meanRatio);
-  summary["bias_floor_global_ia"] = {{"rmse", globalBias.rmse}, {"relmse", globalBias.relMse}, {"mae", globalBias.mae},
-                                     {"rmse_trimmed", globalBias.rmseTrimmed}, {"mean_ratio", globalBias.meanRatio}};
+  summary["bias_floor_global_ia"] = errorJson(globalBias);
   for (const auto& [name, reference] : reflectorReferences) {
     const render::ImageError reached = render::imageError(reference, ptReference);
     const render::ImageError global = render::imageError(study.globalReference(name), ptReference);
@@ -306,12 +308,8 @@ void runConverge(const ConvergeOptions& o) {
       fmt::print("bias floor with secondary reflectors ({}), {}: RMSE {:.5f}, relMSE {:.5f}, MAE {:.5f}, trimmed RMSE "
                  "{:.5f}, mean ratio {:.4f}\n",
                  name, which, e.rmse, e.relMse, e.mae, e.rmseTrimmed, e.meanRatio);
-    auto json = [](const render::ImageError& e) {
-      return nlohmann::json{{"rmse", e.rmse}, {"relmse", e.relMse}, {"mae", e.mae}, {"rmse_trimmed", e.rmseTrimmed},
-                            {"mean_ratio", e.meanRatio}};
-    };
-    summary["bias_floor_" + name] = json(reached);
-    summary["bias_floor_" + name + "_global_ia"] = json(global);
+    summary["bias_floor_" + name] = errorJson(reached);
+    summary["bias_floor_" + name + "_global_ia"] = errorJson(global);
   }
   summary["crossover_ms"] = ptBelowFloor.ms;
   summary["crossover_extrapolated"] = ptBelowFloor.extrapolated;
