@@ -44,6 +44,7 @@ bool touched(uint pixel, uvec2 framePixel) {
     // Shadow rays run from a hit point to a point of a light: within (hit radius + light radius)
     // of the segment between the two spheres' centres.
     for (uint s = 0u; s < pc.frame.w; ++s) {
+      if (s == floatBitsToUint(pc.params.z)) continue; // a new light, traced at every pixel
       vec4 light = lightBounds[2u * s], direction = lightBounds[2u * s + 1u];
       bool infinite = direction.w != 0.0;
       vec3 far = infinite ? centre - direction.xyz : light.xyz;

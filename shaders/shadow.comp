@@ -40,22 +40,10 @@ void main() {
   StepBudget budget = newStepBudget();
   const vec4 lightShift = rngNext4(rng); // the hit's light samples: one shifted low-discrepancy set
   if ((pc.band.z & kShadeFlagPerLight) != 0u) {
-    // The paper's visibility sampling [IVR §3.1]: kPerLightRays rays to this light; where they
-    // disagree (a penumbra) more, up to kPerLightMaxRays, all averaged.
     const uint light = pc.band.w;
-    vec3 sum = vec3(0.0);
-    uint taken = 0u, seen = 0u;
-    for (uint k = 0u; k < kPerLightMaxRays; ++k) {
-      if (k == kPerLightRays && (seen == 0u || seen == kPerLightRays)) break;
-      vec4 u = kroneckerPoint4(k, lightShift);
-      vec3 contribution;
-      bool visible;
-      directLightFrom(sp, sampleChosenLight(sp.position, sp.ng, u, light, 1.0), 0.0, budget, contribution, visible);
-      sum += contribution;
-      seen += visible ? 1u : 0u;
-      ++taken;
-    }
-    OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(sum / float(taken), 0.0))
+    uint taken;
+    vec3 direct = directLightFromOne(sp, light, lightShift, budget, taken);
+    OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(direct, 0.0))
     atomicAdd(status[kStatusShadowRays], taken);
     if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
     return;

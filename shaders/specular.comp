@@ -11,6 +11,11 @@
 // heuristic against the vertex's N_s light samples (lib/shade.glsl weighs the other side), and
 // without it (the paper's estimator, per-light shadow rays) not at all, since the shadow rays
 // then take all of that light.
+//
+// With kShadeFlagPerLight (a light just added, band.w) the same paths are followed again: the
+// lobe samples draw from a generator of their own, so the path of a sample does not depend on
+// what is gathered along it. Only that light is gathered, alone as in shadow.comp (no MIS, its
+// emission counted after mirror bounces only), and the hit box is left as it was.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -62,9 +67,12 @@ void main() {
   const uint lightCount = pc.counts.x;
   const uint shadowRays = lightCount > 0u ? pc.counts.y : 0u;
   const uint maxDepth = uint(pc.params.w);
+  const bool oneLight = (pc.band.z & kShadeFlagPerLight) != 0u;
+  const uint addedLight = pc.band.w;
 
   ShadingPoint sp = shadingPointFromGBuffer(gbuffer[pixel], pc.eye.xyz);
-  uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu);
+  uint pathRng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu); // lobe samples only
+  uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x6c8e9cf5u);     // what is gathered
   StepBudget budget = newStepBudget();
   vec3 throughput = vec3(1.0);
   uint rays = 0u;
@@ -77,7 +85,7 @@ void main() {
     vec3 wo = vec3(dot(sp.wo, t), dot(sp.wo, b), dot(sp.wo, sp.ns));
     vec3 wiLocal, weight;
     bool delta;
-    if (wo.z <= 0.0 || !sampleSpecularLobe(sp, wo, vec2(rngNext(rng), rngNext(rng)), wiLocal, weight, delta)) break;
+    if (wo.z <= 0.0 || !sampleSpecularLobe(sp, wo, vec2(rngNext(pathRng), rngNext(pathRng)), wiLocal, weight, delta)) break;
     vec3 wi = toWorld(wiLocal, t, b, sp.ns);
     if (dot(wi, sp.ng) <= 0.0) break; // below the geometric surface: no leaks
     // What MIS needs of the vertex the lobe sample leaves (its light samples' density).
@@ -92,7 +100,8 @@ void main() {
       escaped = true;
       // The sky along the lobe: whole after a mirror, MIS-weighted after a glossy bounce.
       uint sky = findBackgroundLight(lightCount);
-      if (h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || glossyMis)) { // a miss, not a truncation
+      if (oneLight && sky != addedLight) sky = kInvalidIndex;
+      if (h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || (glossyMis && !oneLight))) { // a miss, not a truncation
         float w = delta ? 1.0 : powerHeuristic(lobePdf, float(shadowRays) * backgroundLightPdf(sky, previous, previousNormal, lightCount, wi));
         OBS_ACCUMULATE(specularBasis, sky * pixelCount + pixel, vec4(w * throughput, 0.0))
       }
@@ -103,7 +112,8 @@ void main() {
     pathHi = max(pathHi, s.position);
     GpuMaterial m = materials[s.material];
     vec3 baseColor = materialBaseColor(m, s.uv).rgb;
-    if ((delta || glossyMis) && s.lightGroup != kInvalidIndex && s.lightGroup < lightCount) {
+    const bool counted = oneLight ? delta && s.lightGroup == addedLight : delta || glossyMis;
+    if (counted && s.lightGroup != kInvalidIndex && s.lightGroup < lightCount) {
       float w = 1.0;
       if (!delta) {
         float lightPdf = emitterHitLightPdf(s.lightGroup, previous, previousNormal, lightCount, h, s.position, wi);
@@ -118,6 +128,13 @@ void main() {
     // MIS only where a lobe sample follows from this vertex (the loop goes on past it).
     float misSamples = glossyMis && depth + 1u < maxDepth ? float(shadowRays) : 0.0;
     const vec4 lightShift = rngNext4(rng); // this vertex's light samples: one shifted low-discrepancy set
+    if (oneLight) {
+      uint taken;
+      vec3 direct = directLightFromOne(sp, addedLight, lightShift, budget, taken);
+      OBS_ACCUMULATE(specularBasis, addedLight * pixelCount + pixel, vec4(throughput * direct, 0.0))
+      rays += taken;
+      continue;
+    }
     for (uint k = 0u; k < shadowRays; ++k) {
       vec4 u = kroneckerPoint4(k, lightShift);
       vec3 contribution;
@@ -130,9 +147,11 @@ void main() {
     OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
     rays += shadowRays + pc.counts.z;
   }
-  vec4 lo = hitBounds[2u * pixel], hi = hitBounds[2u * pixel + 1u];
-  hitBounds[2u * pixel] = vec4(min(lo.xyz, pathLo), max(lo.w, escaped ? 1.0 : 0.0));
-  hitBounds[2u * pixel + 1u] = vec4(max(hi.xyz, pathHi), hi.w);
+  if (!oneLight) {
+    vec4 lo = hitBounds[2u * pixel], hi = hitBounds[2u * pixel + 1u];
+    hitBounds[2u * pixel] = vec4(min(lo.xyz, pathLo), max(lo.w, escaped ? 1.0 : 0.0));
+    hitBounds[2u * pixel + 1u] = vec4(max(hi.xyz, pathHi), hi.w);
+  }
   atomicAdd(status[kStatusSpecularRays], rays);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

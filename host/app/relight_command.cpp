@@ -144,7 +144,9 @@ void relightScene(RelightOptions& o) {
   gpu::Context context(o.render.device.contextOptions());
   render::ObscuranceSettings settings = obscuranceSettings(o.render, camera);
   settings.spareLightSlots = static_cast<std::uint32_t>(std::count_if(
-      edits.begin(), edits.end(), [](const relight::Edit& e) { return e.kind == relight::Edit::Kind::AddLight; }));
+      edits.begin(), edits.end(), [](const relight::Edit& e) {
+        return e.kind == relight::Edit::Kind::AddLight || e.kind == relight::Edit::Kind::AddQuad;
+      }));
   // Each geometry edit makes the next scene; the renderer keeps a pointer to the current one.
   std::deque<scene::Scene> scenes;
   std::deque<bvh::Bvh> trees;
@@ -159,6 +161,9 @@ void relightScene(RelightOptions& o) {
     if (e.kind == relight::Edit::Kind::Insert) {
       const std::size_t i = scene::insertObject(next, inserts.at(e.entry), e.name, e.translate);
       changed.push_back(scene::objectBounds(next, i));
+    } else if (e.kind == relight::Edit::Kind::AddQuad) {
+      const std::size_t i = scene::insertEmissiveQuad(next, e.quad);
+      changed.push_back(scene::objectBounds(next, i));
     } else {
       const std::size_t i = scene::objectIndex(next, e.name, where);
       changed.push_back(scene::objectBounds(next, i));
@@ -170,10 +175,10 @@ void relightScene(RelightOptions& o) {
       }
     }
     scenes.push_back(std::move(next));
-    // A move or a removal keeps every triangle: the BVH is refitted; an insert adds triangles
-    // and rebuilds it.
+    // A move or a removal keeps every triangle: the BVH is refitted; an insert (or a quad) adds
+    // triangles and rebuilds it.
     const auto start = Clock::now();
-    const bool refit = e.kind != relight::Edit::Kind::Insert;
+    const bool refit = e.kind == relight::Edit::Kind::Move || e.kind == relight::Edit::Kind::Remove;
     if (refit) {
       trees.push_back(*currentBvh);
       bvh::refit(trees.back(), render::triangleSoup(scenes.back()));
@@ -184,6 +189,7 @@ void relightScene(RelightOptions& o) {
                  {"ms", std::chrono::duration<double, std::milli>(Clock::now() - start).count()}};
     current = &scenes.back();
     currentBvh = &trees.back();
+    if (e.kind == relight::Edit::Kind::AddQuad) return renderer.addEmitter(scenes.back(), trees.back(), changed);
     return renderer.updateGeometry(scenes.back(), trees.back(), changed);
   };
   // After renderer.composeDisplay(): the PNG from the fast path's display bytes, then the full
@@ -232,6 +238,16 @@ void relightScene(RelightOptions& o) {
         scale.push_back(1.0f);
         color.push_back(glm::vec3(1.0f));
         retraced = renderer.layout().pixels();
+        break;
+      }
+      case relight::Edit::Kind::AddQuad: {
+        // An area light: it goes before the punctual lights, at its light group's index.
+        renderer.setEmissions(emissionsNow());
+        retraced = geometryEdit(e);
+        const auto i = static_cast<std::ptrdiff_t>(renderer.lightIndex(e.name));
+        base.insert(base.begin() + i, renderer.emissions()[static_cast<std::size_t>(i)]);
+        scale.insert(scale.begin() + i, 1.0f);
+        color.insert(color.begin() + i, glm::vec3(1.0f));
         break;
       }
       case relight::Edit::Kind::RemoveLight: {

@@ -58,9 +58,7 @@ scene::PunctualLight addedLight(const json& j, const EntryContext& at) {
   const std::string type = text(j, "type", at);
   scene::PunctualLight l;
   l.name = text(j, "name", at);
-  if (type == "quad")
-    at.fail("an emissive quad needs scene geometry, which edits cannot insert yet; insert a glTF mesh instead");
-  if (type != "point" && type != "spot") at.fail(fmt::format("light type '{}' (known: point, spot)", type));
+  if (type != "point" && type != "spot") at.fail(fmt::format("light type '{}' (known: point, spot, quad)", type));
   l.type = type == "point" ? scene::PunctualType::Point : scene::PunctualType::Spot;
   l.position = vec3(j, "position", at);
   l.color = j.contains("color") ? vec3(j, "color", at) : glm::vec3(1.0f);
@@ -79,13 +77,26 @@ scene::PunctualLight addedLight(const json& j, const EntryContext& at) {
   return l;
 }
 
+scene::EmissiveQuad addedQuad(const json& j, const EntryContext& at) {
+  scene::EmissiveQuad q;
+  q.name = text(j, "name", at);
+  q.corner = vec3(j, "corner", at);
+  q.edge1 = vec3(j, "edge1", at);
+  q.edge2 = vec3(j, "edge2", at);
+  q.emission = vec3(j, "emission", at);
+  if (!(glm::length(glm::cross(q.edge1, q.edge2)) > 0.0f)) at.fail("'edge1' and 'edge2' span no area");
+  if (glm::any(glm::lessThan(q.emission, glm::vec3(0.0f)))) at.fail("'emission' must not be negative");
+  return q;
+}
+
 } // namespace
 
 std::string Edit::kindName() const {
   switch (kind) {
     case Kind::Scale: return "scale";
     case Kind::Color: return "color";
-    case Kind::AddLight: return "add_light";
+    case Kind::AddLight:
+    case Kind::AddQuad: return "add_light";
     case Kind::RemoveLight: return "remove_light";
     case Kind::Move: return "move";
     case Kind::Remove: return "remove";
@@ -129,13 +140,26 @@ std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> li
         at.fail("a light edit needs 'scale' or 'color'");
       }
     } else if (j.contains("add_light")) {
-      e.kind = Edit::Kind::AddLight;
-      e.light = addedLight(j.at("add_light"), at);
-      e.name = e.light.name;
+      const json& light = j.at("add_light");
+      const bool quad = light.is_object() && light.contains("type") && light.at("type") == "quad";
+      if (quad) {
+        e.kind = Edit::Kind::AddQuad;
+        e.quad = addedQuad(light, at);
+        e.name = e.quad.name;
+        // The quad is an object too: later edits may move or remove it.
+        if (std::find(objectNames.begin(), objectNames.end(), e.name) != objectNames.end())
+          at.fail(fmt::format("an object named '{}' exists already", e.name));
+        objectNames.push_back(e.name);
+      } else {
+        e.kind = Edit::Kind::AddLight;
+        e.light = addedLight(light, at);
+        e.name = e.light.name;
+      }
       if (std::find(lightNames.begin(), lightNames.end(), e.name) != lightNames.end())
         at.fail(fmt::format("a light named '{}' exists already", e.name));
+      // Area lights come before punctual ones; only a punctual light's name goes on removal.
       lightNames.push_back(e.name);
-      areaLights.push_back(false);
+      areaLights.push_back(quad);
     } else if (j.contains("remove_light")) {
       e.kind = Edit::Kind::RemoveLight;
       e.name = text(j, "remove_light", at);

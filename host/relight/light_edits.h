@@ -4,6 +4,8 @@
 //   {"light": NAME, "color": [r, g, b]}    its RGB multipliers (absolute, start at 1, 1, 1)
 //   {"add_light": {"type": "point"|"spot", "name": N, "position": [..], "color": [..],
 //                  "intensity": I, "direction": [..], "inner_cone": a, "outer_cone": b}}
+//   {"add_light": {"type": "quad", "name": N, "corner": [..], "edge1": [..], "edge2": [..],
+//                  "emission": [r, g, b]}}     an emissive quad: a light and an object named N
 //   {"remove_light": NAME}
 //   {"move": NODE, "translate": [..], "rotate_deg": [..]}, {"remove": NODE},
 //   {"insert": "other.gltf", "name": N, "translate": [..]}   (the path relative to the edits file)
@@ -17,17 +19,19 @@
 #include <glm/glm.hpp>
 
 #include "scene/scene.h"
+#include "scene/scene_edit.h"
 
 namespace obscura::relight {
 
 struct Edit {
-  enum class Kind { Scale, Color, AddLight, RemoveLight, Move, Remove, Insert };
+  enum class Kind { Scale, Color, AddLight, AddQuad, RemoveLight, Move, Remove, Insert };
   Kind kind = Kind::Scale;
   std::size_t entry = 0;       // index in the file, for messages
   std::string name;            // the light or node it names
   float scale = 1.0f;
   glm::vec3 color{1.0f};
   scene::PunctualLight light;  // AddLight
+  scene::EmissiveQuad quad;    // AddQuad
   glm::vec3 translate{0.0f};   // Move, Insert
   glm::vec3 rotateDegrees{0.0f};
   std::string path;            // Insert: the other glTF

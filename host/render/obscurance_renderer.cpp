@@ -275,6 +275,13 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
                                                  const std::vector<scene::Bounds>& changed) {
   const auto start = Clock::now();
   const double wallBefore = wallSeconds_;
+  const bool emittersMoved = replaceScene(edited, bvh);
+  const std::uint64_t retraced = retraceDirty(changed, emittersMoved);
+  wallSeconds_ = wallBefore + secondsSince(start);
+  return retraced;
+}
+
+bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh& bvh) {
   // Same lights: only an emitter that moved changes them, and then every pixel may change.
   LightSet moved = buildLightSet(edited);
   bool emittersMoved = moved.emitters.size() != lights_.emitters.size();
@@ -304,7 +311,11 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
   if (reflectorsOn()) markReflectors();
   if (rebind || emittersMoved) uploadLights();
+  return emittersMoved;
+}
 
+std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>& changed, bool everyPixel,
+                                               std::uint32_t tracedLight) {
   const FrameLayout& layout = frame_.layout();
   const gpu::GpuCamera camera = primaryCamera();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
@@ -312,7 +323,7 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
     // The sky lights every pixel from every direction: any edit may change any pixel.
     // So do secondary reflectors: what the edit lights or shades anew is marked anew.
     dirty_.prepare(b, layout, camera, changed, dMax_, lightCount,
-                   emittersMoved || backgroundLight(lights_) < lights_.size() || reflectorsOn());
+                   everyPixel || backgroundLight(lights_) < lights_.size() || reflectorsOn(), tracedLight);
   const std::uint32_t dirtyBefore = frame_.statusWords()[gpu::kStatusDirtyPixels];
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
@@ -338,7 +349,6 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
     primaryRays_ += retraced * (last - first);
   }
   markResolveStale(0, true);
-  wallSeconds_ = wallBefore + secondsSince(start);
   return retraced;
 }
 
@@ -519,7 +529,7 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
   if (std::find(lights_.names.begin(), lights_.names.end(), light.name) != lights_.names.end())
     throw InputError(fmt::format("add light '{}': a light of that name exists", light.name));
   const std::size_t index = lights_.size();
-  frame_.addLightSlot(stream_);
+  frame_.addLightSlot(stream_, static_cast<std::uint32_t>(index));
   markResolveStale(static_cast<std::uint32_t>(index), false);
   appendPunctual(lights_, light, scene_->bounds);
   updateSelection(lights_);
@@ -534,9 +544,15 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
     return index;
   }
 
-  // The new light's shadow rays from the frame's own primary hits: the G-buffer of every sample
-  // so far is made again (same seed, same sub-pixel position, no accumulation) and the shadow
-  // pass samples the new light alone.
+  traceAddedLight(static_cast<std::uint32_t>(index));
+  return index;
+}
+
+void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
+  // The new light's rays from the frame's own primary hits and specular paths: the G-buffer of
+  // every sample so far is made again (same seed, same sub-pixel position, no accumulation), the
+  // shadow pass samples the new light alone, and the specular pass follows the same paths again
+  // (their lobe samples have a generator of their own) gathering that light alone.
   const auto start = Clock::now();
   const double wallBefore = wallSeconds_;
   const FrameLayout& layout = frame_.layout();
@@ -553,16 +569,65 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
           primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, gpu::kPrimaryFlagGBufferOnly);
         timestamps_.end(cmd, "primary");
         gpu::computeBarrier(cmd);
+        gpu::ShadePush push = shadePush(s);
+        push.band.z = gpu::kShadeFlagPerLight;
+        push.band.w = light;
         timestamps_.begin(cmd, "shadow");
-        recordShadowForLight(cmd, shadePush(s), static_cast<std::uint32_t>(index));
+        for (std::uint32_t b = 0; b < layout.bandCount(); ++b) shadow_.record(cmd, b, layout, push);
         timestamps_.end(cmd, "shadow");
+        if (runSpecular_) {
+          timestamps_.begin(cmd, "specular");
+          for (std::uint32_t b = 0; b < layout.bandCount(); ++b) specularPass_.record(cmd, b, layout, frame_, push);
+          timestamps_.end(cmd, "specular");
+        }
       }
     });
     timestamps_.collect();
     primaryRays_ += layout.pixels() * (last - first);
   }
   wallSeconds_ = wallBefore + secondsSince(start);
-  return index;
+}
+
+std::uint64_t ObscuranceRenderer::addEmitter(const scene::Scene& edited, const bvh::Bvh& bvh,
+                                            const std::vector<scene::Bounds>& changed) {
+  // Area lights come first, one per light group, so the new group's light goes between them and
+  // the punctual lights (its triangles name it by that index).
+  const std::size_t index = edited.lightGroups.size() - 1;
+  const auto areaLights = static_cast<std::size_t>(std::count_if(
+      lights_.lights.begin(), lights_.lights.end(), [](const gpu::GpuLight& l) { return l.info.x == gpu::kLightArea; }));
+  if (edited.lightGroups.empty() || areaLights != index)
+    throw std::logic_error("addEmitter: the edited scene must have exactly one light group more than the renderer");
+  if (std::find(lights_.names.begin(), lights_.names.end(), edited.lightGroups[index].name) != lights_.names.end())
+    throw InputError(fmt::format("add light '{}': a light of that name exists", edited.lightGroups[index].name));
+  const auto start = Clock::now();
+  const double wallBefore = wallSeconds_;
+  frame_.addLightSlot(stream_, static_cast<std::uint32_t>(index));
+  markResolveStale(static_cast<std::uint32_t>(index), true);
+  const LightSet fresh = buildLightSet(edited);
+  lights_.emitters = fresh.emitters; // the new group's triangles come last: the others keep their places
+  auto insertAt = [&](auto& v, const auto& value) { v.insert(v.begin() + static_cast<std::ptrdiff_t>(index), value); };
+  insertAt(lights_.lights, fresh.lights[index]);
+  insertAt(lights_.names, fresh.names[index]);
+  insertAt(lights_.emission, fresh.emission[index]);
+  insertAt(lights_.unitFlux, fresh.unitFlux[index]);
+  insertAt(lights_.power, fresh.power[index]);
+  updateSelection(lights_);
+  insertAt(emissions_, fresh.emission[index]);
+  if (reached_) ambient_.reach.insert(ambient_.reach.begin() + static_cast<std::ptrdiff_t>(index), LightReach{});
+  updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
+  // The quad is geometry too: replaceScene uploads it, measures what every light reaches anew,
+  // and the pixels it can change are retraced for every light (the new one included).
+  const bool everyPixel = replaceScene(edited, bvh);
+  std::uint64_t retraced = 0;
+  if (reflectorsOn()) {
+    retraceAll();
+    retraced = frame_.layout().pixels();
+  } else {
+    traceAddedLight(static_cast<std::uint32_t>(index));
+    retraced = retraceDirty(changed, everyPixel, static_cast<std::uint32_t>(index));
+  }
+  wallSeconds_ = wallBefore + secondsSince(start);
+  return retraced;
 }
 
 void ObscuranceRenderer::removeLight(std::size_t index) {

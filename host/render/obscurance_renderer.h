@@ -151,6 +151,13 @@ public:
   // pixels retraced. Moving an emitter retraces every pixel.
   std::uint64_t updateGeometry(const scene::Scene& edited, const bvh::Bvh& bvh,
                                const std::vector<scene::Bounds>& changed);
+  // Adds an area light that is also geometry (an emissive quad, scene::insertEmissiveQuad):
+  // `edited` is the scene with one light group more, the last, and `changed` the new object's box.
+  // The new light's rays are traced at every pixel and along the frame's specular paths, as
+  // addLight does, and the pixels the new surface can change (it is seen, casts shadows and
+  // occludes) are retraced for every light, as updateGeometry does. Its light index is that of
+  // its group (area lights come first). Returns the pixels retraced.
+  std::uint64_t addEmitter(const scene::Scene& edited, const bvh::Bvh& bvh, const std::vector<scene::Bounds>& changed);
 
   // The index of the light named `name`; InputError listing the names when there is none.
   std::size_t lightIndex(const std::string& name) const;
@@ -180,6 +187,17 @@ private:
   // Every sample so far again, every pixel (an edit that changed what the reflectors are).
   void retraceAll();
   void bindAll();
+  // The new light `light`'s rays at every pixel and along the specular paths of every sample so
+  // far, the light sampled alone (addLight, addEmitter).
+  void traceAddedLight(std::uint32_t light);
+  // The geometry half of an edit: `edited` replaces the scene (buffers, reach, lights whose
+  // emitters moved). Returns whether emitters moved (then every pixel may change).
+  bool replaceScene(const scene::Scene& edited, const bvh::Bvh& bvh);
+  // Clears and retraces, for every sample so far, the pixels `changed` can change (all of them
+  // with `everyPixel`). `tracedLight`, a new light traced at every pixel, is left out of the
+  // shadow-segment test. Returns how many.
+  std::uint64_t retraceDirty(const std::vector<scene::Bounds>& changed, bool everyPixel,
+                             std::uint32_t tracedLight = gpu::kInvalidIndex);
   gpu::ShadePush shadePush(std::uint32_t sample) const;
   gpu::GpuCamera primaryCamera() const; // with the background's slot
   std::vector<glm::vec4> downloadBand(const gpu::Buffer& buffer) const;

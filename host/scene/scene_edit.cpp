@@ -1,6 +1,7 @@
 #include "scene/scene_edit.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include <fmt/format.h>
@@ -105,6 +106,46 @@ std::size_t insertObject(Scene& scene, const Scene& other, const std::string& na
   scene.objects.push_back({.name = name, .firstTriangle = first,
                            .triangleCount = static_cast<std::uint32_t>(other.triangles.size()),
                            .world = glm::translate(glm::mat4(1.0f), translate)});
+  recomputeBounds(scene);
+  return scene.objects.size() - 1;
+}
+
+std::size_t insertEmissiveQuad(Scene& scene, const EmissiveQuad& quad) {
+  const glm::vec3 normal = glm::cross(quad.edge1, quad.edge2);
+  if (!(glm::length(normal) > 0.0f) || !std::isfinite(glm::length(normal)))
+    throw InputError(fmt::format("add quad '{}': its edges span no area", quad.name));
+  if (glm::any(glm::lessThan(quad.emission, glm::vec3(0.0f))))
+    throw InputError(fmt::format("add quad '{}': emission must not be negative", quad.name));
+  for (const auto& o : scene.objects)
+    if (o.name == quad.name) throw InputError(fmt::format("add quad '{}': an object of that name exists", quad.name));
+  for (const auto& g : scene.lightGroups)
+    if (g.name == quad.name) throw InputError(fmt::format("add quad '{}': a light of that name exists", quad.name));
+  Material m;
+  m.name = quad.name;
+  m.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  m.metallic = 0.0f;
+  m.roughness = 1.0f;
+  m.emission = quad.emission;
+  scene.materials.push_back(m);
+  const auto material = static_cast<std::uint32_t>(scene.materials.size() - 1);
+  const auto group = static_cast<std::uint32_t>(scene.lightGroups.size());
+  scene.lightGroups.push_back({.name = quad.name, .triangles = {}, .emission = quad.emission});
+  const auto base = static_cast<std::uint32_t>(scene.positions.size());
+  const glm::vec3 n = glm::normalize(normal);
+  for (glm::vec3 p : {quad.corner, quad.corner + quad.edge1, quad.corner + quad.edge1 + quad.edge2, quad.corner + quad.edge2}) {
+    scene.positions.push_back(p);
+    scene.normals.push_back(n);
+    scene.uvs.push_back(glm::vec2(0.0f));
+  }
+  const auto first = static_cast<std::uint32_t>(scene.triangles.size());
+  for (glm::uvec3 t : {glm::uvec3(base, base + 1, base + 2), glm::uvec3(base, base + 2, base + 3)}) {
+    scene.lightGroups.back().triangles.push_back(static_cast<std::uint32_t>(scene.triangles.size()));
+    scene.triangles.push_back(t);
+    scene.triangleMaterial.push_back(material);
+    scene.triangleLightGroup.push_back(group);
+  }
+  scene.objects.push_back({.name = quad.name, .firstTriangle = first, .triangleCount = 2,
+                           .world = glm::translate(glm::mat4(1.0f), quad.corner)});
   recomputeBounds(scene);
   return scene.objects.size() - 1;
 }

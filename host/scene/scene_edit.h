@@ -35,4 +35,18 @@ void removeObject(Scene& scene, std::size_t index);
 // add_light) or the name exists.
 std::size_t insertObject(Scene& scene, const Scene& other, const std::string& name, glm::vec3 translate);
 
+// An emissive quad (relight's {"add_light": {"type": "quad", ...}}): a parallelogram at `corner`
+// spanned by `edge1` and `edge2`, emitting `emission` (radiance) from the side cross(edge1, edge2)
+// points to, reflecting nothing (black, matte).
+struct EmissiveQuad {
+  std::string name;
+  glm::vec3 corner{0.0f}, edge1{1.0f, 0.0f, 0.0f}, edge2{0.0f, 0.0f, 1.0f};
+  glm::vec3 emission{1.0f};
+};
+
+// Inserts `quad` as object `name` with a light group of that name, the last one. InputError when
+// the edges span no area, the emission is negative, or an object or light group of that name
+// exists.
+std::size_t insertEmissiveQuad(Scene& scene, const EmissiveQuad& quad);
+
 } // namespace obscura::scene

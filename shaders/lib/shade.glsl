@@ -91,6 +91,27 @@ void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, float lightSamp
   directLightFrom(sp, ls, lightSamples, budget, contribution, visible);
 }
 
+// Direct light from `light` alone, the relighting paper's visibility sampling [IVR §3.1]:
+// kPerLightRays shadow rays to it; where they disagree (a penumbra) more, up to kPerLightMaxRays,
+// all averaged. No MIS: the caller counts none of this light's emission found by a lobe sample.
+// `rays` says how many were traced.
+vec3 directLightFromOne(ShadingPoint sp, uint light, vec4 lightShift, inout StepBudget budget, out uint rays) {
+  vec3 sum = vec3(0.0);
+  uint seen = 0u;
+  rays = 0u;
+  for (uint k = 0u; k < kPerLightMaxRays; ++k) {
+    if (k == kPerLightRays && (seen == 0u || seen == kPerLightRays)) break;
+    vec4 u = kroneckerPoint4(k, lightShift);
+    vec3 contribution;
+    bool visible;
+    directLightFrom(sp, sampleChosenLight(sp.position, sp.ng, u, light, 1.0), 0.0, budget, contribution, visible);
+    sum += contribution;
+    seen += visible ? 1u : 0u;
+    ++rays;
+  }
+  return sum / float(rays);
+}
+
 // The shadow ray of light sample `ls`; `visible` says whether it reached the light (false also
 // when the light faces away or lies below the surface: nothing to trace).
 void directLightFrom(ShadingPoint sp, LightSample ls, float lightSamples, inout StepBudget budget,

@@ -377,7 +377,8 @@ struct DirtyPush {
   uvec4 frame;        // 0:   width, rows (of the band), first row, light count
   vec4 spheres[4];    // 16:  changed boxes' bounding spheres: centre xyz, radius w (w < 0: unused)
   uvec4 rects[4];     // 80:  their screen rectangles in frame pixels: x0, y0, x1, y1 (inclusive)
-  vec4 params;        // 144: dMax, all dirty (1) or not, unused, unused
+  vec4 params;        // 144: dMax, all dirty (1) or not, a light whose shadow rays are traced
+                      //      anew at every pixel anyway (uint bits; kInvalidIndex: none), unused
 };                    // 160 bytes (> 128: passed in a uniform-like storage buffer, not push constants)
 // Light bounds for dirty.comp, two vec4 per light: (centre xyz, radius) and (direction xyz, 1 for
 // a directional light whose segments run to infinity along -direction, else 0).

@@ -171,8 +171,63 @@ TEST_F(CliRelight, BadEditsAreRefusedNamingTheEntryBeforeAnyFrame) {
       {json::array({{{"remove_light", "b"}}}), "no light named 'b'"},
       {json::array({{{"teleport", "x"}}}), "unknown edit"},
       {json::object({{"light", kCornellLight}}), "list"},
+      {json::array({{{"add_light", {{"type", "quad"}, {"name", "q"}, {"corner", {0, 0, 0}}, {"edge1", {1, 0, 0}},
+                                    {"edge2", {2, 0, 0}}, {"emission", {1, 1, 1}}}}}}),
+       "span no area"},
+      {json::array({{{"add_light", {{"type", "quad"}, {"name", "q"}, {"corner", {0, 0, 0}}, {"edge1", {1, 0, 0}},
+                                    {"edge2", {0, 1, 0}}}}}}),
+       "'emission' is missing"},
+      {json::array({{{"add_light", {{"type", "quad"}, {"name", "cube_1"}, {"corner", {0, 0, 0}}, {"edge1", {1, 0, 0}},
+                                    {"edge2", {0, 1, 0}}, {"emission", {1, 1, 1}}}}}}),
+       "an object named 'cube_1'"},
   };
   expectEditsRefused(cases);
+}
+
+// An emissive quad on the back wall: a light (its own layer, relit like any other) and an object
+// (later edits may move or remove it); only the pixels its surface can change are retraced.
+TEST_F(CliRelight, AddedEmissiveQuadIsALightAndAnObject) {
+  writeText("edits.json", json::array({
+                              {{"add_light", {{"type", "quad"}, {"name", "panel"}, {"corner", {-0.9, 0.1, -0.99}},
+                                              {"edge1", {0.4, 0.0, 0.0}}, {"edge2", {0.0, 0.3, 0.0}},
+                                              {"emission", {6.0, 6.0, 8.0}}}}},
+                              {{"light", "panel"}, {"scale", 0.5}},
+                              {{"move", "panel"}, {"translate", {0.5, 0.0, 0.0}}},
+                          }).dump());
+  const auto r = runObscura("relight " + cornellBox() + " --edits " + path("edits.json") + " -o " + path("out") +
+                            " --width 32 --height 32 --spp 4");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream log(path("out/edits.jsonl"));
+  std::vector<json> lines;
+  for (std::string line; std::getline(log, line);) lines.push_back(json::parse(line));
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0]["kind"], "add_light");
+  EXPECT_GT(lines[0]["rays"]["shadow"].get<double>(), 0.0);
+  EXPECT_GT(lines[0]["pixels_retraced"].get<int>(), 0);
+  EXPECT_LT(lines[0]["pixels_retraced"].get<int>(), 32 * 32) << "only the pixels the quad's surface can change";
+  EXPECT_EQ(lines[0]["bvh"]["kind"], "rebuild");
+  EXPECT_EQ(lines[1]["pixels_retraced"], 0);
+  EXPECT_EQ(lines[2]["pixels_retraced"], 32 * 32) << "a moved emitter can change every pixel";
+  auto layer = [&](int frame, const std::string& name) {
+    const io::Image image = io::readImage(path("out/frame-00" + std::to_string(frame) + ".exr"));
+    const int c = image.channelIndex(name + ".R");
+    std::vector<float> out;
+    if (c < 0) return out;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        for (int k = 0; k < 3; ++k) out.push_back(image.at(x, y, c + k));
+    return out;
+  };
+  EXPECT_TRUE(layer(0, "light.panel").empty());
+  const auto panel = layer(1, "light.panel"), halved = layer(2, "light.panel");
+  ASSERT_EQ(panel.size(), 32u * 32u * 3u);
+  ASSERT_EQ(halved.size(), panel.size());
+  double sum = 0.0;
+  for (std::size_t i = 0; i < panel.size(); ++i) {
+    sum += panel[i];
+    EXPECT_NEAR(halved[i], 0.5f * panel[i], 1e-5f * std::max(1.0f, panel[i]));
+  }
+  EXPECT_GT(sum / static_cast<double>(panel.size()), 0.01) << "the panel lights the room";
 }
 
 } // namespace

@@ -106,17 +106,24 @@ std::uint64_t ObscuranceFrame::bytes() const {
   return total;
 }
 
-void ObscuranceFrame::addLightSlot(gpu::CommandStream& stream) {
+void ObscuranceFrame::addLightSlot(gpu::CommandStream& stream, std::uint32_t index) {
   if (lights_ >= maxLights_)
     throw InputError(fmt::format("{} lights: this frame was made with room for {} (spare light slots: {})",
                                  lights_ + 1, maxLights_, contents_.spareLightSlots));
+  if (index > lights_) throw std::logic_error("addLightSlot: index past the last light");
   stream.submit([&](const vk::raii::CommandBuffer& cmd) {
     for (std::size_t i = 0; i < bands_.size(); ++i) {
       const std::uint64_t slot = layout_.bandPixels(i) * kAccumulator;
       Band& b = bands_[i];
-      cmd.fillBuffer(b.basis.handle(), lights_ * slot, slot, 0u);
-      cmd.fillBuffer(b.emissionBasis.handle(), lights_ * slot, slot, 0u);
-      if (contents_.specular) cmd.fillBuffer(b.specularBasis.handle(), lights_ * slot, slot, 0u);
+      std::vector<const gpu::Buffer*> perLight = {&b.basis, &b.emissionBasis};
+      if (contents_.specular) perLight.push_back(&b.specularBasis);
+      // Slot by slot from the top, each copy after the last (copies within one buffer must not overlap).
+      for (std::uint32_t l = lights_; l > index; --l) {
+        const vk::BufferCopy region{.srcOffset = (l - 1) * slot, .dstOffset = l * slot, .size = slot};
+        for (const gpu::Buffer* buffer : perLight) cmd.copyBuffer(buffer->handle(), buffer->handle(), region);
+        gpu::computeBarrier(cmd);
+      }
+      for (const gpu::Buffer* buffer : perLight) cmd.fillBuffer(buffer->handle(), index * slot, slot, 0u);
     }
   });
   ++lights_;

@@ -76,8 +76,9 @@ public:
   // Device bytes allocated now (the real buffers' sizes).
   std::uint64_t bytes() const;
 
-  // Appends a light slot (zero transport); InputError when the spare slots are used up.
-  void addLightSlot(gpu::CommandStream& stream);
+  // Inserts a light slot (zero transport) at `index`; the slots from there move up one.
+  // InputError when the spare slots are used up.
+  void addLightSlot(gpu::CommandStream& stream, std::uint32_t index);
   // Drops light slot `index`; the slots after it move down one (lights keep their order).
   void removeLightSlot(gpu::CommandStream& stream, std::uint32_t index);
   std::uint32_t lightCapacity() const { return maxLights_; }

@@ -1,6 +1,7 @@
 #include "render/passes/dirty_pass.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "clear.spv.h"
@@ -84,7 +85,8 @@ void DirtyPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu
 }
 
 void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu::GpuCamera& camera,
-                        const std::vector<scene::Bounds>& changed, float dMax, std::uint32_t lights, bool all) {
+                        const std::vector<scene::Bounds>& changed, float dMax, std::uint32_t lights, bool all,
+                        std::uint32_t tracedLight) {
   gpu::DirtyPush push{};
   push.frame = glm::uvec4(layout.width, layout.bands[band].rows, layout.bands[band].firstRow, lights);
   const bool tooMany = changed.size() > gpu::kMaxChangedBoxes;
@@ -98,7 +100,7 @@ void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu
       push.rects[i] = glm::uvec4(1u, 1u, 0u, 0u);
     }
   }
-  push.params = glm::vec4(dMax, all || tooMany ? 1.0f : 0.0f, 0.0f, 0.0f);
+  push.params = glm::vec4(dMax, all || tooMany ? 1.0f : 0.0f, std::bit_cast<float>(tracedLight), 0.0f);
   params_[band].upload(*context_, &push, sizeof(push));
 }
 
