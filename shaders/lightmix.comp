@@ -2,6 +2,9 @@
 // lightmix.comp — a light edit's frame in one pass from the resolved transport (resolve.comp):
 //   display = tonemap( sum_s E_s T_s + I_a(E) A_t )      [SPEC §3, IVR eq. 4]
 // reading 4 bytes per light and pixel, so that relighting stays interactive with many lights.
+// Four neighbouring pixels per invocation, read as one RGBA32UI texel per light: on lavapipe a
+// load with per-lane addresses costs a scalar load per lane, so one 16-byte texel per lane is a
+// quarter of the loads of four words (measured: docs/BENCHMARKS.md).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/srgb.glsl"
@@ -9,15 +12,29 @@
 
 layout(local_size_x = kWorkgroupSize1D) in;
 layout(push_constant) uniform Push { LightMixPush pc; };
-layout(std430, binding = kBindingLightMixResolved) readonly buffer Resolved { uint resolved[]; };
+layout(binding = kBindingLightMixResolved) uniform usamplerBuffer resolved;
 layout(std430, binding = kBindingLightMixEmissions) readonly buffer Emissions { vec4 emission[]; };
 layout(std430, binding = kBindingLightMixOutput) writeonly buffer Out { uint display[]; };
 
 void main() {
-  uint pixel = gl_GlobalInvocationID.x;
-  uint pixelCount = pc.frame.x * pc.frame.y;
-  if (pixel >= pixelCount) return;
-  vec3 c = pc.ambient.rgb * unpackRgb9e5(resolved[pc.frame.w * pixelCount + pixel]);
-  for (uint s = 0u; s < pc.frame.z; ++s) c += emission[s].rgb * unpackRgb9e5(resolved[s * pixelCount + pixel]);
-  display[pixel] = displayRgba8(c, pc.ambient.w);
+  const uint quad = gl_GlobalInvocationID.x;
+  const uint pixelCount = pc.frame.x * pc.frame.y;
+  const uint first = quad * kResolvedPixelAlign;
+  if (first >= pixelCount) return;
+  const uint rowTexels = resolvedStride(pixelCount) / kResolvedPixelAlign; // texels per light
+  uvec4 a = texelFetch(resolved, int(pc.frame.w * rowTexels + quad));
+  vec3 c0 = pc.ambient.rgb * unpackRgb9e5(a.x), c1 = pc.ambient.rgb * unpackRgb9e5(a.y);
+  vec3 c2 = pc.ambient.rgb * unpackRgb9e5(a.z), c3 = pc.ambient.rgb * unpackRgb9e5(a.w);
+  for (uint s = 0u; s < pc.frame.z; ++s) {
+    const uvec4 t = texelFetch(resolved, int(s * rowTexels + quad));
+    const vec3 e = emission[s].rgb;
+    c0 += e * unpackRgb9e5(t.x);
+    c1 += e * unpackRgb9e5(t.y);
+    c2 += e * unpackRgb9e5(t.z);
+    c3 += e * unpackRgb9e5(t.w);
+  }
+  display[first] = displayRgba8(c0, pc.ambient.w);
+  if (first + 1u < pixelCount) display[first + 1u] = displayRgba8(c1, pc.ambient.w);
+  if (first + 2u < pixelCount) display[first + 2u] = displayRgba8(c2, pc.ambient.w);
+  if (first + 3u < pixelCount) display[first + 3u] = displayRgba8(c3, pc.ambient.w);
 }

@@ -22,14 +22,15 @@ void main() {
   if (pixel >= pixelCount) return;
   float inv = 1.0 / float(max(pc.frame.z, 1u));
   const bool withSpecular = pc.flags.x != 0u;
+  const uint stride = resolvedStride(pixelCount);
   for (uint s = pc.flags.y; s < pc.frame.w; ++s) {
     uint i = s * pixelCount + pixel;
     vec3 t = OBS_SUM(basis, i).rgb + OBS_SUM(emissionBasis, i).rgb;
     if (withSpecular) t += OBS_SUM(specularBasis, i).rgb;
-    resolved[i] = packRgb9e5(t * inv);
+    resolved[s * stride + pixel] = packRgb9e5(t * inv);
   }
   if (pc.flags.z == 0u) return;
   vec3 a = OBS_SUM(ambient, pixel).rgb;
   if (withSpecular) a += OBS_SUM(specularAmbient, pixel).rgb;
-  resolved[pc.capacity.x * pixelCount + pixel] = packRgb9e5(a * inv);
+  resolved[pc.capacity.x * stride + pixel] = packRgb9e5(a * inv);
 }

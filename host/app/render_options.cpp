@@ -57,7 +57,7 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
   cmd.add_flag("--no-bleed", o.noBleed, "grey obscurance W instead of colour bleeding W_c");
   cmd.add_option("--shadow-sampling", o.shadowSampling,
                  "selection (N_s rays per hit to lights chosen by power, default) or per-light (every light "
-                 "alone, 4 rays per hit, up to 64 in penumbrae: relit images stay as clean as fresh ones)")
+                 "alone, 4 rays per hit, up to 64 in penumbrae, one to a point light: relit images stay as clean as fresh ones)")
       ->check(CLI::IsMember({"selection", "per-light"}));
   cmd.add_option("--light-sampling", o.lightSampling,
                  "how shadow rays pick lights (both methods): spatial (default: by importance at the point, "

@@ -87,6 +87,13 @@ void Buffer::fill(const Context& context, std::uint32_t value) {
   });
 }
 
+TexelBuffer::TexelBuffer(const Context& context, vk::DeviceSize size, vk::Format format,
+                         vk::BufferUsageFlags extraUsage, const std::string& name)
+    : buffer_(context, size, vk::BufferUsageFlagBits::eUniformTexelBuffer | extraUsage, name) {
+  view_ = context.device().createBufferView({.buffer = buffer_.handle(), .format = format, .offset = 0,
+                                             .range = VK_WHOLE_SIZE});
+}
+
 TexelBuffer::TexelBuffer(const Context& context, const void* data, vk::DeviceSize size,
                          const std::string& name)
     : buffer_(context, size, vk::BufferUsageFlagBits::eUniformTexelBuffer, name) {

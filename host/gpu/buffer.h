@@ -59,12 +59,17 @@ private:
   std::string name_;
 };
 
-// A buffer with a texel view, for the BVH (lavapipe gathers texels as vectors, see
-// docs/ARCHITECTURE.md). RGBA32F texels.
+// A buffer with a texel view, read through uniform texel buffers where lavapipe gathers texels as
+// vectors instead of one scalar load per lane (docs/ARCHITECTURE.md): the BVH (RGBA32F texels),
+// the resolved transport of light edits (R32_UINT).
 class TexelBuffer {
 public:
   TexelBuffer() = default;
   TexelBuffer(const Context& context, const void* data, vk::DeviceSize size, const std::string& name);
+  // `size` bytes of `format` texels, uninitialised; `extraUsage` (e.g. storage, for a pass that
+  // writes them) besides the texel view.
+  TexelBuffer(const Context& context, vk::DeviceSize size, vk::Format format, vk::BufferUsageFlags extraUsage,
+              const std::string& name);
   const Buffer& buffer() const { return buffer_; }
   // New contents of the same size; the view stays valid.
   void upload(const Context& context, const void* data, vk::DeviceSize size) { buffer_.upload(context, data, size); }

@@ -319,10 +319,14 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
   const FrameLayout& layout = frame_.layout();
   const gpu::GpuCamera camera = primaryCamera();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
+  // Ray origins leave their surfaces by a few hundred ulps of their coordinates (lib/ray.glsl):
+  // a changed box grown by 1e-3 of the scene's size and reach covers them.
+  const scene::Bounds& bounds = scene_->bounds;
+  const float dirtyPad = 1e-3f * (glm::length(bounds.extent()) + glm::length(glm::max(glm::abs(bounds.lo), glm::abs(bounds.hi))));
   for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
     // The sky lights every pixel from every direction: any edit may change any pixel.
     // So do secondary reflectors: what the edit lights or shades anew is marked anew.
-    dirty_.prepare(b, layout, camera, changed, dMax_, lightCount,
+    dirty_.prepare(b, layout, camera, changed, dirtyPad, dMax_, lightCount,
                    everyPixel || backgroundLight(lights_) < lights_.size() || reflectorsOn(), tracedLight);
   const std::uint32_t dirtyBefore = frame_.statusWords()[gpu::kStatusDirtyPixels];
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {

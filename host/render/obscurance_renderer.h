@@ -50,7 +50,8 @@ enum class RhoKind : std::uint32_t { Sqrt = 0, Exp = 1, Ao = 2 };
 // How the shadow pass spends its rays [SPEC §1.3, IVR §3.1].
 enum class ShadowSampling {
   Selection, // shadowRays per hit, each to a light chosen by power (the obscurance paper's)
-  PerLight,  // every light alone, 4 rays per hit, up to 64 in penumbrae (the relighting paper's):
+  PerLight,  // every light alone, 4 rays per hit, up to 64 in penumbrae, one to a point light (exact)
+             // (the relighting paper's):
              // each D_s is independent of the other lights' powers, and a light of zero power
              // still gets transport, so switching it on later is a clean relight
 };
@@ -139,7 +140,8 @@ public:
 
   // Light edits that trace rays. addLight traces only the new light's shadow rays, from the same
   // primary hits as the frame's samples (the G-buffer is made again per sample), sampled alone
-  // (4 rays per hit, up to 64 in penumbrae), into a new basis buffer; removeLight drops one. Both
+  // (4 rays per hit, up to 64 in penumbrae; one to a point light), into a new basis buffer, and
+  // along the frame's specular paths (specular.comp followed again); removeLight drops one. Both
   // update I_a. Indices shift like a vector's.
   std::size_t addLight(const scene::PunctualLight& light);
   void removeLight(std::size_t index);

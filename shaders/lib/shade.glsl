@@ -93,14 +93,17 @@ void directLightSample(ShadingPoint sp, vec4 u, uint lightCount, float lightSamp
 
 // Direct light from `light` alone, the relighting paper's visibility sampling [IVR §3.1]:
 // kPerLightRays shadow rays to it; where they disagree (a penumbra) more, up to kPerLightMaxRays,
-// all averaged. No MIS: the caller counts none of this light's emission found by a lobe sample.
-// `rays` says how many were traced.
+// all averaged. A point, spot or directional light has one shadow ray, whose answer is exact. No
+// MIS: the caller counts none of this light's emission found by a lobe sample. `rays` says how
+// many were traced.
 vec3 directLightFromOne(ShadingPoint sp, uint light, vec4 lightShift, inout StepBudget budget, out uint rays) {
   vec3 sum = vec3(0.0);
   uint seen = 0u;
   rays = 0u;
+  const uint type = lights[light].info.x;
+  const uint first = type == kLightArea || type == kLightBackground ? kPerLightRays : 1u;
   for (uint k = 0u; k < kPerLightMaxRays; ++k) {
-    if (k == kPerLightRays && (seen == 0u || seen == kPerLightRays)) break;
+    if (k == first && (seen == 0u || seen == first)) break;
     vec4 u = kroneckerPoint4(k, lightShift);
     vec3 contribution;
     bool visible;

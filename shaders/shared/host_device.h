@@ -18,8 +18,10 @@ using ivec4 = glm::ivec4;
 using mat4 = glm::mat4;
 using uint = std::uint32_t;
 #define OBS_CONST inline constexpr
+#define OBS_FN inline constexpr
 #else
 #define OBS_CONST const
+#define OBS_FN
 #endif
 
 // ---- Workgroup sizes. lavapipe runs 8 invocations per SIMD group: keep multiples of 8.
@@ -245,7 +247,8 @@ struct ShadePush {
 };              // 112 bytes
 OBS_CONST uint kShadeFlagDirtyOnly = 1u; // only pixels the dirty mask marks run
 // shadow.comp samples light band.w alone, the paper's way [IVR §3.1]: kPerLightRays rays per
-// sample, up to kPerLightMaxRays where they disagree (a penumbra); one dispatch per light, so each
+// sample, up to kPerLightMaxRays where they disagree (a penumbra), one for a point, spot or
+// directional light (exact: every ray would go to the same point); one dispatch per light, so each
 // D_s is independent of the other lights' powers and each dispatch stays within the loop limiter.
 OBS_CONST uint kShadeFlagPerLight = 2u;
 OBS_CONST uint kPerLightRays = 4u;
@@ -338,9 +341,13 @@ OBS_CONST uint kTonemapBindingCount = 2;
 // ---- resolve.comp and lightmix.comp: the fast relighting path [SPEC §3]. resolve.comp turns the
 // Kahan sums into the per-light transport T_s = (D_s + M_s + S_s) / n and the ambient
 // A_t = (A + A^spec) / n, as RGB9E5 words (lib/rgb9e5.glsl: 9-bit mantissas, shared exponent),
-// [light][pixel] then the ambient after the frame's light slots, at [slots][pixel]. lightmix.comp composes and tonemaps from them
-// in one pass: display = tonemap(sum_s E_s T_s + I_a(E) A_t). A term keeps 2^-9 of its pixel's
-// largest channel (tests: LightMix.*).
+// [light][pixel] then the ambient after the frame's light slots, at [slots][pixel], each light's
+// row kResolvedPixelAlign-aligned (resolvedStride). lightmix.comp composes and tonemaps from them
+// in one pass: display = tonemap(sum_s E_s T_s + I_a(E) A_t), four pixels per invocation reading
+// one RGBA32UI texel per light (lavapipe: one 16-byte load per lane instead of four 4-byte ones).
+// A term keeps 2^-9 of its pixel's largest channel (tests: LightMix.*).
+OBS_CONST uint kResolvedPixelAlign = 4;
+OBS_FN uint resolvedStride(uint pixels) { return (pixels + kResolvedPixelAlign - 1u) / kResolvedPixelAlign * kResolvedPixelAlign; }
 struct ResolvePush {
   uvec4 frame;     // 0:  width, rows (of the band), samples accumulated, light count
   uvec4 flags;     // 16: x = 1 when the specular buffers hold data, y = first light to resolve (the
@@ -352,36 +359,38 @@ OBS_CONST uint kBindingResolveEmissionBasis = 1;   // vec4 pairs [light][pixel]:
 OBS_CONST uint kBindingResolveSpecularBasis = 2;   // vec4 pairs [light][pixel]: S_s
 OBS_CONST uint kBindingResolveAmbient = 3;         // vec4 pairs [pixel]: A
 OBS_CONST uint kBindingResolveSpecularAmbient = 4; // vec4 pairs [pixel]: A^spec
-OBS_CONST uint kBindingResolveOutput = 5;          // uint [(slots + 1) * pixels], RGB9E5
+OBS_CONST uint kBindingResolveOutput = 5;          // uint [(slots + 1) * resolvedStride(pixels)], RGB9E5
 OBS_CONST uint kResolveBindingCount = 6;
 
 struct LightMixPush {
   uvec4 frame;     // 0:  width, rows (of the band), light count, light slots (A_t lives after them)
   vec4 ambient;    // 16: I_a(E) rgb, w = exposure scale 2^stops
 };                 // 32 bytes
-OBS_CONST uint kBindingLightMixResolved = 0;  // uint [(slots + 1) * pixels] (resolve.comp)
+OBS_CONST uint kBindingLightMixResolved = 0;  // RGBA32UI texels of resolve.comp's words
 OBS_CONST uint kBindingLightMixEmissions = 1; // vec4[lights]: E_s
 OBS_CONST uint kBindingLightMixOutput = 2;    // uint[pixel]: RGBA8 (as tonemap.comp)
 OBS_CONST uint kLightMixBindingCount = 3;
 
 // ---- dirty.comp: the pixels a geometry edit can change [IVR §3.3; SPEC §2], conservatively:
-// those whose screen footprint the changed boxes cover (primary rays), those whose hit points lie
-// within dMax of a changed box (obscurance is local), those whose segments to a light pass near a
-// changed box (shadow rays: the paper's shafts, here the segment from the hit box's bounding
-// sphere to the light's bounding sphere against the changed box's sphere), with a glossy pixel's
-// specular path vertices counted in its hit box (every segment of a path lies in the box of its
-// vertices); a path that left the scene makes its pixel always dirty. Up to kMaxChangedBoxes
-// boxes (old and new places).
+// those whose screen footprint the changed boxes cover (primary rays), those whose hit box lies
+// within dMax of a changed box (obscurance is local), those whose segments to a light can meet a
+// changed box (shadow rays: the paper's shafts, here the convex hull of the pixel's hit box and the
+// light's box, tested against the changed box on separating axes), with a glossy pixel's specular
+// path vertices counted in its hit box (every segment of a path lies in the box of its vertices);
+// a path that left the scene makes its pixel always dirty. Up to kMaxChangedBoxes boxes (old and
+// new places), each padded by more than a ray origin's offset.
 OBS_CONST uint kMaxChangedBoxes = 4;
 struct DirtyPush {
   uvec4 frame;        // 0:   width, rows (of the band), first row, light count
-  vec4 spheres[4];    // 16:  changed boxes' bounding spheres: centre xyz, radius w (w < 0: unused)
-  uvec4 rects[4];     // 80:  their screen rectangles in frame pixels: x0, y0, x1, y1 (inclusive)
-  vec4 params;        // 144: dMax, all dirty (1) or not, a light whose shadow rays are traced
+  vec4 boxLo[4];      // 16:  changed boxes, padded: lo xyz, w = 1 (used) or 0 (unused)
+  vec4 boxHi[4];      // 80:  hi xyz
+  uvec4 rects[4];     // 144: their screen rectangles in frame pixels: x0, y0, x1, y1 (inclusive)
+  vec4 params;        // 208: dMax, all dirty (1) or not, a light whose shadow rays are traced
                       //      anew at every pixel anyway (uint bits; kInvalidIndex: none), unused
-};                    // 160 bytes (> 128: passed in a uniform-like storage buffer, not push constants)
-// Light bounds for dirty.comp, two vec4 per light: (centre xyz, radius) and (direction xyz, 1 for
-// a directional light whose segments run to infinity along -direction, else 0).
+};                    // 224 bytes (> 128: passed in a uniform-like storage buffer, not push constants)
+// Light bounds for dirty.comp, two vec4 per light: (centre xyz, w = 1 for a directional light,
+// whose segments run to infinity along -direction, else 0) and (the box's half extent xyz, or the
+// directional light's direction).
 OBS_CONST uint kBindingDirtyParams = 0;    // DirtyPush (one element)
 OBS_CONST uint kBindingDirtyHitBounds = 1; // vec4[2 * pixel] (primary.comp)
 OBS_CONST uint kBindingDirtyLights = 2;    // vec4[2 * lights]

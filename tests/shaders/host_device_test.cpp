@@ -29,7 +29,7 @@ static_assert(sizeof(PrimaryPush) == 96 && offsetof(PrimaryPush, band) == 80 && 
 static_assert(sizeof(TracePush) == 16);
 static_assert(sizeof(PathPush) == 112 && offsetof(PathPush, band) == 96 && sizeof(PathPush) <= 128);
 static_assert(sizeof(ShadePush) == 112 && offsetof(ShadePush, reflectors) == 96 && sizeof(ComposePush) == 48);
-static_assert(sizeof(TonemapPush) == 48 && sizeof(ResolvePush) == 48 && sizeof(DirtyPush) == 160 && sizeof(ClearPush) == 16 && sizeof(LightMixPush) == 32);
+static_assert(sizeof(TonemapPush) == 48 && sizeof(ResolvePush) == 48 && sizeof(DirtyPush) == 224 && sizeof(ClearPush) == 16 && sizeof(LightMixPush) == 32);
 static_assert(kBvhStackSize >= kBvhMaxDepth, "the traversal stack must hold the deepest path");
 static_assert(kMaxTraversalSteps < 65535u, "must stop before lavapipe's loop limiter");
 } // namespace obscura::gpu

@@ -89,7 +89,13 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.emissionBasis = gpu::Buffer(context, px * slots * kAccumulator, kStorage, "frame.emission_basis" + tag);
     b.specularBasis = gpu::Buffer(context, specular ? px * slots * kAccumulator : kVec4, kStorage,
                                   "frame.specular_basis" + tag);
-    b.resolved = gpu::Buffer(context, px * (slots + 1) * 4, kStorage, "frame.resolved" + tag);
+    // One word per light and pixel, each light's row padded to whole RGBA32UI texels.
+    const std::uint64_t resolvedWords = std::uint64_t(gpu::resolvedStride(static_cast<std::uint32_t>(px))) * (slots + 1);
+    if (resolvedWords / 4 > context.info().maxTexelBufferElements)
+      throw DeviceError(fmt::format("a band's resolved transport needs {} texels, more than the device's "
+                                    "maxTexelBufferElements ({})", resolvedWords / 4, context.info().maxTexelBufferElements));
+    b.resolved = gpu::TexelBuffer(context, resolvedWords * 4, vk::Format::eR32G32B32A32Uint, kStorage,
+                                  "frame.resolved" + tag);
     b.hitBounds = gpu::Buffer(context, px * 2 * kVec4, kStorage, "frame.hit_bounds" + tag);
     b.dirty = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.dirty" + tag);
     bands_.push_back(std::move(b));
@@ -101,7 +107,7 @@ std::uint64_t ObscuranceFrame::bytes() const {
   std::uint64_t total = status_.buffer().size();
   for (const auto& b : bands_)
     for (const gpu::Buffer* buffer : {&b.gbuffer, &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
-                                      &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved, &b.hitBounds, &b.dirty})
+                                      &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty})
       total += buffer->size();
   return total;
 }

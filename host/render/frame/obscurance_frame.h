@@ -46,7 +46,8 @@ public:
     FrameBand rows;
     gpu::Buffer gbuffer, aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, composed,
         display;
-    gpu::Buffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits
+    gpu::TexelBuffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits:
+                               // lightmix.comp reads it as R32_UINT texels (a vector gather)
     gpu::Buffer hitBounds; // per pixel, the box of its primary hits over samples (geometry edits)
     gpu::Buffer dirty;     // per pixel, 1 = retrace after a geometry edit (dirty.comp)
   };

@@ -47,12 +47,12 @@ std::vector<glm::vec4> lightBounds(const LightSet& lights) {
       for (std::uint32_t e = l.info.y; e < l.info.y + l.info.z; ++e)
         for (const glm::vec4* v : {&lights.emitters[e].v0, &lights.emitters[e].v1, &lights.emitters[e].v2})
           b.grow(glm::vec3(*v));
-      const glm::vec3 centre = b.empty() ? glm::vec3(0.0f) : 0.5f * (b.lo + b.hi);
-      out.emplace_back(centre, b.empty() ? 0.0f : 0.5f * glm::length(b.hi - b.lo));
-      out.emplace_back(0.0f);
+      // A removed emitter (no area, never sampled) is a point at the origin.
+      out.emplace_back(b.empty() ? glm::vec3(0.0f) : 0.5f * (b.lo + b.hi), 0.0f);
+      out.emplace_back(b.empty() ? glm::vec3(0.0f) : 0.5f * (b.hi - b.lo), 0.0f);
     } else if (l.info.x == gpu::kLightDirectional) {
-      out.emplace_back(0.0f);
-      out.emplace_back(glm::vec3(l.direction), 1.0f);
+      out.emplace_back(0.0f, 0.0f, 0.0f, 1.0f);
+      out.emplace_back(glm::vec3(l.direction), 0.0f);
     } else {
       out.emplace_back(glm::vec3(l.position), 0.0f);
       out.emplace_back(0.0f);
@@ -85,18 +85,20 @@ void DirtyPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu
 }
 
 void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu::GpuCamera& camera,
-                        const std::vector<scene::Bounds>& changed, float dMax, std::uint32_t lights, bool all,
-                        std::uint32_t tracedLight) {
+                        const std::vector<scene::Bounds>& changed, float pad, float dMax, std::uint32_t lights,
+                        bool all, std::uint32_t tracedLight) {
   gpu::DirtyPush push{};
   push.frame = glm::uvec4(layout.width, layout.bands[band].rows, layout.bands[band].firstRow, lights);
   const bool tooMany = changed.size() > gpu::kMaxChangedBoxes;
   for (std::uint32_t i = 0; i < gpu::kMaxChangedBoxes; ++i) {
     if (i < changed.size() && !changed[i].empty()) {
       const scene::Bounds& box = changed[i];
-      push.spheres[i] = glm::vec4(0.5f * (box.lo + box.hi), 0.5f * glm::length(box.hi - box.lo));
+      push.boxLo[i] = glm::vec4(box.lo - glm::vec3(pad), 1.0f);
+      push.boxHi[i] = glm::vec4(box.hi + glm::vec3(pad), 0.0f);
       push.rects[i] = screenRect(camera, layout.width, layout.height, box);
     } else {
-      push.spheres[i] = glm::vec4(0.0f, 0.0f, 0.0f, -1.0f);
+      push.boxLo[i] = glm::vec4(0.0f); // unused
+      push.boxHi[i] = glm::vec4(0.0f);
       push.rects[i] = glm::uvec4(1u, 1u, 0u, 0u);
     }
   }

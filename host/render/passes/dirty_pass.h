@@ -24,10 +24,11 @@ public:
   DirtyPass(const gpu::Context& context, std::uint32_t bands);
   void bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& lightBounds);
   // Writes band `band`'s parameters (`changed`: up to kMaxChangedBoxes world boxes) for the next
-  // record. `all` marks every pixel. Segments to `tracedLight` are not tested: that light is new,
-  // and its rays are traced at every pixel anyway (ObscuranceRenderer::addEmitter).
+  // record, each box grown by `pad` on every side (more than a ray origin's offset from its
+  // surface). `all` marks every pixel. Segments to `tracedLight` are not tested: that light is
+  // new, and its rays are traced at every pixel anyway (ObscuranceRenderer::addEmitter).
   void prepare(std::uint32_t band, const FrameLayout& layout, const gpu::GpuCamera& camera,
-               const std::vector<scene::Bounds>& changed, float dMax, std::uint32_t lights, bool all,
+               const std::vector<scene::Bounds>& changed, float pad, float dMax, std::uint32_t lights, bool all,
                std::uint32_t tracedLight = gpu::kInvalidIndex);
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout) const;
   void recordClear(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,

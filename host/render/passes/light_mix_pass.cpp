@@ -7,7 +7,12 @@
 namespace obscura::render {
 
 LightMixPass::LightMixPass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, gpu::storageKernelDesc("lightmix", kSpirv_lightmix, gpu::kLightMixBindingCount, sizeof(gpu::LightMixPush), bands)) {}
+    : kernel_(context, [&] {
+        gpu::KernelDesc desc = gpu::storageKernelDesc("lightmix", kSpirv_lightmix, gpu::kLightMixBindingCount,
+                                                      sizeof(gpu::LightMixPush), bands);
+        desc.bindings[gpu::kBindingLightMixResolved] = gpu::BindingKind::UniformTexelBuffer;
+        return desc;
+      }()) {}
 
 void LightMixPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& emissions) {
   kernel_.bind(gpu::kBindingLightMixResolved, frame.band(band).resolved, band);
@@ -20,7 +25,8 @@ void LightMixPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band
                           float exposureStops) const {
   gpu::LightMixPush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, lights, slots),
                          .ambient = glm::vec4(ambientIntensity, std::exp2(exposureStops))};
-  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+  const std::uint64_t quads = (layout.bandPixels(band) + gpu::kResolvedPixelAlign - 1) / gpu::kResolvedPixelAlign;
+  kernel_.dispatch(cmd, gpu::groupsFor(quads, gpu::kWorkgroupSize1D), 1, 1, &push, band);
 }
 
 } // namespace obscura::render

@@ -14,7 +14,7 @@ void ResolvePass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
   kernel_.bind(gpu::kBindingResolveSpecularBasis, b.specularBasis, band);
   kernel_.bind(gpu::kBindingResolveAmbient, b.ambient, band);
   kernel_.bind(gpu::kBindingResolveSpecularAmbient, b.specularAmbient, band);
-  kernel_.bind(gpu::kBindingResolveOutput, b.resolved, band);
+  kernel_.bind(gpu::kBindingResolveOutput, b.resolved.buffer(), band);
 }
 
 void ResolvePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
