@@ -35,6 +35,17 @@ constexpr float kAddedIntensity = 1.5f;
 const scene::EmissiveQuad kPanel{.name = "panel", .corner = {0.8f, 0.2f, 0.1f}, .edge1 = {0.0f, 0.6f, 0.0f},
                                  .edge2 = {0.0f, 0.0f, -0.6f}, .emission = {8.0f, 7.0f, 6.0f}};
 
+// The point light "added", as a scene with withAdded has it.
+scene::PunctualLight addedLight() {
+  scene::PunctualLight added;
+  added.name = "added";
+  added.type = scene::PunctualType::Point;
+  added.position = kAddedPosition;
+  added.color = glm::vec3(0.7f, 0.8f, 1.0f);
+  added.intensity = kAddedIntensity;
+  return added;
+}
+
 scene::Scene room(const RoomLights& l) {
   SceneBuilder b;
   auto white = b.lambertian(glm::vec3(0.7f));
@@ -50,7 +61,7 @@ scene::Scene room(const RoomLights& l) {
   b.quad({-0.2f, 0.0f, -0.2f}, {0.4f, 0, 0}, {0, 0.6f, 0}, white); // a screen casting shadows
   if (l.withPanel) b.quad(kPanel.corner, kPanel.edge1, kPanel.edge2, b.lambertian(glm::vec3(0.0f), kPanel.emission), "panel");
   if (l.withBulb) b.pointLight({-0.5f, 1.2f, 0.5f}, glm::vec3(1.0f, 0.9f, 0.7f), l.bulb, "bulb");
-  if (l.withAdded) b.pointLight(kAddedPosition, glm::vec3(0.7f, 0.8f, 1.0f), kAddedIntensity, "added");
+  if (l.withAdded) b.pointLight(addedLight().position, addedLight().color, addedLight().intensity, "added");
   return b.build();
 }
 
@@ -259,13 +270,7 @@ TEST_F(Relight, RemovedBulbMatchesAFreshRenderWithoutIt) {
 TEST_F(Relight, AddedLightTracesOnlyItsShadowRaysAndMatchesAFreshRender) {
   auto& r = base();
   const render::RenderStats before = r.stats();
-  scene::PunctualLight added;
-  added.name = "added";
-  added.type = scene::PunctualType::Point;
-  added.position = kAddedPosition;
-  added.color = glm::vec3(0.7f, 0.8f, 1.0f);
-  added.intensity = kAddedIntensity;
-  r.addLight(added);
+  r.addLight(addedLight());
   r.compose();
   const render::RenderStats after = r.stats();
   // No obscurance ray; one shadow ray for the new point light (exact) at every hit pixel of every
@@ -289,12 +294,7 @@ TEST_F(Relight, AddedLightIsGatheredAlongTheSpecularPathsOfAGlossyFloor) {
   auto& r = base(glossy);
   ASSERT_TRUE(r.specular());
   const render::RenderStats before = r.stats();
-  scene::PunctualLight added;
-  added.name = "added";
-  added.position = kAddedPosition;
-  added.color = glm::vec3(0.7f, 0.8f, 1.0f);
-  added.intensity = kAddedIntensity;
-  r.addLight(added);
+  r.addLight(addedLight());
   r.compose();
   const render::RenderStats after = r.stats();
   EXPECT_GT(after.passes.at("specular").rays, before.passes.at("specular").rays);
@@ -403,11 +403,7 @@ TEST_F(LightMix, FastDisplayMatchesTheFullComposeAcrossEdits) {
   e[light("lampA")] *= glm::vec3(0.2f, 1.5f, 3.0f);
   r.setEmissions(e);
   expectDisplaysAgree(r, 1.0f);
-  scene::PunctualLight added;
-  added.name = "added";
-  added.position = kAddedPosition;
-  added.intensity = kAddedIntensity;
-  r.addLight(added);
+  r.addLight(addedLight());
   expectDisplaysAgree(r, -0.5f);
   r.removeLight(light("bulb"));
   expectDisplaysAgree(r, 0.0f);
