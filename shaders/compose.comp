@@ -17,12 +17,13 @@ layout(std430, binding = kBindingComposeEmissions) readonly buffer Emissions { v
 layout(std430, binding = kBindingComposeOutput) writeonly buffer Out { vec4 composed[]; };
 layout(std430, binding = kBindingComposeSpecularBasis) readonly buffer SpecularBasis { vec4 specularBasis[]; };
 layout(std430, binding = kBindingComposeSpecularAmbient) readonly buffer SpecularAmbient { vec4 specularAmbient[]; };
+layout(std430, binding = kBindingComposeSampleCounts) readonly buffer SampleCounts { uint sampleCounts[]; };
 
 void main() {
   uint pixel = gl_GlobalInvocationID.x;
   uint pixelCount = pc.frame.x * pc.frame.y;
   if (pixel >= pixelCount) return;
-  float inv = 1.0 / float(max(pc.frame.z, 1u));
+  float inv = 1.0 / float(max(sampleCounts[pixel], 1u));
   vec3 direct = vec3(0.0);
   vec3 seen = vec3(0.0);
   vec3 specular = vec3(0.0);

@@ -21,6 +21,7 @@ layout(std430, set = 0, binding = kBindingPrimaryLightScales) readonly buffer Li
 layout(std430, set = 0, binding = kBindingPrimaryEmissionBasis) buffer EmissionBasis { vec4 emissionBasis[]; };
 layout(std430, set = 0, binding = kBindingPrimaryHitBounds) buffer HitBounds { vec4 hitBounds[]; };
 layout(std430, set = 0, binding = kBindingPrimaryDirty) readonly buffer DirtyMask { uint dirty[]; };
+layout(std430, set = 0, binding = kBindingPrimarySampleCounts) buffer SampleCounts { uint sampleCounts[]; };
 
 void accumulate(uint pixel, uint slot, vec4 value, bool first) {
   uint i = pixel * kAovSlots + slot;
@@ -83,6 +84,9 @@ void main() {
   }
   gbuffer[pixel] = g;
   if (!accumulateSums) return;
+  // Every sum of the pixel restarts at its sample 0 (a whole frame's, or a dirty pixel's retrace),
+  // and so does its count: compose divides each pixel by its own.
+  sampleCounts[pixel] = first ? 1u : sampleCounts[pixel] + 1u;
 
   // The box of the pixel's hits over its samples, for the dirty pixels of a geometry edit
   // (specular.comp adds its paths' vertices, and w = 1 when one left the scene).

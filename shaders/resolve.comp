@@ -15,12 +15,13 @@ layout(std430, binding = kBindingResolveSpecularBasis) readonly buffer SpecularB
 layout(std430, binding = kBindingResolveAmbient) readonly buffer Ambient { vec4 ambient[]; };
 layout(std430, binding = kBindingResolveSpecularAmbient) readonly buffer SpecularAmbient { vec4 specularAmbient[]; };
 layout(std430, binding = kBindingResolveOutput) writeonly buffer Resolved { uint resolved[]; };
+layout(std430, binding = kBindingResolveSampleCounts) readonly buffer SampleCounts { uint sampleCounts[]; };
 
 void main() {
   uint pixel = gl_GlobalInvocationID.x;
   uint pixelCount = pc.frame.x * pc.frame.y;
   if (pixel >= pixelCount) return;
-  float inv = 1.0 / float(max(pc.frame.z, 1u));
+  float inv = 1.0 / float(max(sampleCounts[pixel], 1u));
   const bool withSpecular = pc.flags.x != 0u;
   const uint stride = resolvedStride(pixelCount);
   for (uint s = pc.flags.y; s < pc.frame.w; ++s) {

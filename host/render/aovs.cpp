@@ -1,5 +1,6 @@
 #include "render/aovs.h"
 
+#include <algorithm>
 #include <bit>
 
 #include "shared/host_device.h"
@@ -23,16 +24,16 @@ std::vector<std::string> aovChannels(const std::string& aov) {
 
 // Converts the accumulated AOV slots into image channels.
 io::Image resolvePrimaryAovs(const std::vector<glm::vec4>& aov, std::uint32_t width, std::uint32_t height,
-                      std::uint32_t spp) {
+                             const std::vector<std::uint32_t>& samples) {
   io::Image image;
   image.width = static_cast<int>(width);
   image.height = static_cast<int>(height);
   for (const auto& name : aovNames())
     for (const auto& channel : aovChannels(name)) image.channels.push_back(channel);
   image.pixels.resize(std::size_t(width) * height * image.channels.size());
-  const float inv = 1.0f / static_cast<float>(spp);
   std::size_t k = 0;
   for (std::size_t p = 0; p < std::size_t(width) * height; ++p) {
+    const float inv = 1.0f / static_cast<float>(std::max(samples[p], 1u));
     // Each accumulator is (sum, compensation): the sum of slot k is at k * kAccumulatorVec4s.
     auto sum = [&](std::uint32_t slot) { return aov[(p * gpu::kAovSlots + slot) * gpu::kAccumulatorVec4s]; };
     const glm::vec4 slot[gpu::kAovSlots] = {sum(0), sum(1), sum(2), sum(3), sum(4), sum(5)};

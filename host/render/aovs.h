@@ -38,9 +38,9 @@ inline constexpr std::uint32_t kSamplesPerSubmission = 16;
 // Progress callback: samples done, samples total, seconds so far.
 using ProgressFn = std::function<void(std::uint32_t, std::uint32_t, double)>;
 
-// The image of primary.comp's accumulated AOV slots (kAovSlots Kahan pairs per pixel) after
-// `spp` samples, for `rows` rows of `width` pixels.
+// The image of primary.comp's accumulated AOV slots (kAovSlots Kahan pairs per pixel), for `rows`
+// rows of `width` pixels, pixel p holding `samples[p]` samples.
 io::Image resolvePrimaryAovs(const std::vector<glm::vec4>& aov, std::uint32_t width, std::uint32_t rows,
-                             std::uint32_t spp);
+                             const std::vector<std::uint32_t>& samples);
 
 } // namespace obscura::render

@@ -156,7 +156,7 @@ void ObscuranceRenderer::reset() {
     for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) {
       const auto& band = frame_.band(b);
       for (const gpu::Buffer* buffer : {&band.basis, &band.ambient, &band.specularBasis, &band.specularAmbient,
-                                        &band.emissionBasis, &band.aovs})
+                                        &band.emissionBasis, &band.aovs, &band.sampleCounts})
         cmd.fillBuffer(buffer->handle(), 0, VK_WHOLE_SIZE, 0u);
     }
   });
@@ -453,7 +453,7 @@ io::Image ObscuranceRenderer::image() const {
     io::Image primary;
     if (primaryAovs)
       primary = resolvePrimaryAovs(downloadBand(frame_.band(b).aovs), layout.width, layout.bands[b].rows,
-                                   std::max(samples_, 1u));
+                                   frame_.band(b).sampleCounts.download<std::uint32_t>(*context_));
     const std::size_t pc = primary.channels.size();
     const std::uint64_t first = std::uint64_t(layout.bands[b].firstRow) * layout.width;
     for (std::uint64_t p = 0; p < layout.bandPixels(b); ++p) {
@@ -488,7 +488,6 @@ Transport ObscuranceRenderer::transport() const {
     t.specularAmbient.resize(layout.pixels());
   }
   t.ambient.resize(layout.pixels());
-  const float inv = 1.0f / static_cast<float>(std::max(samples_, 1u));
   // Accumulators are Kahan pairs: the sum of entry i is element i * kAccumulatorVec4s.
   auto sum = [](const std::vector<glm::vec4>& v, std::uint64_t i) { return v[i * gpu::kAccumulatorVec4s]; };
   for (std::uint32_t b = 0; b < layout.bandCount(); ++b) {
@@ -497,9 +496,11 @@ Transport ObscuranceRenderer::transport() const {
     const auto ambient = downloadBand(band.ambient);
     const std::vector<glm::vec4> specularBasis = runSpecular_ ? downloadBand(band.specularBasis) : std::vector<glm::vec4>();
     const std::vector<glm::vec4> specularAmbient = runSpecular_ ? downloadBand(band.specularAmbient) : std::vector<glm::vec4>();
+    const auto counts = band.sampleCounts.download<std::uint32_t>(*context_);
     const std::uint64_t px = layout.bandPixels(b);
     const std::uint64_t first = std::uint64_t(layout.bands[b].firstRow) * layout.width;
     for (std::uint64_t p = 0; p < px; ++p) {
+      const float inv = 1.0f / static_cast<float>(std::max(counts[p], 1u)); // compose.comp's divisor
       t.ambient[first + p] = sum(ambient, p) * inv;
       if (runSpecular_) t.specularAmbient[first + p] = glm::vec3(sum(specularAmbient, p)) * inv;
       for (std::size_t s = 0; s < lights; ++s) {
@@ -510,6 +511,15 @@ Transport ObscuranceRenderer::transport() const {
     }
   }
   return t;
+}
+
+std::vector<std::uint32_t> ObscuranceRenderer::sampleCounts() const {
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) {
+    auto band = frame_.band(b).sampleCounts.download<std::uint32_t>(*context_);
+    out.insert(out.end(), band.begin(), band.begin() + static_cast<std::ptrdiff_t>(frame_.layout().bandPixels(b)));
+  }
+  return out;
 }
 
 std::vector<std::uint32_t> ObscuranceRenderer::display() const {

@@ -169,6 +169,9 @@ public:
   glm::vec3 ambientIntensity() const { return ambient_.intensity(emissions_); }
   float dMax() const { return dMax_; }
   std::uint32_t samples() const { return samples_; }
+  // The samples each pixel's sums hold, row by row (compose divides by them): samples() everywhere
+  // once a frame or an edit's retrace is done.
+  std::vector<std::uint32_t> sampleCounts() const;
   const ObscuranceSettings& settings() const { return settings_; }
   const FrameLayout& layout() const { return frame_.layout(); }
   bool specular() const { return runSpecular_; }

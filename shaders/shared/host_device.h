@@ -280,7 +280,10 @@ OBS_CONST uint kBindingPrimaryHitBounds = 10;    // vec4[2 * pixel]: the box of 
                                                  // (min xyz, w = 1 if a specular path left the
                                                  // scene; max xyz, w = 1 if any sample hit)
 OBS_CONST uint kBindingPrimaryDirty = 11;        // uint[pixel]: 1 = retrace (kPrimaryFlagDirtyOnly)
-OBS_CONST uint kPrimaryBindingCount = 12;
+OBS_CONST uint kBindingPrimarySampleCounts = 12; // uint[pixel]: the samples in the pixel's sums
+                                                 // (restarts at its sample 0, as the sums do);
+                                                 // compose and resolve divide by it
+OBS_CONST uint kPrimaryBindingCount = 13;
 
 // Header of the specular queue: an indirect dispatch (groups x, y, z) and the entry count.
 OBS_CONST uint kQueueGroupsX = 0;
@@ -313,7 +316,7 @@ OBS_CONST uint kComposeEmission = 5;   // sum_s E_s M_s: emission the camera see
 OBS_CONST uint kComposeSlots = 6;
 
 struct ComposePush {
-  uvec4 frame;     // 0:  width, rows (of the band), samples accumulated, light count
+  uvec4 frame;     // 0:  width, rows (of the band), unused (samples are counted per pixel), light count
   vec4 ambient;    // 16: I_a(E) rgb, w = 1 when the specular buffers hold data
   uvec4 slots;     // 32: x = slots per pixel in the output: kComposeSlots, or 1 (combined only)
 };                 // 48 bytes
@@ -326,7 +329,8 @@ OBS_CONST uint kBindingComposeEmissions = 3;       // vec4[lights]: E_s to compo
 OBS_CONST uint kBindingComposeOutput = 4;          // vec4[pixel * kComposeSlots]
 OBS_CONST uint kBindingComposeSpecularBasis = 5;   // vec4 pairs [light][pixel]
 OBS_CONST uint kBindingComposeSpecularAmbient = 6; // vec4 pairs [pixel]
-OBS_CONST uint kComposeBindingCount = 7;
+OBS_CONST uint kBindingComposeSampleCounts = 7;    // uint[pixel] (primary.comp)
+OBS_CONST uint kComposeBindingCount = 8;
 
 // ---- tonemap.comp: composed radiance -> display RGBA8 (exposure, then the sRGB curve).
 struct TonemapPush {
@@ -349,7 +353,7 @@ OBS_CONST uint kTonemapBindingCount = 2;
 OBS_CONST uint kResolvedPixelAlign = 4;
 OBS_FN uint resolvedStride(uint pixels) { return (pixels + kResolvedPixelAlign - 1u) / kResolvedPixelAlign * kResolvedPixelAlign; }
 struct ResolvePush {
-  uvec4 frame;     // 0:  width, rows (of the band), samples accumulated, light count
+  uvec4 frame;     // 0:  width, rows (of the band), unused (samples are counted per pixel), light count
   uvec4 flags;     // 16: x = 1 when the specular buffers hold data, y = first light to resolve (the
                    //     ones before are current), z = 1 to resolve the ambient too
   uvec4 capacity;  // 32: x = light slots of the frame (A_t lives after them)
@@ -360,7 +364,8 @@ OBS_CONST uint kBindingResolveSpecularBasis = 2;   // vec4 pairs [light][pixel]:
 OBS_CONST uint kBindingResolveAmbient = 3;         // vec4 pairs [pixel]: A
 OBS_CONST uint kBindingResolveSpecularAmbient = 4; // vec4 pairs [pixel]: A^spec
 OBS_CONST uint kBindingResolveOutput = 5;          // uint [(slots + 1) * resolvedStride(pixels)], RGB9E5
-OBS_CONST uint kResolveBindingCount = 6;
+OBS_CONST uint kBindingResolveSampleCounts = 6;    // uint[pixel] (primary.comp)
+OBS_CONST uint kResolveBindingCount = 7;
 
 struct LightMixPush {
   uvec4 frame;     // 0:  width, rows (of the band), light count, light slots (A_t lives after them)

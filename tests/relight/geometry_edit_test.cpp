@@ -3,6 +3,7 @@
 // since every pixel is traced with the same seeds either way. A dirty set that is too small fails
 // here: the moved occluder's shadow falls far from its screen footprint, a small object changes
 // the floor's obscurance only within dMax, and an object is seen in a mirror floor.
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -75,6 +76,10 @@ protected:
     const std::uint64_t retraced = r.updateGeometry(edited_, editedBvh_, {objectBox(from, size), objectBox(to, size)});
     r.compose();
     const io::Image moved = r.image();
+    // Compose divides each pixel by its own sample count: the retraced pixels count theirs again
+    // from 0, and end with as many as the others.
+    const auto counts = r.sampleCounts();
+    EXPECT_EQ(std::count(counts.begin(), counts.end(), r.samples()), static_cast<std::ptrdiff_t>(counts.size()));
     const io::Image fresh =
         renderObscurances(context(), edited_, bvh::build(render::triangleSoup(edited_)), editSettings(secondaryReflectors))
             .image;

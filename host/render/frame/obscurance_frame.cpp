@@ -34,6 +34,7 @@ std::vector<FrameBufferKind> ObscuranceFrame::bufferKinds(const FrameContents& c
       {"resolved_ambient", 4, false},
       {"hit_bounds", 2 * kVec4, false},
       {"dirty", 4, false},
+      {"sample_counts", 4, false},
   };
   if (contents.primaryAovs) kinds.push_back({"aovs", gpu::kAovSlots * kAccumulator, false});
   if (contents.specular) {
@@ -98,6 +99,7 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
                                   "frame.resolved" + tag);
     b.hitBounds = gpu::Buffer(context, px * 2 * kVec4, kStorage, "frame.hit_bounds" + tag);
     b.dirty = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.dirty" + tag);
+    b.sampleCounts = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.sample_counts" + tag);
     bands_.push_back(std::move(b));
   }
   status_ = StatusCounters(context, "frame.status");
@@ -107,7 +109,8 @@ std::uint64_t ObscuranceFrame::bytes() const {
   std::uint64_t total = status_.buffer().size();
   for (const auto& b : bands_)
     for (const gpu::Buffer* buffer : {&b.gbuffer, &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
-                                      &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty})
+                                      &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty,
+                                      &b.sampleCounts})
       total += buffer->size();
   return total;
 }

@@ -50,6 +50,7 @@ public:
                                // lightmix.comp reads it as R32_UINT texels (a vector gather)
     gpu::Buffer hitBounds; // per pixel, the box of its primary hits over samples (geometry edits)
     gpu::Buffer dirty;     // per pixel, 1 = retrace after a geometry edit (dirty.comp)
+    gpu::Buffer sampleCounts; // per pixel, the samples its sums hold (primary.comp); compose divides by it
   };
 
   // `maxBufferBytes` 0 = the device's per-buffer limit (a smaller one tests banding).

@@ -16,6 +16,7 @@ void ComposePass::bind(std::uint32_t band, const ObscuranceFrame& frame, const g
   kernel_.bind(gpu::kBindingComposeOutput, b.composed, band);
   kernel_.bind(gpu::kBindingComposeSpecularBasis, b.specularBasis, band);
   kernel_.bind(gpu::kBindingComposeSpecularAmbient, b.specularAmbient, band);
+  kernel_.bind(gpu::kBindingComposeSampleCounts, b.sampleCounts, band);
 }
 
 void ComposePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,

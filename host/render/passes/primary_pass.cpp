@@ -42,6 +42,7 @@ void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const Obsc
   kernel_.bind(gpu::kBindingPrimaryEmissionBasis, b.emissionBasis, band);
   kernel_.bind(gpu::kBindingPrimaryHitBounds, b.hitBounds, band);
   kernel_.bind(gpu::kBindingPrimaryDirty, b.dirty, band);
+  kernel_.bind(gpu::kBindingPrimarySampleCounts, b.sampleCounts, band);
 }
 
 void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,

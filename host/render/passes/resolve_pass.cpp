@@ -15,6 +15,7 @@ void ResolvePass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
   kernel_.bind(gpu::kBindingResolveAmbient, b.ambient, band);
   kernel_.bind(gpu::kBindingResolveSpecularAmbient, b.specularAmbient, band);
   kernel_.bind(gpu::kBindingResolveOutput, b.resolved.buffer(), band);
+  kernel_.bind(gpu::kBindingResolveSampleCounts, b.sampleCounts, band);
 }
 
 void ResolvePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
