@@ -146,6 +146,7 @@ void ObscuranceRenderer::markResolveStale(std::uint32_t fromLight, bool ambient)
 void ObscuranceRenderer::reset() {
   markResolveStale(0, true);
   samples_ = 0;
+  gbufferSample_ = kNoSample;
   primaryRays_ = 0;
   wallSeconds_ = 0.0;
   frame_.resetStatus();
@@ -226,6 +227,7 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
     timestamps_.collect();
     primaryRays_ += layout.pixels() * (last - samples_);
     samples_ = last;
+    gbufferSample_ = last - 1;
     wallSeconds_ = wallBefore + secondsSince(start);
     if (progress) progress(samples_ - (end - samples), samples, secondsSince(start));
   }
@@ -352,6 +354,8 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
     timestamps_.collect();
     primaryRays_ += retraced * (last - first);
   }
+  // The retraced pixels' G-buffer now holds the last sample; the others' still hold theirs.
+  if (retraced > 0 && gbufferSample_ + 1 != samples_) gbufferSample_ = kNoSample;
   markResolveStale(0, true);
   return retraced;
 }
@@ -572,17 +576,28 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
   const FrameLayout& layout = frame_.layout();
   const gpu::GpuCamera camera = primaryCamera();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
-  for (std::uint32_t first = 0; first < samples_; first += kSamplesPerSubmission) {
-    const std::uint32_t last = std::min(samples_, first + kSamplesPerSubmission);
+  // The sample whose G-buffer the frame holds goes first and needs no primary pass (at one sample
+  // per pixel, none at all); the others follow in order.
+  std::vector<std::uint32_t> order;
+  if (gbufferSample_ < samples_) order.push_back(gbufferSample_);
+  for (std::uint32_t s = 0; s < samples_; ++s)
+    if (s != gbufferSample_) order.push_back(s);
+  std::uint64_t primaryPixels = 0;
+  for (std::size_t first = 0; first < order.size(); first += kSamplesPerSubmission) {
+    const std::size_t last = std::min(order.size(), first + kSamplesPerSubmission);
     stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
       timestamps_.reset(cmd);
-      for (std::uint32_t s = first; s < last; ++s) {
-        if (s > first) gpu::computeBarrier(cmd);
-        timestamps_.begin(cmd, "primary");
-        for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
-          primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, gpu::kPrimaryFlagGBufferOnly);
-        timestamps_.end(cmd, "primary");
-        gpu::computeBarrier(cmd);
+      for (std::size_t k = first; k < last; ++k) {
+        const std::uint32_t s = order[k];
+        if (k > first) gpu::computeBarrier(cmd);
+        if (s != gbufferSample_) {
+          timestamps_.begin(cmd, "primary");
+          for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+            primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, gpu::kPrimaryFlagGBufferOnly);
+          timestamps_.end(cmd, "primary");
+          gpu::computeBarrier(cmd);
+          primaryPixels += layout.pixels();
+        }
         gpu::ShadePush push = shadePush(s);
         push.band.z = gpu::kShadeFlagPerLight;
         push.band.w = light;
@@ -597,8 +612,9 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
       }
     });
     timestamps_.collect();
-    primaryRays_ += layout.pixels() * (last - first);
   }
+  primaryRays_ += primaryPixels;
+  if (!order.empty()) gbufferSample_ = order.back();
   wallSeconds_ = wallBefore + secondsSince(start);
 }
 

@@ -230,6 +230,10 @@ private:
   ObscuranceFrame frame_;
   std::uint32_t samples_ = 0;
   std::uint64_t primaryRays_ = 0;
+  // The sample whose primary hits the G-buffer holds at every pixel (kNoSample: none, or mixed),
+  // so that an added light's rays start from it without a primary pass.
+  static constexpr std::uint32_t kNoSample = ~0u;
+  std::uint32_t gbufferSample_ = kNoSample;
 
   // Passes.
   PrimaryPass primary_;
