@@ -11,7 +11,7 @@ layout(local_size_x = kWorkgroupSize1D) in;
 layout(std430, binding = kBindingDirtyParams) readonly buffer Params { DirtyPush pc; };
 layout(std430, binding = kBindingDirtyHitBounds) readonly buffer HitBounds { vec4 hitBounds[]; };
 layout(std430, binding = kBindingDirtyLights) readonly buffer LightBounds { vec4 lightBounds[]; };
-layout(std430, binding = kBindingDirtyMask) writeonly buffer Mask { uint dirty[]; };
+layout(std430, binding = kBindingDirtyMask) buffer Mask { uint dirty[]; }; // mask, then list
 layout(std430, binding = kBindingDirtyStatus) buffer Status { uint status[]; };
 
 // The interval a box (centre c, half extent h) projects to on axis n.
@@ -87,5 +87,12 @@ void main() {
   if (pixel >= width * pc.frame.y) return;
   bool d = touched(pixel, uvec2(pixel % width, pixel / width + pc.frame.z));
   dirty[pixel] = d ? 1u : 0u;
-  if (d) atomicAdd(status[kStatusDirtyPixels], 1u);
+  if (!d) return;
+  atomicAdd(status[kStatusDirtyPixels], 1u);
+  // The list the retrace dispatches over (the host reset its header to (0, 1, 1, 0)); lanes append
+  // in order, so neighbours stay neighbours.
+  const uint base = dirtyListBase(width * pc.frame.y);
+  uint slot = atomicAdd(dirty[base + kQueueCount], 1u);
+  dirty[base + kQueueHeader + slot] = pixel;
+  atomicMax(dirty[base + kQueueGroupsX], slot / kWorkgroupSize1D + 1u);
 }

@@ -25,11 +25,10 @@ layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
 void main() {
   gSceneScale = pc.eye.w;
-  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, pc.frame.xy, pc.band.xy);
+  BandPixel bp = shadedPixel(); // every pixel of the band, or the dirty ones of a retrace
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;
-  if (skipClean(pixel)) return;
   GBufferTexel g = gbuffer[pixel];
   if (g.albedo.a == 0.0) return;
 

@@ -30,11 +30,17 @@ void accumulate(uint pixel, uint slot, vec4 value, bool first) {
 
 void main() {
   uvec2 size = pc.frame.xy;
-  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, size, pc.band.xy);
+  // Every pixel of the band, or (a retrace) the band's dirty list, dispatched indirectly.
+  BandPixel bp;
+  if ((pc.band.w & kPrimaryFlagDirtyOnly) == 0u) {
+    bp = bandPixel(gl_GlobalInvocationID.xy, size, pc.band.xy);
+  } else {
+    const uint base = dirtyListBase(size.x * pc.band.y), entry = listEntry(), count = dirty[base + kQueueCount];
+    bp = listedPixel(entry, count, entry < count ? dirty[base + kQueueHeader + entry] : 0u, size, pc.band.xy);
+  }
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;
-  if ((pc.band.w & kPrimaryFlagDirtyOnly) != 0u && dirty[pixel] == 0u) return;
   uint sampleIndex = pc.frame.z;
   bool first = sampleIndex == 0u;
   const uint lightCount = pc.band.z;

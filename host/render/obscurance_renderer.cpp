@@ -241,8 +241,14 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   const gpu::GpuCamera camera = primaryCamera();
   gpu::ShadePush push = shadePush(s);
   push.band.z = shadeFlags;
+  // A retrace runs over the dirty pixels' list (dirty.comp), dispatched indirectly.
+  const bool dirtyOnly = (shadeFlags & gpu::kShadeFlagDirtyOnly) != 0;
+  if (dirtyOnly != ((primaryFlags & gpu::kPrimaryFlagDirtyOnly) != 0))
+    throw std::logic_error("recordSample: the primary and shading passes retrace different pixels");
+  auto dirtyList = [&](std::uint32_t b) { return dirtyOnly ? &frame_.band(b).dirty : nullptr; };
   timestamps_.begin(cmd, "primary");
-  for (std::uint32_t b = 0; b < bands; ++b) primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, primaryFlags);
+  for (std::uint32_t b = 0; b < bands; ++b)
+    primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, primaryFlags, dirtyList(b));
   timestamps_.end(cmd, "primary");
   gpu::computeBarrier(cmd);
   if (settings_.shadowSampling == ShadowSampling::PerLight) {
@@ -251,12 +257,12 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
     timestamps_.end(cmd, "shadow");
   } else if (lights_.anySampled() && settings_.shadowRays > 0) {
     timestamps_.begin(cmd, "shadow");
-    for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push);
+    for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push, dirtyList(b));
     timestamps_.end(cmd, "shadow");
   }
   if (settings_.obscuranceRays > 0) {
     timestamps_.begin(cmd, "obscurance");
-    for (std::uint32_t b = 0; b < bands; ++b) obscurance_.record(cmd, b, layout, push);
+    for (std::uint32_t b = 0; b < bands; ++b) obscurance_.record(cmd, b, layout, push, dirtyList(b));
     timestamps_.end(cmd, "obscurance");
   }
   if (runSpecular_) {
@@ -270,7 +276,9 @@ void ObscuranceRenderer::recordShadowForLight(const vk::raii::CommandBuffer& cmd
                                               std::uint32_t light) const {
   push.band.z |= gpu::kShadeFlagPerLight;
   push.band.w = light;
-  for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) shadow_.record(cmd, b, frame_.layout(), push);
+  const bool dirtyOnly = (push.band.z & gpu::kShadeFlagDirtyOnly) != 0;
+  for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b)
+    shadow_.record(cmd, b, frame_.layout(), push, dirtyOnly ? &frame_.band(b).dirty : nullptr);
 }
 
 std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, const bvh::Bvh& bvh,

@@ -26,4 +26,17 @@ BandPixel bandPixelFromIndex(uint index, uvec2 size, uvec2 band) {
   return bandPixel(uvec2(index % size.x, index / size.x), size, band);
 }
 
+// Entry `entry` of a list of `count` band-local pixel indices, `index` being its value (read by
+// the caller when entry < count): the pixel of an invocation dispatched over a list.
+BandPixel listedPixel(uint entry, uint count, uint index, uvec2 size, uvec2 band) {
+  BandPixel b = bandPixelFromIndex(index, size, band);
+  b.inside = b.inside && entry < count;
+  return b;
+}
+
+// The entry an invocation of a kWorkgroupSizeX x kWorkgroupSizeY workgroup handles in a 1D
+// indirect dispatch over a list sized in groups of kWorkgroupSize1D (the same count). Not
+// gl_WorkGroupSize: it is (1, 1, 1) where read before the shader's local_size declaration.
+uint listEntry() { return gl_WorkGroupID.x * kWorkgroupSize1D + gl_LocalInvocationIndex; }
+
 #endif

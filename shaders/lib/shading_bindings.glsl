@@ -3,6 +3,8 @@
 #ifndef OBSCURA_SHADING_BINDINGS_GLSL
 #define OBSCURA_SHADING_BINDINGS_GLSL
 
+#include "band.glsl"
+
 layout(std430, set = 0, binding = kBindingGBuffer) readonly buffer GBuffer { GBufferTexel gbuffer[]; };
 layout(std430, set = 0, binding = kBindingLights) readonly buffer LightBuffer { GpuLight lights[]; };
 layout(std430, set = 0, binding = kBindingEmitters) readonly buffer EmitterBuffer { GpuEmitter emitters[]; };
@@ -26,5 +28,13 @@ layout(push_constant) uniform Push { ShadePush pc; };
 
 // Whether this pass skips `pixel`: a retrace after a geometry edit runs the dirty pixels only.
 bool skipClean(uint pixel) { return (pc.band.z & kShadeFlagDirtyOnly) != 0u && dirty[pixel] == 0u; }
+
+// The pixel of this invocation: over the band in 2D, or (a retrace, kShadeFlagDirtyOnly) over the
+// band's dirty list, dispatched indirectly.
+BandPixel shadedPixel() {
+  if ((pc.band.z & kShadeFlagDirtyOnly) == 0u) return bandPixel(gl_GlobalInvocationID.xy, pc.frame.xy, pc.band.xy);
+  const uint base = dirtyListBase(pc.frame.x * pc.band.y), entry = listEntry(), count = dirty[base + kQueueCount];
+  return listedPixel(entry, count, entry < count ? dirty[base + kQueueHeader + entry] : 0u, pc.frame.xy, pc.band.xy);
+}
 
 #endif

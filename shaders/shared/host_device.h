@@ -28,6 +28,9 @@ using uint = std::uint32_t;
 OBS_CONST uint kWorkgroupSize1D = 64;
 OBS_CONST uint kWorkgroupSizeX = 8;
 OBS_CONST uint kWorkgroupSizeY = 8;
+#ifdef __cplusplus
+static_assert(kWorkgroupSizeX * kWorkgroupSizeY == kWorkgroupSize1D, "lists are dispatched to 2D passes in 1D groups");
+#endif
 
 // ---- BVH limits. The builder guarantees depth <= kBvhMaxDepth for ANY input (it falls back to
 // median splits near the limit), so a traversal stack of kBvhStackSize entries never overflows.
@@ -264,7 +267,7 @@ OBS_CONST uint kBindingSpecularBasis = 11;   // vec4[lights * pixels]: D_s gathe
 OBS_CONST uint kBindingSpecularAmbient = 12; // vec4[pixels]: A gathered along specular paths
 OBS_CONST uint kBindingSpecularQueue = 13;   // uint[]: kQueueHeader words, then glossy pixel indices
 OBS_CONST uint kBindingLightScales = 14;     // vec4[lights]: E_s (to make seen emission unit)
-OBS_CONST uint kBindingDirty = 15;           // uint[pixel]: 1 = retrace (kShadeFlagDirtyOnly)
+OBS_CONST uint kBindingDirty = 15;           // uint[]: the dirty mask and list (kDirtyListBase)
 OBS_CONST uint kBindingHitBounds = 16;       // = primary.comp's kBindingPrimaryHitBounds; specular
                                              // paths grow it with their vertices
 OBS_CONST uint kShadingBindingCount = 17;
@@ -384,6 +387,11 @@ OBS_CONST uint kLightMixBindingCount = 3;
 // path vertices counted in its hit box (every segment of a path lies in the box of its vertices);
 // a path that left the scene makes its pixel always dirty. Up to kMaxChangedBoxes boxes (old and
 // new places), each padded by more than a ray origin's offset.
+// A band's dirty buffer: the mask, uint[pixel] (1 = retrace), then at kDirtyListBase(pixels) a
+// list as the specular queue's (kQueueHeader words: indirect groups x, y, z and the count; then
+// the dirty pixels' band-local indices). A retrace dispatches its passes over the list, so no SIMD
+// lane waits on a clean neighbour.
+OBS_FN uint dirtyListBase(uint pixels) { return pixels; }
 OBS_CONST uint kMaxChangedBoxes = 4;
 struct DirtyPush {
   uvec4 frame;        // 0:   width, rows (of the band), first row, light count

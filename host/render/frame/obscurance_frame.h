@@ -49,7 +49,8 @@ public:
     gpu::TexelBuffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits:
                                // lightmix.comp reads it as R32_UINT texels (a vector gather)
     gpu::Buffer hitBounds; // per pixel, the box of its primary hits over samples (geometry edits)
-    gpu::Buffer dirty;     // per pixel, 1 = retrace after a geometry edit (dirty.comp)
+    gpu::Buffer dirty;     // per pixel, 1 = retrace after a geometry edit, then the list of those
+                           // pixels with its indirect dispatch (dirty.comp; host_device.h)
     gpu::Buffer sampleCounts; // per pixel, the samples its sums hold (primary.comp); compose divides by it
   };
 

@@ -39,6 +39,7 @@ private:
   gpu::Kernel mark_;
   gpu::Kernel clear_;
   std::vector<gpu::Buffer> params_; // one DirtyPush per band
+  std::vector<const gpu::Buffer*> dirtyBuffers_; // the frame's, per band (bind)
 };
 
 } // namespace obscura::render

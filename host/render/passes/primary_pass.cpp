@@ -47,11 +47,16 @@ void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const Obsc
 
 void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
                          const gpu::GpuCamera& camera, std::uint32_t sampleIndex, std::uint32_t seed,
-                         std::uint32_t lights, std::uint32_t flags) const {
+                         std::uint32_t lights, std::uint32_t flags, const gpu::Buffer* dirty) const {
   const FrameBand& rows = layout.bands[band];
   gpu::PrimaryPush push{.camera = camera,
                         .frame = glm::uvec4(layout.width, layout.height, sampleIndex, seed),
                         .band = glm::uvec4(rows.firstRow, rows.rows, lights, flags)};
+  if (dirty != nullptr) {
+    kernel_.dispatchIndirect(cmd, *dirty, gpu::dirtyListBase(static_cast<std::uint32_t>(layout.bandPixels(band))) * 4,
+                             &push, band);
+    return;
+  }
   kernel_.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
                    gpu::groupsFor(rows.rows, gpu::kWorkgroupSizeY), 1, &push, band);
 }
