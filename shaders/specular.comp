@@ -15,7 +15,8 @@
 // With kShadeFlagPerLight (a light just added, band.w) the same paths are followed again: the
 // lobe samples draw from a generator of their own, so the path of a sample does not depend on
 // what is gathered along it. Only that light is gathered, alone as in shadow.comp (no MIS, its
-// emission counted after mirror bounces only), and the hit box is left as it was.
+// emission counted after mirror bounces only), and the hit box is left as it was. With
+// kShadeFlagNoDirect no light is gathered (those per-light dispatches do it), only the ambient.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -69,6 +70,7 @@ void main() {
   const uint maxDepth = uint(pc.params.w);
   const bool oneLight = (pc.band.z & kShadeFlagPerLight) != 0u;
   const uint addedLight = pc.band.w;
+  const bool noDirect = (pc.band.z & kShadeFlagNoDirect) != 0u;
 
   ShadingPoint sp = shadingPointFromGBuffer(gbuffer[pixel], pc.eye.xyz);
   uint pathRng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu); // lobe samples only
@@ -100,7 +102,7 @@ void main() {
       escaped = true;
       // The sky along the lobe: whole after a mirror, MIS-weighted after a glossy bounce.
       uint sky = findBackgroundLight(lightCount);
-      if (oneLight && sky != addedLight) sky = kInvalidIndex;
+      if ((oneLight && sky != addedLight) || noDirect) sky = kInvalidIndex;
       if (h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || (glossyMis && !oneLight))) { // a miss, not a truncation
         float w = delta ? 1.0 : powerHeuristic(lobePdf, float(shadowRays) * backgroundLightPdf(sky, previous, previousNormal, lightCount, wi));
         OBS_ACCUMULATE(specularBasis, sky * pixelCount + pixel, vec4(w * throughput, 0.0))
@@ -112,7 +114,7 @@ void main() {
     pathHi = max(pathHi, s.position);
     GpuMaterial m = materials[s.material];
     vec3 baseColor = materialBaseColor(m, s.uv).rgb;
-    const bool counted = oneLight ? delta && s.lightGroup == addedLight : delta || glossyMis;
+    const bool counted = oneLight ? delta && s.lightGroup == addedLight : !noDirect && (delta || glossyMis);
     if (counted && s.lightGroup != kInvalidIndex && s.lightGroup < lightCount) {
       float w = 1.0;
       if (!delta) {
@@ -135,7 +137,7 @@ void main() {
       rays += taken;
       continue;
     }
-    for (uint k = 0u; k < shadowRays; ++k) {
+    for (uint k = 0u; k < (noDirect ? 0u : shadowRays); ++k) {
       vec4 u = kroneckerPoint4(k, lightShift);
       vec3 contribution;
       uint light;
@@ -145,7 +147,7 @@ void main() {
     // Secondary reflectors only at primary hits: here the ambient keeps its whole I_a.
     vec4 aw = gatherObscurance(sp, rng, budget, kInvalidIndex, pixelCount);
     OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
-    rays += shadowRays + pc.counts.z;
+    rays += (noDirect ? 0u : shadowRays) + pc.counts.z;
   }
   if (!oneLight) {
     vec4 lo = hitBounds[2u * pixel], hi = hitBounds[2u * pixel + 1u];

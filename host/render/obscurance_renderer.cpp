@@ -267,7 +267,22 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   }
   if (runSpecular_) {
     timestamps_.begin(cmd, "specular");
-    for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, push);
+    if (settings_.shadowSampling == ShadowSampling::PerLight) {
+      // The ambient along the paths once, then every light alone along the same paths: each
+      // light's S_s is as independent of the others' powers as its D_s.
+      gpu::ShadePush ambientOnly = push;
+      ambientOnly.band.z |= gpu::kShadeFlagNoDirect;
+      for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, ambientOnly);
+      for (std::uint32_t light = 0; light < lightCount; ++light) {
+        gpu::ShadePush one = push;
+        one.band.z |= gpu::kShadeFlagPerLight;
+        one.band.w = light;
+        gpu::computeBarrier(cmd);
+        for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, one);
+      }
+    } else {
+      for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, push);
+    }
     timestamps_.end(cmd, "specular");
   }
 }

@@ -254,6 +254,10 @@ OBS_CONST uint kShadeFlagDirtyOnly = 1u; // only pixels the dirty mask marks run
 // directional light (exact: every ray would go to the same point); one dispatch per light, so each
 // D_s is independent of the other lights' powers and each dispatch stays within the loop limiter.
 OBS_CONST uint kShadeFlagPerLight = 2u;
+// specular.comp gathers the ambient alone along its paths: in a frame with per-light shadow
+// sampling every light then follows the same paths in a dispatch of its own (kShadeFlagPerLight),
+// so each light's specular transport is independent of the others' powers too.
+OBS_CONST uint kShadeFlagNoDirect = 4u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

@@ -344,13 +344,18 @@ TEST_F(Relight, AddedEmissiveQuadMatchesAFreshRenderWithIt) {
 
 // The relighting paper's shadow sampling: every light alone, 4 rays per hit, up to 64 in penumbrae.
 TEST_F(Relight, PerLightShadowSamplingMatchesSelectionSampling) {
-  auto settings = roomSettings(7);
-  settings.shadowSampling = render::ShadowSampling::PerLight;
-  scene::Scene s = room({});
-  bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-  const auto perLight = renderObscurances(context(), s, tree, settings);
-  EXPECT_EQ(perLight.stats.truncatedTraversals, 0u);
-  expectStatisticallyEqual(perLight.image, RoomLights{});
+  for (bool glossyFloor : {false, true}) { // with a glossy floor, along specular paths too
+    SCOPED_TRACE(glossyFloor ? "glossy floor" : "diffuse floor");
+    RoomLights lights;
+    lights.glossyFloor = glossyFloor;
+    auto settings = roomSettings(7);
+    settings.shadowSampling = render::ShadowSampling::PerLight;
+    scene::Scene s = room(lights);
+    bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+    const auto perLight = renderObscurances(context(), s, tree, settings);
+    EXPECT_EQ(perLight.stats.truncatedTraversals, 0u);
+    expectStatisticallyEqual(perLight.image, lights);
+  }
 }
 
 TEST_F(Relight, PerLightTransportIgnoresTheOtherLightsPowers) {
@@ -374,6 +379,36 @@ TEST_F(Relight, PerLightTransportIgnoresTheOtherLightsPowers) {
                    transportOfLampA(render::ShadowSampling::PerLight, glm::vec3(20.0f))));
   EXPECT_FALSE(same(transportOfLampA(render::ShadowSampling::Selection, glm::vec3(2.0f)),
                     transportOfLampA(render::ShadowSampling::Selection, glm::vec3(20.0f))));
+}
+
+// The same along specular paths: with per-light sampling every light follows the glossy floor's
+// paths in a dispatch of its own, so lamp A's S_s is the same bits whatever lamp B emits.
+TEST_F(Relight, PerLightSpecularTransportIgnoresTheOtherLightsPowers) {
+  auto specularOfLampA = [&](render::ShadowSampling sampling, glm::vec3 lampB) {
+    RoomLights lights;
+    lights.lampB = lampB;
+    lights.glossyFloor = true;
+    scene::Scene s = room(lights);
+    bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+    auto settings = roomSettings(7);
+    settings.spp = 8;
+    settings.shadowSampling = sampling;
+    render::ObscuranceRenderer r(context(), s, tree, settings);
+    r.render();
+    EXPECT_TRUE(r.specular());
+    EXPECT_EQ(r.stats().truncatedTraversals, 0u);
+    return r.transport().specularDirect[r.lightIndex("lampA")];
+  };
+  const auto same = [](const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
+  };
+  const auto perLight = specularOfLampA(render::ShadowSampling::PerLight, glm::vec3(2.0f));
+  double sum = 0.0;
+  for (const auto& v : perLight) sum += v.x + v.y + v.z;
+  EXPECT_GT(sum, 0.0) << "lamp A is seen along the floor's specular paths";
+  EXPECT_TRUE(same(perLight, specularOfLampA(render::ShadowSampling::PerLight, glm::vec3(20.0f))));
+  EXPECT_FALSE(same(specularOfLampA(render::ShadowSampling::Selection, glm::vec3(2.0f)),
+                    specularOfLampA(render::ShadowSampling::Selection, glm::vec3(20.0f))));
 }
 
 // The fast path a light edit takes (resolved RGB9E5 transport, one light-mix pass) shows what the
