@@ -187,6 +187,12 @@ void ObscuranceRenderer::bindAll() {
   }
 }
 
+gpu::ShadePush ObscuranceRenderer::forLight(gpu::ShadePush push, std::uint32_t light) {
+  push.band.z |= gpu::kShadeFlagPerLight;
+  push.band.w = light;
+  return push;
+}
+
 gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
   // Glossy MIS needs the specular pass's lobe sample and light samples drawn over all lights.
   const bool glossyMis = settings_.lightSampling == LightSampling::Spatial &&
@@ -245,10 +251,10 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   const bool dirtyOnly = (shadeFlags & gpu::kShadeFlagDirtyOnly) != 0;
   if (dirtyOnly != ((primaryFlags & gpu::kPrimaryFlagDirtyOnly) != 0))
     throw std::logic_error("recordSample: the primary and shading passes retrace different pixels");
-  auto dirtyList = [&](std::uint32_t b) { return dirtyOnly ? &frame_.band(b).dirty : nullptr; };
+  const ObscuranceFrame* dirtyOf = dirtyOnly ? &frame_ : nullptr;
   timestamps_.begin(cmd, "primary");
   for (std::uint32_t b = 0; b < bands; ++b)
-    primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, primaryFlags, dirtyList(b));
+    primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, primaryFlags, dirtyOf);
   timestamps_.end(cmd, "primary");
   gpu::computeBarrier(cmd);
   if (settings_.shadowSampling == ShadowSampling::PerLight) {
@@ -257,12 +263,12 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
     timestamps_.end(cmd, "shadow");
   } else if (lights_.anySampled() && settings_.shadowRays > 0) {
     timestamps_.begin(cmd, "shadow");
-    for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push, dirtyList(b));
+    for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push, dirtyOf);
     timestamps_.end(cmd, "shadow");
   }
   if (settings_.obscuranceRays > 0) {
     timestamps_.begin(cmd, "obscurance");
-    for (std::uint32_t b = 0; b < bands; ++b) obscurance_.record(cmd, b, layout, push, dirtyList(b));
+    for (std::uint32_t b = 0; b < bands; ++b) obscurance_.record(cmd, b, layout, push, dirtyOf);
     timestamps_.end(cmd, "obscurance");
   }
   if (runSpecular_) {
@@ -274,11 +280,8 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
       ambientOnly.band.z |= gpu::kShadeFlagNoDirect;
       for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, ambientOnly);
       for (std::uint32_t light = 0; light < lightCount; ++light) {
-        gpu::ShadePush one = push;
-        one.band.z |= gpu::kShadeFlagPerLight;
-        one.band.w = light;
         gpu::computeBarrier(cmd);
-        for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, one);
+        for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, forLight(push, light));
       }
     } else {
       for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, push);
@@ -289,11 +292,9 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
 
 void ObscuranceRenderer::recordShadowForLight(const vk::raii::CommandBuffer& cmd, gpu::ShadePush push,
                                               std::uint32_t light) const {
-  push.band.z |= gpu::kShadeFlagPerLight;
-  push.band.w = light;
   const bool dirtyOnly = (push.band.z & gpu::kShadeFlagDirtyOnly) != 0;
   for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b)
-    shadow_.record(cmd, b, frame_.layout(), push, dirtyOnly ? &frame_.band(b).dirty : nullptr);
+    shadow_.record(cmd, b, frame_.layout(), forLight(push, light), dirtyOnly ? &frame_ : nullptr);
 }
 
 std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, const bvh::Bvh& bvh,
@@ -412,7 +413,7 @@ void ObscuranceRenderer::compose(float exposureStops) {
     timestamps_.reset(cmd);
     timestamps_.begin(cmd, "compose");
     for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
-      compose_.record(cmd, b, layout, samples_, lightCount, ia, runSpecular_, frame_.contents().composedSlots);
+      compose_.record(cmd, b, layout, lightCount, ia, runSpecular_, frame_.contents().composedSlots);
     timestamps_.end(cmd, "compose");
     gpu::computeBarrier(cmd);
     timestamps_.begin(cmd, "tonemap");
@@ -436,7 +437,7 @@ void ObscuranceRenderer::composeDisplay(float exposureStops) {
     if (resolve) {
       timestamps_.begin(cmd, "resolve");
       for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
-        resolve_.record(cmd, b, layout, samples_, lightCount, slots, runSpecular_, resolveFrom_, resolveAmbient_);
+        resolve_.record(cmd, b, layout, lightCount, slots, runSpecular_, resolveFrom_, resolveAmbient_);
       timestamps_.end(cmd, "resolve");
       gpu::computeBarrier(cmd);
     }
@@ -621,9 +622,7 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
           gpu::computeBarrier(cmd);
           primaryPixels += layout.pixels();
         }
-        gpu::ShadePush push = shadePush(s);
-        push.band.z = gpu::kShadeFlagPerLight;
-        push.band.w = light;
+        const gpu::ShadePush push = forLight(shadePush(s), light);
         timestamps_.begin(cmd, "shadow");
         for (std::uint32_t b = 0; b < layout.bandCount(); ++b) shadow_.record(cmd, b, layout, push);
         timestamps_.end(cmd, "shadow");
@@ -645,11 +644,11 @@ std::uint64_t ObscuranceRenderer::addEmitter(const scene::Scene& edited, const b
                                             const std::vector<scene::Bounds>& changed) {
   // Area lights come first, one per light group, so the new group's light goes between them and
   // the punctual lights (its triangles name it by that index).
-  const std::size_t index = edited.lightGroups.size() - 1;
   const auto areaLights = static_cast<std::size_t>(std::count_if(
       lights_.lights.begin(), lights_.lights.end(), [](const gpu::GpuLight& l) { return l.info.x == gpu::kLightArea; }));
-  if (edited.lightGroups.empty() || areaLights != index)
+  if (edited.lightGroups.size() != areaLights + 1)
     throw std::logic_error("addEmitter: the edited scene must have exactly one light group more than the renderer");
+  const std::size_t index = areaLights;
   if (std::find(lights_.names.begin(), lights_.names.end(), edited.lightGroups[index].name) != lights_.names.end())
     throw InputError(fmt::format("add light '{}': a light of that name exists", edited.lightGroups[index].name));
   const auto start = Clock::now();

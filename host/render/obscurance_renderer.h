@@ -204,6 +204,8 @@ private:
   std::uint64_t retraceDirty(const std::vector<scene::Bounds>& changed, bool everyPixel,
                              std::uint32_t tracedLight = gpu::kInvalidIndex);
   gpu::ShadePush shadePush(std::uint32_t sample) const;
+  // `push` for a dispatch of `light` alone (kShadeFlagPerLight).
+  static gpu::ShadePush forLight(gpu::ShadePush push, std::uint32_t light);
   gpu::GpuCamera primaryCamera() const; // with the background's slot
   std::vector<glm::vec4> downloadBand(const gpu::Buffer& buffer) const;
 

@@ -19,6 +19,7 @@
 #include "gpu/context.h"
 #include "render/frame/frame_layout.h"
 #include "render/status_counters.h"
+#include "shared/host_device.h"
 
 namespace obscura::render {
 
@@ -75,6 +76,11 @@ public:
   const gpu::Buffer& status() const { return status_.buffer(); }
   std::vector<std::uint32_t> statusWords() const { return status_.words(); }
   void resetStatus() { status_.reset(); }
+
+  // Where band `band`'s dirty list (its indirect dispatch arguments) starts in its dirty buffer.
+  vk::DeviceSize dirtyListOffset(std::size_t band) const {
+    return vk::DeviceSize(gpu::dirtyListBase(static_cast<std::uint32_t>(layout_.bandPixels(band)))) * 4;
+  }
 
   // Device bytes allocated now (the real buffers' sizes).
   std::uint64_t bytes() const;

@@ -16,7 +16,7 @@ public:
   // `emissions`: vec4[lights], the E_s to compose with (not the render-time normaliser).
   void bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& emissions);
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-              std::uint32_t samples, std::uint32_t lights, const glm::vec3& ambientIntensity,
+              std::uint32_t lights, const glm::vec3& ambientIntensity,
               bool specular, std::uint32_t slots) const;
 
 private:

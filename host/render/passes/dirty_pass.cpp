@@ -77,8 +77,7 @@ void DirtyPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu
   mark_.bind(gpu::kBindingDirtyHitBounds, b.hitBounds, band);
   mark_.bind(gpu::kBindingDirtyLights, bounds, band);
   mark_.bind(gpu::kBindingDirtyMask, b.dirty, band);
-  if (dirtyBuffers_.size() <= band) dirtyBuffers_.resize(band + 1);
-  dirtyBuffers_[band] = &b.dirty;
+  frame_ = &frame;
   mark_.bind(gpu::kBindingDirtyStatus, frame.status(), band);
   clear_.bind(gpu::kBindingClearDirty, b.dirty, band);
   clear_.bind(gpu::kBindingClearBasis, b.basis, band);
@@ -112,8 +111,7 @@ void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu
 void DirtyPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout) const {
   // The list starts empty: dispatching it indirectly runs (0, 1, 1) groups until dirty.comp appends.
   static constexpr std::array<std::uint32_t, gpu::kQueueHeader> kEmptyList = {0u, 1u, 1u, 0u};
-  cmd.updateBuffer<std::uint32_t>(dirtyBuffers_.at(band)->handle(),
-                                  gpu::dirtyListBase(static_cast<std::uint32_t>(layout.bandPixels(band))) * 4, kEmptyList);
+  cmd.updateBuffer<std::uint32_t>(frame_->band(band).dirty.handle(), frame_->dirtyListOffset(band), kEmptyList);
   gpu::computeBarrier(cmd);
   mark_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, nullptr, band);
 }

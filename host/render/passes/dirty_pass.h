@@ -39,7 +39,7 @@ private:
   gpu::Kernel mark_;
   gpu::Kernel clear_;
   std::vector<gpu::Buffer> params_; // one DirtyPush per band
-  std::vector<const gpu::Buffer*> dirtyBuffers_; // the frame's, per band (bind)
+  const ObscuranceFrame* frame_ = nullptr; // whose dirty buffers record resets (bind)
 };
 
 } // namespace obscura::render

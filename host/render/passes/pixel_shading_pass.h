@@ -15,14 +15,13 @@ public:
 
   void bind(std::uint32_t band, const ShadingInputs& in) { bindShadingInputs(kernel_, band, in); }
 
-  // Every pixel of the band; or, with `dirty` (the band's dirty buffer, and kShadeFlagDirtyOnly in
-  // the push), only the pixels of its list, dispatched indirectly.
+  // Every pixel of the band; or, with `dirtyOf` (and kShadeFlagDirtyOnly in the push), only the
+  // pixels of that frame's dirty list for the band, dispatched indirectly.
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-              const gpu::ShadePush& push, const gpu::Buffer* dirty = nullptr) const {
+              const gpu::ShadePush& push, const ObscuranceFrame* dirtyOf = nullptr) const {
     const gpu::ShadePush p = forBand(push, layout, band);
-    if (dirty != nullptr) {
-      kernel_.dispatchIndirect(cmd, *dirty, gpu::dirtyListBase(static_cast<std::uint32_t>(layout.bandPixels(band))) * 4,
-                               &p, band);
+    if (dirtyOf != nullptr) {
+      kernel_.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &p, band);
       return;
     }
     kernel_.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),

@@ -47,14 +47,13 @@ void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const Obsc
 
 void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
                          const gpu::GpuCamera& camera, std::uint32_t sampleIndex, std::uint32_t seed,
-                         std::uint32_t lights, std::uint32_t flags, const gpu::Buffer* dirty) const {
+                         std::uint32_t lights, std::uint32_t flags, const ObscuranceFrame* dirtyOf) const {
   const FrameBand& rows = layout.bands[band];
   gpu::PrimaryPush push{.camera = camera,
                         .frame = glm::uvec4(layout.width, layout.height, sampleIndex, seed),
                         .band = glm::uvec4(rows.firstRow, rows.rows, lights, flags)};
-  if (dirty != nullptr) {
-    kernel_.dispatchIndirect(cmd, *dirty, gpu::dirtyListBase(static_cast<std::uint32_t>(layout.bandPixels(band))) * 4,
-                             &push, band);
+  if (dirtyOf != nullptr) {
+    kernel_.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &push, band);
     return;
   }
   kernel_.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),

@@ -27,11 +27,11 @@ public:
 
   // Records sample `sampleIndex` of band `band` (sample 0 restarts the accumulators). `flags`:
   // kPrimaryFlagGBufferOnly makes the G-buffer again and accumulates nothing; kPrimaryFlagNoAovs
-  // skips the AOV accumulators the frame does not keep. With kPrimaryFlagDirtyOnly, `dirty` is the
-  // band's dirty buffer, and only the pixels of its list run (an indirect dispatch).
+  // skips the AOV accumulators the frame does not keep. With kPrimaryFlagDirtyOnly, only the pixels
+  // of `dirtyOf`'s dirty list for the band run (an indirect dispatch).
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
               const gpu::GpuCamera& camera, std::uint32_t sampleIndex, std::uint32_t seed, std::uint32_t lights,
-              std::uint32_t flags, const gpu::Buffer* dirty = nullptr) const;
+              std::uint32_t flags, const ObscuranceFrame* dirtyOf = nullptr) const;
 
 private:
   gpu::Kernel kernel_;

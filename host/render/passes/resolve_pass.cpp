@@ -19,9 +19,9 @@ void ResolvePass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
 }
 
 void ResolvePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-                         std::uint32_t samples, std::uint32_t lights, std::uint32_t slots, bool specular,
+                         std::uint32_t lights, std::uint32_t slots, bool specular,
                          std::uint32_t firstLight, bool ambient) const {
-  gpu::ResolvePush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, samples, lights),
+  gpu::ResolvePush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, 0u, lights),
                         .flags = glm::uvec4(specular ? 1u : 0u, firstLight, ambient ? 1u : 0u, 0u),
                         .capacity = glm::uvec4(slots, 0u, 0u, 0u)};
   kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);

@@ -12,7 +12,7 @@ public:
   ResolvePass(const gpu::Context& context, std::uint32_t bands);
   void bind(std::uint32_t band, const ObscuranceFrame& frame);
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-              std::uint32_t samples, std::uint32_t lights, std::uint32_t slots, bool specular,
+              std::uint32_t lights, std::uint32_t slots, bool specular,
               std::uint32_t firstLight, bool ambient) const;
 
 private:
