@@ -61,7 +61,7 @@ private:
 
 // A buffer with a texel view, read through uniform texel buffers where lavapipe gathers texels as
 // vectors instead of one scalar load per lane (docs/ARCHITECTURE.md): the BVH (RGBA32F texels),
-// the resolved transport of light edits (R32_UINT).
+// the resolved transport of light edits (RGBA32UI: four pixels per texel).
 class TexelBuffer {
 public:
   TexelBuffer() = default;

@@ -48,7 +48,7 @@ public:
     gpu::Buffer gbuffer, aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, composed,
         display;
     gpu::TexelBuffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits:
-                               // lightmix.comp reads it as R32_UINT texels (a vector gather)
+                               // lightmix.comp reads four pixels at a time as RGBA32UI texels
     gpu::Buffer hitBounds; // per pixel, the box of its primary hits over samples (geometry edits)
     gpu::Buffer dirty;     // per pixel, 1 = retrace after a geometry edit, then the list of those
                            // pixels with its indirect dispatch (dirty.comp; host_device.h)
