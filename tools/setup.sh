@@ -7,6 +7,7 @@ packages=(
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libopenimageio-dev
   libcli11-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
   libembree-dev
+  libglfw3-dev libimgui-dev xvfb xauth
   clang libclang-rt-14-dev
   python3-matplotlib
 )

@@ -20,5 +20,6 @@ void addBenchRaysCommand(CLI::App& app);
 void addConvergeCommand(CLI::App& app);
 void addRelightCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
 
 } // namespace obscura::app

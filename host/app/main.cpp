@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   obscura::app::addConvergeCommand(app);
   obscura::app::addRelightCommand(app);
   obscura::app::addCompareCommand(app);
+  obscura::app::addViewCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -99,9 +99,9 @@ void writeExr(const std::string& path, const Image& image) {
   });
 }
 
-void writePng(const std::string& path, const Image& image, int firstChannel, float exposure, int count) {
+std::vector<std::uint32_t> encodeRgba8(const Image& image, int firstChannel, float exposure, int count) {
   const float scale = std::exp2(exposure);
-  std::vector<unsigned char> rgb(std::size_t(image.width) * image.height * 3);
+  std::vector<std::uint32_t> rgba(std::size_t(image.width) * image.height, 0xFF000000u);
   const int n = image.channelCount();
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x)
@@ -109,13 +109,13 @@ void writePng(const std::string& path, const Image& image, int firstChannel, flo
         int source = std::min(firstChannel + (count == 1 ? 0 : c), n - 1);
         float v = image.at(x, y, source) * scale;
         if (!std::isfinite(v)) v = 0.0f;
-        rgb[(std::size_t(y) * image.width + x) * 3 + c] =
-            static_cast<unsigned char>(std::lround(linearToSrgb(v) * 255.0f));
+        rgba[std::size_t(y) * image.width + x] |= std::uint32_t(std::lround(linearToSrgb(v) * 255.0f)) << (8 * c);
       }
-  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-  writeAtomically(path, [&](const std::string& temp) {
-    writeWithOiio(temp, path, spec, OIIO::TypeDesc::UINT8, rgb.data());
-  });
+  return rgba;
+}
+
+void writePng(const std::string& path, const Image& image, int firstChannel, float exposure, int count) {
+  writePngRgba8(path, image.width, image.height, encodeRgba8(image, firstChannel, exposure, count));
 }
 
 Image readImage(const std::string& path) {

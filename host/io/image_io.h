@@ -27,6 +27,8 @@ void writeExr(const std::string& path, const Image& image);
 // count 1 is shown grey (the channel in R, G and B).
 void writePng(const std::string& path, const Image& image, int firstChannel = 0, float exposure = 0.0f,
               int count = 3);
+// The pixels writePng writes, packed RGBA8 (R in the low byte, alpha 255), as the window shows them.
+std::vector<std::uint32_t> encodeRgba8(const Image& image, int firstChannel = 0, float exposure = 0.0f, int count = 3);
 // Reads any image OpenImageIO reads (linear floats as stored; PNG values / 255, no decoding).
 Image readImage(const std::string& path);
 

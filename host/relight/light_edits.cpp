@@ -10,50 +10,27 @@
 
 #include "core/error.h"
 #include "io/json_file.h"
+#include "io/json_fields.h"
 
 namespace obscura::relight {
 namespace {
 
 using nlohmann::json;
 
-struct EntryContext {
-  const std::string& file;
-  std::size_t entry;
-  [[noreturn]] void fail(const std::string& what) const {
-    throw InputError(fmt::format("{}: entry {}: {}", file, entry, what));
-  }
-};
+using EntryContext = io::JsonEntry;
 
-float number(const json& j, const char* key, const EntryContext& at) {
-  if (!j.contains(key) || !j.at(key).is_number()) at.fail(fmt::format("'{}' must be a number", key));
-  const float v = j.at(key).get<float>();
-  if (!std::isfinite(v)) at.fail(fmt::format("'{}' must be finite", key));
-  return v;
-}
-
-glm::vec3 vec3(const json& j, const char* key, const EntryContext& at) {
-  if (!j.contains(key)) at.fail(fmt::format("'{}' is missing", key));
-  const json& v = j.at(key);
-  if (!v.is_array() || v.size() != 3 || !std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); }))
-    at.fail(fmt::format("'{}' must be an array of 3 numbers", key));
-  glm::vec3 out(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
-  if (!std::isfinite(out.x) || !std::isfinite(out.y) || !std::isfinite(out.z))
-    at.fail(fmt::format("'{}' must be finite", key));
-  return out;
-}
-
-std::string text(const json& j, const char* key, const EntryContext& at) {
-  if (!j.contains(key) || !j.at(key).is_string() || j.at(key).get<std::string>().empty())
-    at.fail(fmt::format("'{}' must be a non-empty string", key));
-  return j.at(key).get<std::string>();
-}
+float number(const json& j, const char* key, const EntryContext& at) { return io::jsonNumber(j, key, at); }
+glm::vec3 vec3(const json& j, const char* key, const EntryContext& at) { return io::jsonVec3(j, key, at); }
+std::string text(const json& j, const char* key, const EntryContext& at) { return io::jsonText(j, key, at); }
 
 void requireLight(const std::vector<std::string>& names, const std::string& name, const EntryContext& at) {
   if (std::find(names.begin(), names.end(), name) == names.end())
     at.fail(fmt::format("no light named '{}' at this point (lights: {})", name, fmt::join(names, ", ")));
 }
 
-scene::PunctualLight addedLight(const json& j, const EntryContext& at) {
+} // namespace
+
+scene::PunctualLight readAddedLight(const json& j, const io::JsonEntry& at) {
   if (!j.is_object()) at.fail("'add_light' must be an object");
   const std::string type = text(j, "type", at);
   scene::PunctualLight l;
@@ -76,6 +53,8 @@ scene::PunctualLight addedLight(const json& j, const EntryContext& at) {
   }
   return l;
 }
+
+namespace {
 
 scene::EmissiveQuad addedQuad(const json& j, const EntryContext& at) {
   scene::EmissiveQuad q;
@@ -152,7 +131,7 @@ std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> li
         objectNames.push_back(e.name);
       } else {
         e.kind = Edit::Kind::AddLight;
-        e.light = addedLight(light, at);
+        e.light = readAddedLight(light, at);
         e.name = e.light.name;
       }
       if (std::find(lightNames.begin(), lightNames.end(), e.name) != lightNames.end())

@@ -17,9 +17,11 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include "scene/scene.h"
 #include "scene/scene_edit.h"
+#include "io/json_fields.h"
 
 namespace obscura::relight {
 
@@ -44,6 +46,11 @@ struct Edit {
 // are InputErrors naming the file and the entry. `lightNames` are the scene's lights, `areaLights`
 // which of them are emissive meshes (removing one switches it off; its name stays), `objectNames`
 // its objects. An insert's path is made absolute here and must exist.
+// An added point or spot light: {"type": "point"|"spot", "name", "position", "color", "intensity",
+// "direction", "inner_cone", "outer_cone"} in glTF KHR_lights_punctual units (also the view
+// script's and panel's). InputError naming `at` when malformed.
+scene::PunctualLight readAddedLight(const nlohmann::json& j, const io::JsonEntry& at);
+
 std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> lightNames,
                             std::vector<bool> areaLights, std::vector<std::string> objectNames);
 

@@ -1,0 +1,26 @@
+// json_fields.h — typed fields of one entry of a JSON list a user wrote (an edits file, a view
+// script), with errors that name the file, the entry and the field.
+#pragma once
+#include <cstddef>
+#include <string>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+namespace obscura::io {
+
+struct JsonEntry {
+  const std::string& file;
+  std::size_t entry;
+  // InputError "<file>: entry <n>: <what>".
+  [[noreturn]] void fail(const std::string& what) const;
+};
+
+// A finite number at `key`.
+float jsonNumber(const nlohmann::json& j, const char* key, const JsonEntry& at);
+// An array of 3 finite numbers at `key`.
+glm::vec3 jsonVec3(const nlohmann::json& j, const char* key, const JsonEntry& at);
+// A non-empty string at `key`.
+std::string jsonText(const nlohmann::json& j, const char* key, const JsonEntry& at);
+
+} // namespace obscura::io

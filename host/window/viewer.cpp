@@ -1,0 +1,551 @@
+// viewer.cpp — see viewer.h.
+#include "window/viewer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/format.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include "bvh/bvh.h"
+#include "render/scene/scene_buffers.h"
+#include "core/error.h"
+#include "io/image_io.h"
+#include "render/aovs.h"
+#include "render/transport.h"
+#include "scene/scene_edit.h"
+
+namespace obscura::window {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Kind = ViewerAction::Kind;
+
+// Light slots reserved for lights added in the window (each holds a basis buffer per pixel).
+constexpr std::uint32_t kSpareLightSlots = 8;
+
+gpu::ContextOptions presentable(gpu::ContextOptions options) {
+  options.instanceExtensions = GlfwWindow::requiredInstanceExtensions();
+  // The panel draws with a graphics pipeline and the frame is blitted: the queue must do graphics.
+  // Presentation to the surface itself is checked once the surface exists (Swapchain).
+  options.canPresent = [](const vk::raii::PhysicalDevice& device, std::uint32_t family) {
+    return static_cast<bool>(device.getQueueFamilyProperties()[family].queueFlags & vk::QueueFlagBits::eGraphics);
+  };
+  return options;
+}
+
+std::uint64_t totalRays(const render::RenderStats& stats) {
+  std::uint64_t rays = 0;
+  for (const auto& [name, pass] : stats.passes) rays += pass.rays;
+  return rays;
+}
+
+double totalGpuMs(const render::RenderStats& stats) {
+  double ms = 0.0;
+  for (const auto& [name, pass] : stats.passes) ms += pass.gpuMs;
+  return ms;
+}
+
+render::RhoKind rhoKind(const std::string& name) {
+  if (name == "exp") return render::RhoKind::Exp;
+  if (name == "ao") return render::RhoKind::Ao;
+  return render::RhoKind::Sqrt;
+}
+
+std::string rhoName(render::RhoKind kind) {
+  switch (kind) {
+  case render::RhoKind::Exp: return "exp";
+  case render::RhoKind::Ao: return "ao";
+  default: return "sqrt";
+  }
+}
+
+} // namespace
+
+struct Viewer::FrameRecord {
+  std::size_t frame = 0;
+  bool restarted = false, preview = false, presented = false;
+  std::uint64_t retraced = 0;
+  std::uint64_t rays = 0;      // traced this frame: edits, samples
+  double gpuMs = 0.0;          // the renderer's GPU time this frame (its passes' timestamps)
+  double renderMs = 0.0;       // wall time of the edits, the samples and the compose
+  double presentMs = 0.0;      // wall time of the panel and the presentation
+  double frameMs = 0.0;
+  std::vector<std::string> actions;
+};
+
+Viewer::Viewer(const gpu::ContextOptions& device, scene::Scene scene, bvh::Bvh bvh, ViewerConfig config)
+    : config_(std::move(config)),
+      window_(static_cast<int>(config_.obscurance.width), static_cast<int>(config_.obscurance.height), config_.title),
+      context_(presentable(device)),
+      surface_(window_.createSurface(context_.instance())),
+      swapchain_(context_, surface_),
+      presenter_(context_, swapchain_, config_.obscurance.width, config_.obscurance.height),
+      camera_(config_.obscurance.camera, scene.bounds) {
+  if (!config_.log.empty()) {
+    log_.open(config_.log);
+    if (!log_) throw InputError(fmt::format("{}: cannot write the frame log", config_.log));
+  }
+  scenes_.push_back(std::move(scene));
+  bvhs_.push_back(std::move(bvh));
+  const scene::Bounds& b = scenes_.back().bounds;
+  sceneSize_ = std::max(glm::length(b.hi - b.lo), 1e-3f);
+
+  render::ObscuranceSettings settings = config_.obscurance;
+  settings.spareLightSlots = kSpareLightSlots;
+  settings.primaryAovs = true; // picking reads the primitive AOV; the AOV list shows them
+  settings.composedAovs = true;
+  config_.obscurance = settings;
+  renderer_ = std::make_unique<render::ObscuranceRenderer>(context_, scenes_.back(), bvhs_.back(), settings);
+  renderer_->configure(fullSettings());
+  const auto& names = renderer_->lights().names;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    lights_.push_back({.name = names[i], .base = renderer_->emissions()[i]});
+
+  swapchain_.recreate(config_.obscurance.width, config_.obscurance.height);
+  if (config_.panel) overlay_ = std::make_unique<UiOverlay>(context_, window_, swapchain_);
+  lastFrameStart_ = Clock::now();
+}
+
+Viewer::~Viewer() { context_.device().waitIdle(); }
+
+render::ObscuranceSettings Viewer::fullSettings() const {
+  render::ObscuranceSettings s = config_.obscurance;
+  s.camera = camera_.camera();
+  return s;
+}
+
+void Viewer::restart(bool preview) {
+  render::ObscuranceSettings s = fullSettings();
+  if (preview) {
+    s.shadowRays = std::min(s.shadowRays, 1u);
+    s.obscuranceRays = std::min(s.obscuranceRays, 1u);
+  }
+  renderer_->configure(s);
+  pathTracer_.reset(); // made again with the new camera when shown
+  previewShown_ = preview;
+  needsCompose_ = true;
+}
+
+std::size_t Viewer::lightIndex(const std::string& name) const {
+  for (std::size_t i = 0; i < lights_.size(); ++i)
+    if (lights_[i].name == name) return i;
+  std::vector<std::string> names;
+  for (const auto& l : lights_) names.push_back(l.name);
+  throw InputError(fmt::format("no light named '{}' (lights: {})", name, fmt::join(names, ", ")));
+}
+
+void Viewer::updateEmissions() {
+  std::vector<glm::vec3> emissions;
+  for (const auto& l : lights_) emissions.push_back(l.base * l.scale * l.color);
+  renderer_->setEmissions(emissions);
+  needsCompose_ = true;
+}
+
+void Viewer::moveObject(std::size_t object, glm::vec3 translate, FrameRecord& record) {
+  scene::Scene next = scenes_.back();
+  std::vector<scene::Bounds> changed{scene::objectBounds(next, object)};
+  scene::moveObject(next, object, translate, glm::vec3(0.0f));
+  changed.push_back(scene::objectBounds(next, object));
+  bvh::Bvh tree = bvhs_.back();
+  bvh::refit(tree, render::triangleSoup(next));
+  scenes_.push_back(std::move(next));
+  bvhs_.push_back(std::move(tree));
+  // The renderer now points at the newest scene; the path tracer is made again when shown.
+  pathTracer_.reset();
+  // With the preview's rays in the frame, the retrace must use the same; after it the older scenes
+  // are no longer referenced.
+  record.retraced = renderer_->updateGeometry(scenes_.back(), bvhs_.back(), changed);
+  while (scenes_.size() > 1) {
+    scenes_.pop_front();
+    bvhs_.pop_front();
+  }
+  needsCompose_ = true;
+  status_ = fmt::format("moved {}: {} pixels retraced ({:.1f} %)", scenes_.back().objects[object].name, record.retraced,
+                        100.0 * double(record.retraced) / (double(config_.obscurance.width) * config_.obscurance.height));
+}
+
+void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
+  switch (a.kind) {
+  case Kind::LightScale:
+    lights_[lightIndex(a.name)].scale = a.value;
+    updateEmissions();
+    record.actions.push_back("light_scale");
+    break;
+  case Kind::LightColor:
+    lights_[lightIndex(a.name)].color = a.vector;
+    updateEmissions();
+    record.actions.push_back("light_color");
+    break;
+  case Kind::AddLight: {
+    for (const auto& l : lights_)
+      if (l.name == a.light.name) throw InputError(fmt::format("a light named '{}' exists", a.light.name));
+    const std::size_t index = renderer_->addLight(a.light);
+    LightControl control{.name = a.light.name, .base = renderer_->emissions()[index], .added = true, .light = a.light};
+    lights_.insert(lights_.begin() + static_cast<std::ptrdiff_t>(index), control);
+    updateEmissions();
+    record.actions.push_back("add_light");
+    status_ = fmt::format("added {}: its rays alone were traced", a.light.name);
+    break;
+  }
+  case Kind::RemoveLight: {
+    const std::size_t index = lightIndex(a.name);
+    renderer_->removeLight(index);
+    if (lights_[index].added) lights_.erase(lights_.begin() + static_cast<std::ptrdiff_t>(index));
+    else lights_[index].scale = 0.0f; // an area light is switched off, its slot stays
+    updateEmissions();
+    record.actions.push_back("remove_light");
+    break;
+  }
+  case Kind::MoveLight: {
+    const std::size_t index = lightIndex(a.name);
+    if (!lights_[index].added) throw InputError(fmt::format("'{}' is not a light added in the window", a.name));
+    LightControl control = lights_[index];
+    control.light.position = a.vector;
+    renderer_->removeLight(index);
+    lights_.erase(lights_.begin() + static_cast<std::ptrdiff_t>(index));
+    const std::size_t at = renderer_->addLight(control.light);
+    lights_.insert(lights_.begin() + static_cast<std::ptrdiff_t>(at), control);
+    updateEmissions();
+    record.actions.push_back("move_light");
+    break;
+  }
+  case Kind::SelectObject:
+    selected_ = a.name.empty() ? -1 : static_cast<int>(scene::objectIndex(scenes_.back(), a.name, "select"));
+    record.actions.push_back("select");
+    break;
+  case Kind::MoveObject: {
+    const std::size_t object = a.name.empty() ? static_cast<std::size_t>(std::max(selected_, 0))
+                                              : scene::objectIndex(scenes_.back(), a.name, "move");
+    if (a.name.empty() && selected_ < 0) throw InputError("move: no object is selected");
+    moveObject(object, a.vector, record);
+    record.actions.push_back("move_object");
+    break;
+  }
+  case Kind::Exposure:
+    config_.exposure = a.value;
+    needsCompose_ = true;
+    record.actions.push_back("exposure");
+    break;
+  case Kind::Aov: {
+    const auto& names = render::obscuranceAovNames();
+    if (a.name != "combined" && std::find(names.begin(), names.end(), a.name) == names.end())
+      throw InputError(fmt::format("no AOV named '{}' (AOVs: combined, {})", a.name, fmt::join(names, ", ")));
+    config_.aov = a.name;
+    needsCompose_ = true;
+    record.actions.push_back("aov");
+    break;
+  }
+  case Kind::Method:
+    config_.method = a.name;
+    needsCompose_ = true;
+    record.actions.push_back("method");
+    break;
+  case Kind::Rho:
+    config_.obscurance.rho = rhoKind(a.name);
+    restart(false);
+    record.restarted = true;
+    record.actions.push_back("rho");
+    break;
+  case Kind::DMax:
+    config_.obscurance.dMax = a.value;
+    restart(false);
+    record.restarted = true;
+    record.actions.push_back("dmax");
+    break;
+  case Kind::ShadowRays:
+    config_.obscurance.shadowRays = static_cast<std::uint32_t>(a.count);
+    restart(false);
+    record.restarted = true;
+    record.actions.push_back("shadow_rays");
+    break;
+  case Kind::ObscuranceRays:
+    config_.obscurance.obscuranceRays = static_cast<std::uint32_t>(a.count);
+    restart(false);
+    record.restarted = true;
+    record.actions.push_back("obscurance_rays");
+    break;
+  case Kind::Camera: {
+    const auto& cameras = scenes_.back().cameras;
+    if (a.count >= cameras.size())
+      throw InputError(fmt::format("camera {}: the scene has {} camera(s)", a.count, cameras.size()));
+    camera_.setCamera(cameras[a.count]);
+    restart(false);
+    record.restarted = true;
+    record.actions.push_back("camera");
+    break;
+  }
+  case Kind::Denoise:
+    config_.denoise = a.count != 0;
+    needsCompose_ = true;
+    record.actions.push_back("denoise");
+    break;
+  case Kind::SaveView:
+    saveView(a.name, camera_.camera());
+    status_ = fmt::format("view saved to {}", a.name);
+    record.actions.push_back("save_view");
+    break;
+  case Kind::LoadView:
+    camera_.setCamera(loadView(a.name));
+    restart(false);
+    record.restarted = true;
+    status_ = fmt::format("view loaded from {}", a.name);
+    record.actions.push_back("load_view");
+    break;
+  }
+}
+
+void Viewer::applyWindowEvent(const ScriptEvent& e) {
+  if (e.text == "resize") window_.resize(static_cast<int>(e.xy[0]), static_cast<int>(e.xy[1]));
+  else if (e.text == "minimize") window_.iconify();
+  else if (e.text == "restore") window_.restore();
+  else if (e.text == "close") window_.requestClose();
+}
+
+int Viewer::pick(double x, double y) {
+  const auto drawable = window_.framebufferSize();
+  if (drawable[0] <= 0 || drawable[1] <= 0) return -1;
+  const auto rect = fitToDrawable(config_.obscurance.width, config_.obscurance.height,
+                                  {static_cast<std::uint32_t>(drawable[0]), static_cast<std::uint32_t>(drawable[1])});
+  const double u = (x - rect[0].x) / double(rect[1].x - rect[0].x), v = (y - rect[0].y) / double(rect[1].y - rect[0].y);
+  if (u < 0.0 || u >= 1.0 || v < 0.0 || v >= 1.0) return -1;
+  const int px = static_cast<int>(u * config_.obscurance.width), py = static_cast<int>(v * config_.obscurance.height);
+  renderer_->compose(config_.exposure);
+  const io::Image image = renderer_->image();
+  const int channel = image.channelIndex(render::aovChannels("primitive").front());
+  if (channel < 0) return -1;
+  const float primitive = image.at(px, py, channel);
+  if (!(primitive >= 0.0f)) return -1; // background
+  const auto triangle = static_cast<std::uint32_t>(std::lround(primitive));
+  const auto& objects = scenes_.back().objects;
+  for (std::size_t i = 0; i < objects.size(); ++i)
+    if (triangle >= objects[i].firstTriangle && triangle < objects[i].firstTriangle + objects[i].triangleCount)
+      return static_cast<int>(i);
+  return -1;
+}
+
+void Viewer::renderStep(FrameRecord& record) {
+  const std::uint32_t maxSamples = std::max(config_.obscurance.spp, 1u);
+  if (config_.method == "pathtrace") {
+    if (!pathTracer_) {
+      render::PathTraceSettings s;
+      s.width = config_.obscurance.width;
+      s.height = config_.obscurance.height;
+      s.seed = config_.obscurance.seed;
+      s.camera = camera_.camera();
+      s.maxDepth = config_.pathDepth;
+      s.spp = maxSamples;
+      s.lightSampling = config_.obscurance.lightSampling;
+      pathTracer_ = std::make_unique<render::PathTracer>(context_, scenes_.back(), bvhs_.back(), s,
+                                                         config_.obscurance.maxBufferBytes);
+      record.restarted = true;
+    }
+    if (pathTracer_->samples() < maxSamples) {
+      pathTracer_->iterate(1);
+      needsCompose_ = true;
+    }
+    if (needsCompose_) shown_ = io::encodeRgba8(pathTracer_->image(), 0, config_.exposure, 3);
+    needsCompose_ = false;
+    return;
+  }
+
+  if (previewShown_ && !record.preview) {
+    restart(false); // the preview is over: full rays from sample 0
+    record.restarted = true;
+  }
+  if (renderer_->samples() < maxSamples) {
+    renderer_->iterate(1);
+    needsCompose_ = true;
+  }
+
+  if (!needsCompose_) return;
+  needsCompose_ = false;
+  if (config_.aov == "combined") {
+    renderer_->composeDisplay(config_.exposure);
+    shown_ = renderer_->display();
+
+  } else {
+    renderer_->compose(config_.exposure);
+    const io::Image image = renderer_->image();
+    const auto channels = render::aovChannels(config_.aov);
+    shown_ = io::encodeRgba8(image, image.channelIndex(channels.front()), config_.exposure,
+                             static_cast<int>(channels.size()));
+  }
+}
+
+render::RenderStats Viewer::currentStats() const {
+  if (config_.method == "pathtrace") return pathTracer_ ? pathTracer_->stats() : render::RenderStats{};
+  return renderer_->stats();
+}
+
+PanelState Viewer::panelState() const {
+  PanelState s;
+  s.method = config_.method;
+  s.aov = config_.aov;
+  s.aovs = {"combined"};
+  for (const auto& name : render::obscuranceAovNames())
+    if (name != "combined") s.aovs.push_back(name);
+  s.rho = rhoName(config_.obscurance.rho);
+  s.exposure = config_.exposure;
+  s.dMax = renderer_->dMax();
+  s.shadowRays = config_.obscurance.shadowRays;
+  s.obscuranceRays = config_.obscurance.obscuranceRays;
+  s.denoise = config_.denoise;
+  s.samples = config_.method == "pathtrace" && pathTracer_ ? pathTracer_->samples() : renderer_->samples();
+  s.maxSamples = std::max(config_.obscurance.spp, 1u);
+  s.preview = previewShown_;
+  s.frameMs = lastFrameMs_;
+  const auto stats = currentStats();
+  s.passes = stats.passes;
+  const double ms = totalGpuMs(stats);
+  s.raysPerSecond = ms > 0 ? double(totalRays(stats)) / (ms * 1e-3) : 0.0;
+  for (const auto& l : lights_) s.lights.push_back({l.name, l.scale, l.color, l.added, l.light.position});
+  for (const auto& c : scenes_.back().cameras) s.cameras.push_back(c.name);
+  if (selected_ >= 0) s.selected = scenes_.back().objects[static_cast<std::size_t>(selected_)].name;
+  const scene::Camera& cam = camera_.camera();
+  s.newLightPosition = cam.position + cam.forward * (0.15f * sceneSize_);
+  s.newLightIntensity = 0.05f * sceneSize_ * sceneSize_;
+  s.sceneSize = sceneSize_;
+  s.status = status_;
+  s.viewFile = config_.viewFile;
+  return s;
+}
+
+void Viewer::writeLog(const FrameRecord& r) {
+  if (!log_) return;
+  nlohmann::json line = {{"frame", r.frame},
+                         {"method", config_.method},
+                         {"samples", config_.method == "pathtrace" && pathTracer_ ? pathTracer_->samples()
+                                                                                   : renderer_->samples()},
+                         {"restarted", r.restarted},
+                         {"preview", r.preview},
+                         {"presented", r.presented},
+                         {"pixels_retraced", r.retraced},
+                         {"rays", r.rays},
+                         {"gpu_ms", r.gpuMs},
+                         {"render_ms", r.renderMs},
+                         {"present_ms", r.presentMs},
+                         {"frame_ms", r.frameMs},
+                         {"actions", r.actions}};
+  log_ << line.dump() << "\n";
+  log_.flush();
+}
+
+io::Image Viewer::shownImage() {
+  if (config_.method == "pathtrace") return pathTracer_->image();
+  renderer_->compose(config_.exposure);
+  return renderer_->image();
+}
+
+void Viewer::takeScreenshot(const std::string& path, const std::vector<std::uint32_t>& shown,
+                            const std::vector<std::uint32_t>& captured, vk::Extent2D extent) {
+  if (io::extensionOf(path) == "exr") {
+    io::writeExr(path, shownImage()); // linear, every AOV the frame keeps
+    return;
+  }
+  if (config_.screenshotUi) {
+    if (captured.empty()) throw DeviceError(fmt::format("{}: no frame was presented to capture (minimised?)", path));
+    io::writePngRgba8(path, static_cast<int>(extent.width), static_cast<int>(extent.height), captured);
+  } else {
+    io::writePngRgba8(path, static_cast<int>(config_.obscurance.width), static_cast<int>(config_.obscurance.height), shown);
+  }
+}
+
+void Viewer::run() {
+  bool panelVisible = config_.panel;
+  for (frame_ = 0; config_.frames == 0 || frame_ < config_.frames; ++frame_) {
+    const auto start = Clock::now();
+    const double seconds = std::chrono::duration<double>(start - lastFrameStart_).count();
+    lastFrameStart_ = start;
+    FrameRecord record;
+    record.frame = frame_;
+
+    InputState& input = window_.input();
+    input.beginFrame();
+    const auto drawable = window_.framebufferSize();
+    window_.pollEvents(drawable[0] == 0 && config_.script.empty() ? 0.05 : 0.0);
+    if (window_.shouldClose()) break;
+    config_.script.feed(frame_, input);
+    std::vector<ViewerAction> actions;
+    if (overlay_ && panelVisible) {
+      overlay_->beginFrame(input);
+      actions = drawControlPanel(panelState());
+    }
+    std::vector<std::string> screenshots;
+    for (const ScriptEvent* e : config_.script.eventsAt(frame_)) {
+      if (e->kind == ScriptEvent::Kind::Panel) actions.push_back(e->action);
+      else if (e->kind == ScriptEvent::Kind::Window) applyWindowEvent(*e);
+      else screenshots.push_back(e->text);
+    }
+    if (!input.uiWantsKeyboard) {
+      for (int key : input.keysPressed) {
+        if (key == GLFW_KEY_ESCAPE) window_.requestClose();
+        if (key == GLFW_KEY_TAB) panelVisible = !panelVisible;
+        if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && std::size_t(key - GLFW_KEY_1) < scenes_.back().cameras.size()) {
+          ViewerAction a;
+          a.kind = Kind::Camera;
+          a.count = static_cast<std::size_t>(key - GLFW_KEY_1);
+          actions.push_back(a);
+        }
+        if (key == GLFW_KEY_F5 || key == GLFW_KEY_F9) {
+          ViewerAction a;
+          a.kind = key == GLFW_KEY_F5 ? Kind::SaveView : Kind::LoadView;
+          a.name = config_.viewFile;
+          actions.push_back(a);
+        }
+      }
+    }
+    if (!input.uiWantsMouse)
+      for (const auto& click : input.clicks) {
+        const int object = pick(click[0], click[1]);
+        selected_ = object;
+        status_ = object >= 0 ? fmt::format("selected {}", scenes_.back().objects[std::size_t(object)].name)
+                              : "nothing selected";
+        record.actions.push_back("pick");
+      }
+
+    const auto renderStart = Clock::now();
+    const render::RenderStats before = currentStats();
+    for (const auto& a : actions) {
+      try {
+        apply(a, record);
+      } catch (const InputError& e) {
+        // A person's mistake on the panel is shown there; a script's is fatal (tests must see it).
+        if (!config_.script.empty()) throw;
+        status_ = e.what();
+      }
+    }
+    if (camera_.update(input, seconds)) {
+      restart(true);
+      record.preview = true;
+      record.restarted = true;
+    }
+    renderStep(record);
+    const render::RenderStats after = currentStats();
+    // A restart zeroes the renderer's counters: then all it counts is this frame's.
+    record.rays = totalRays(after) - (record.restarted ? 0 : totalRays(before));
+    record.gpuMs = totalGpuMs(after) - (record.restarted ? 0.0 : totalGpuMs(before));
+    const auto presentStart = Clock::now();
+    record.renderMs = std::chrono::duration<double, std::milli>(presentStart - renderStart).count();
+
+    std::vector<std::uint32_t> captured;
+    vk::Extent2D capturedExtent{};
+    const bool lastFrame = config_.frames != 0 && frame_ + 1 == config_.frames;
+    const bool capture = config_.screenshotUi && (!screenshots.empty() || (lastFrame && !config_.screenshot.empty()));
+    record.presented = presenter_.present(shown_, window_.framebufferSize(),
+                                          overlay_ && panelVisible ? overlay_.get() : nullptr,
+                                          capture ? &captured : nullptr, &capturedExtent);
+    if (overlay_ && panelVisible && !record.presented) overlay_->discardFrame();
+    for (const auto& path : screenshots) takeScreenshot(path, shown_, captured, capturedExtent);
+    if (lastFrame && !config_.screenshot.empty()) takeScreenshot(config_.screenshot, shown_, captured, capturedExtent);
+    record.presentMs = std::chrono::duration<double, std::milli>(Clock::now() - presentStart).count();
+    record.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    lastFrameMs_ = record.frameMs;
+    writeLog(record);
+  }
+  context_.device().waitIdle();
+}
+
+} // namespace obscura::window

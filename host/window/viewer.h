@@ -1,0 +1,122 @@
+// viewer.h — `obscura view`: the real-time window. A frame loop around the persistent renderers
+// (render/obscurance_renderer.h, render/path_tracer.h) that
+//   - renders progressively: one sample per frame, accumulated until something changes (up to
+//     `maxSamples`), the first frame after a camera move a cheap preview (one primary sample, one
+//     shadow and one obscurance ray);
+//   - edits as the relighting paper does: a light's intensity or colour is one compose pass (the
+//     accumulation goes on), an added or dragged light traces only that light, a moved object
+//     retraces only the pixels it can change, and a camera move restarts;
+//   - shows it with the panel (window/control_panel.h) over it, driven by a person or a script.
+#pragma once
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bvh/bvh.h"
+#include "gpu/context.h"
+#include "render/obscurance_renderer.h"
+#include "render/path_tracer.h"
+#include "scene/scene.h"
+#include "window/camera_controller.h"
+#include "window/control_panel.h"
+#include "window/event_script.h"
+#include "window/frame_presenter.h"
+#include "window/glfw_window.h"
+#include "window/swapchain.h"
+#include "window/ui_overlay.h"
+#include "window/viewer_action.h"
+
+namespace obscura::window {
+
+struct ViewerConfig {
+  std::string title = "obscura";
+  render::ObscuranceSettings obscurance; // size, camera, rays; spp = the samples accumulated
+  std::uint32_t pathDepth = 6;
+  std::string method = "obscurance";     // or "pathtrace"
+  std::string aov = "combined";
+  float exposure = 0.0f;
+  bool denoise = true;
+  bool panel = true;
+  std::size_t frames = 0;                // frames to show, then exit; 0: until the window closes
+  std::string screenshot;                // the last frame, as shown (PNG), or linear (EXR)
+  bool screenshotUi = false;             // screenshots include the panel
+  EventScript script;                    // replayed input (window/event_script.h); empty: none
+  std::string log;                       // one JSON line per frame
+  std::string viewFile = "view.json";    // F5 saves the view there, F9 loads it
+};
+
+class Viewer {
+public:
+  // Opens the window and makes the renderer. DeviceError without a window system.
+  Viewer(const gpu::ContextOptions& device, scene::Scene scene, bvh::Bvh bvh, ViewerConfig config);
+  ~Viewer();
+  // The frame loop, until the window closes or `frames` have been shown.
+  void run();
+
+private:
+  struct FrameRecord; // what one frame did, for the log and the panel
+  void apply(const ViewerAction& action, FrameRecord& record);
+  void applyWindowEvent(const ScriptEvent& event);
+  // Restarts accumulation with the current settings (and camera).
+  void restart(bool preview);
+  void renderStep(FrameRecord& record);
+  std::vector<std::uint32_t> displayBytes();
+  // The object under window pixel (x, y), from the primitive AOV; -1 for none.
+  int pick(double x, double y);
+  void moveObject(std::size_t object, glm::vec3 translate, FrameRecord& record);
+  void updateEmissions();
+  std::size_t lightIndex(const std::string& name) const;
+  render::ObscuranceSettings fullSettings() const;
+  PanelState panelState() const;
+  // The shown method's counters since its last restart.
+  render::RenderStats currentStats() const;
+  void writeLog(const FrameRecord& record);
+  // The frame shown, linear (the AOVs of an obscurance frame; combined for path tracing).
+  io::Image shownImage();
+  void takeScreenshot(const std::string& path, const std::vector<std::uint32_t>& shown,
+                      const std::vector<std::uint32_t>& captured, vk::Extent2D capturedExtent);
+
+  ViewerConfig config_;
+  GlfwWindow window_;
+  gpu::Context context_;
+  vk::raii::SurfaceKHR surface_ = nullptr;
+  Swapchain swapchain_;
+  std::unique_ptr<UiOverlay> overlay_;
+  FramePresenter presenter_;
+  std::ofstream log_;
+
+  // The scene as edited so far (the renderers keep pointers to the newest).
+  std::deque<scene::Scene> scenes_;
+  std::deque<bvh::Bvh> bvhs_;
+  float sceneSize_ = 1.0f;
+  CameraController camera_;
+  std::unique_ptr<render::ObscuranceRenderer> renderer_;
+  std::unique_ptr<render::PathTracer> pathTracer_; // made when first shown, again after edits
+
+  struct LightControl {
+    std::string name;
+    glm::vec3 base{1.0f}; // the light's own emission (E_s at scale 1, colour 1)
+    float scale = 1.0f;
+    glm::vec3 color{1.0f};
+    bool added = false;   // added in the window (can be dragged)
+    scene::PunctualLight light;
+  };
+  std::vector<LightControl> lights_;
+  int selected_ = -1;
+  bool previewShown_ = false;
+  bool needsCompose_ = true;
+  std::vector<std::uint32_t> shown_;
+  std::size_t frame_ = 0;
+  std::string status_; // the last edit's outcome, shown on the panel
+  double lastFrameMs_ = 0.0;
+  std::chrono::steady_clock::time_point lastFrameStart_;
+};
+
+} // namespace obscura::window
