@@ -86,7 +86,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--frames", options->frames, "show N frames, then exit (default: until the window closes)");
   cmd->add_option("--screenshot", options->screenshot, "write the last frame as shown: PNG (tonemapped, without the panel) or EXR (linear AOVs)");
   cmd->add_flag("--screenshot-ui", options->screenshotUi, "screenshots include the panel");
-  cmd->add_option("--script", options->script, "replay timed input from a JSON list of events (see docs/VIEWER.md)");
+  cmd->add_option("--script", options->script, "replay timed input from a JSON list of events (format: README, host/window/event_script.h)");
   cmd->add_option("--log", options->log, "write one JSON line per frame (samples, restarts, pixels retraced, rays, ms)");
   cmd->add_option("--view", options->view, "start from a view saved with F5 (a glTF-style camera JSON)");
   cmd->add_option("--view-file", options->viewFile, "where F5 saves and F9 loads the view (default view.json)");

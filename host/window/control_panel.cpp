@@ -41,7 +41,7 @@ const char* viewerControlsHelp() {
 std::vector<ViewerAction> drawControlPanel(const PanelState& s) {
   std::vector<ViewerAction> out;
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(330, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("obscura");
 
   ImGui::Text("%.1f ms/frame (%.0f fps)  %.2f Mrays/s", s.frameMs, s.frameMs > 0 ? 1000.0 / s.frameMs : 0.0,
@@ -78,7 +78,7 @@ std::vector<ViewerAction> drawControlPanel(const PanelState& s) {
     out.push_back(a);
   }
 
-  if (ImGui::CollapsingHeader("obscurances", ImGuiTreeNodeFlags_DefaultOpen)) {
+  if (ImGui::CollapsingHeader("obscurances")) {
     if (combo("rho", s.rho, {"sqrt", "exp", "ao"}, chosen)) {
       auto a = action(Kind::Rho);
       a.name = chosen;
@@ -104,6 +104,7 @@ std::vector<ViewerAction> drawControlPanel(const PanelState& s) {
   }
 
   if (ImGui::CollapsingHeader("lights", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (s.method == "pathtrace") ImGui::TextWrapped("path tracing shows the scene's own lights; edits here are the obscurance method's");
     for (const auto& light : s.lights) {
       ImGui::PushID(light.name.c_str());
       ImGui::TextUnformatted(light.name.c_str());
