@@ -29,6 +29,7 @@ void InputState::beginFrame() {
   clicks.clear();
   mouseDx = mouseDy = 0.0;
   scroll = 0.0;
+  uiWantsMouse = uiWantsKeyboard = false; // the panel says so again when it is drawn
 }
 
 GlfwWindow::GlfwWindow(int width, int height, const std::string& title) {

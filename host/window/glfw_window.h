@@ -26,7 +26,8 @@ struct InputState {
   bool shift = false;
   bool uiWantsMouse = false, uiWantsKeyboard = false; // the panel took it (set by the overlay)
 
-  // Forgets the per-frame parts (presses, clicks, motion, scroll); held keys and buttons stay.
+  // Forgets the per-frame parts (presses, clicks, motion, scroll, the panel's claims); held keys and
+  // buttons stay.
   void beginFrame();
 };
 

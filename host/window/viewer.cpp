@@ -217,9 +217,9 @@ void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
     record.actions.push_back("select");
     break;
   case Kind::MoveObject: {
-    const std::size_t object = a.name.empty() ? static_cast<std::size_t>(std::max(selected_, 0))
-                                              : scene::objectIndex(scenes_.back(), a.name, "move");
     if (a.name.empty() && selected_ < 0) throw InputError("move: no object is selected");
+    const std::size_t object = a.name.empty() ? static_cast<std::size_t>(selected_)
+                                              : scene::objectIndex(scenes_.back(), a.name, "move");
     moveObject(object, a.vector, record);
     record.actions.push_back("move_object");
     break;
