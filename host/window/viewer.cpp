@@ -457,7 +457,12 @@ void Viewer::run() {
   bool panelVisible = config_.panel;
   for (frame_ = 0; config_.frames == 0 || frame_ < config_.frames; ++frame_) {
     const auto start = Clock::now();
-    const double seconds = std::chrono::duration<double>(start - lastFrameStart_).count();
+    // The fly step: the frame's time, but at most 0.1 s, so that one slow frame (seconds on
+    // lavapipe) does not throw the camera through a wall; a script steps 1/30 s per frame, so its
+    // keys move the camera the same on every machine.
+    const double seconds = config_.script.empty()
+                               ? std::min(std::chrono::duration<double>(start - lastFrameStart_).count(), 0.1)
+                               : 1.0 / 30.0;
     lastFrameStart_ = start;
     FrameRecord record;
     record.frame = frame_;
