@@ -3,7 +3,8 @@
 // Illumination", HPG 2017), on the GPU.
 //
 // It works on the renderer's composed terms after compose(): the direct term sum_s E_s D_s and
-// the ambient term I_a A are divided by the albedo (demodulated, so that textures stay sharp),
+// the ambient term I_a A are divided by the albedo (demodulated, so that textures stay sharp) and
+// filtered apart from each other and from the specular paths' light (not demodulated):
 //   gather    the frame's terms, guides (normal, depth, albedo, material) and sample counts into
 //             whole-frame buffers (one dispatch per band; the whole frame must fit one buffer)
 //   reproject after a camera move, the previous frame's terms (its history) seen from the new
@@ -13,8 +14,8 @@
 //             each term's luminance variance
 //   a-trous   edge-aware wavelet iterations (steps 1, 2, 4, ...) guided by normal, depth (plane
 //             distance) and albedo, the luminance weight steered by the variance
-//   remodulate x albedo, + emission + specular, then the tonemap pass (display bytes as
-//             ObscuranceRenderer::display(): RGBA8, R in the low byte).
+//   remodulate x albedo, + specular, + the seen emission (never filtered); then the tonemap pass
+//             (display bytes as ObscuranceRenderer::display(): RGBA8, R in the low byte).
 #pragma once
 #include <cstdint>
 #include <map>
@@ -30,9 +31,13 @@ namespace obscura::render {
 class ObscuranceRenderer;
 
 struct DenoiserSettings {
-  std::uint32_t iterations = 5;         // a-trous iterations (steps 1, 2, 4, ...); 0: no spatial filter
+  std::uint32_t iterations = 4;         // a-trous iterations (steps 1, 2, 4, 8); 0: no spatial filter
   bool temporal = true;                 // reproject the history across camera moves
   std::uint32_t maxHistorySamples = 16; // the most samples a reprojected history counts for
+  float luminanceSigma = 2.0f;          // sigma_l: how many standard deviations of noise a luminance
+                                        // step may be and still be filtered over (Schied et al. use 4
+                                        // with temporal variances; 2 measured lower error with these
+                                        // spatial ones at 4 spp: tests/render/denoise_test.cpp)
 };
 
 class Denoiser {
@@ -63,8 +68,8 @@ public:
   std::map<std::string, double> lastPassMs() const;
 
   // What the last denoise() took from the history, for tests: channels direct.R/G/B and
-  // indirect.R/G/B (demodulated, reprojected to the current camera) and history.N (the samples
-  // it counts for; 0 where rejected or where there was no history).
+  // indirect.R/G/B (demodulated), specular.R/G/B, reprojected to the current camera, and
+  // history.N (the samples it counts for; 0 where rejected or where there was no history).
   io::Image reprojectedHistory() const;
 
   const DenoiserSettings& settings() const { return settings_; }
