@@ -121,7 +121,7 @@ protected:
 // the geometric edges' pixels, which the filter leaves alone (MAE: 0.0044 -> 0.0028, 0.0019 -> 0.0015).
 TEST_F(Denoise, LowersTheErrorAgainstTheConvergedCornellBoxAt1And4Spp) {
   const Loaded l = load(repoPath("scenes/cornell-box/cornell-box.gltf"));
-  expectLowerError(l, settingsFor(l.scene, 96, 96, 1, 3), 256, 0.92);
+  expectLowerError(l, settingsFor(l.scene, 96, 96, 1, 3), 128, 0.95);
 }
 
 // Measured: 0.730 at 1 spp, 0.807 at 4 spp (MAE 0.136 -> 0.094, 0.063 -> 0.047); the glossy floor's
@@ -183,7 +183,7 @@ TEST_F(Denoise, KeepsAHardShadowAndAGeometricEdgeAsSharpAsTheConvergedImage) {
   render::ObscuranceSettings s;
   s.width = s.height = 96;
   s.camera = lookCamera({0.0f, 4.0f, 4.0f}, {0.0f, -1.0f, -1.0f}, {0.0f, 1.0f, -1.0f}, 0.7f);
-  s.spp = 256;
+  s.spp = 64; // the shadow's edge is exact at any count; the profiles average 32 columns' ambient
   s.seed = 7919;
   render::ObscuranceRenderer converged(context(), plate.scene, plate.bvh, s);
   converged.render();
