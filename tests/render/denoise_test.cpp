@@ -253,6 +253,13 @@ TEST_F(Denoise, ReprojectedHistoryMatchesAFreshRenderAndRejectsDisocclusions) {
   denoiser.denoise(renderer);
   const io::Image carried = denoiser.reprojectedHistory();
   const io::Image fresh = renderer.image();
+  EXPECT_TRUE(denoiser.lastPassMs().contains("reproject"));
+  // While the camera stays, the renderer's accumulation goes on and the carry is kept as it is.
+  renderer.iterate(4);
+  renderer.compose();
+  denoiser.denoise(renderer);
+  EXPECT_FALSE(denoiser.lastPassMs().contains("reproject"));
+  EXPECT_EQ(denoiser.reprojectedHistory().pixels, carried.pixels);
   // The same view again with other seeds: how far two renders of it lie apart.
   s.seed = 12;
   renderer.configure(s);
@@ -343,6 +350,25 @@ TEST_F(Denoise, WithoutFilterOrHistoryGivesBackTheFrame) {
   for (std::size_t i = 0; i < frame.pixels.size(); ++i)
     ASSERT_NEAR(denoised.pixels[i], frame.pixels[i], 2e-3f * std::abs(frame.pixels[i]) + 1e-6f) << "value " << i;
   EXPECT_EQ(denoiser.display().size(), std::size_t(48 * 48));
+}
+
+// Frames split into bands of rows are gathered into the denoiser's whole-frame buffers: the
+// denoised image does not depend on the banding.
+TEST_F(Denoise, BandedFrameDenoisesAsTheWholeFrame) {
+  const Loaded l = load(repoPath("scenes/cornell-box/cornell-box.gltf"));
+  render::ObscuranceSettings s = settingsFor(l.scene, 48, 40, 2, 1);
+  render::ObscuranceRenderer whole(context(), l.scene, l.bvh, s);
+  s.maxBufferBytes = 48 * 12 * 16 * 2 * 6; // the AOV sums of 12 rows: 4 bands
+  render::ObscuranceRenderer banded(context(), l.scene, l.bvh, s);
+  ASSERT_GT(banded.layout().bandCount(), 2u);
+  std::vector<io::Image> images;
+  for (render::ObscuranceRenderer* r : {&whole, &banded}) {
+    r->render();
+    render::Denoiser denoiser(context(), *r);
+    denoiser.denoise(*r);
+    images.push_back(denoiser.image());
+  }
+  EXPECT_EQ(images[0].pixels, images[1].pixels);
 }
 
 } // namespace
