@@ -10,7 +10,8 @@
 //
 // Every obscurance method estimates the same image (ray counts and light sampling change the
 // noise, not the expectation), so one converged obscurance render, made with the best
-// estimators, is the noise reference of all of them.
+// estimators, is the noise reference of all of them. The denoised methods (render/denoise/) are
+// measured the same way: one frame denoised alone, its GPU time counted.
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -30,6 +31,7 @@
 #include "io/image_io.h"
 #include "analysis/convergence.h"
 #include "analysis/image_error.h"
+#include "render/denoise/denoiser.h"
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
 
@@ -61,6 +63,7 @@ struct Method {
   std::uint32_t budgetSpp = 8;    // the budget its summary is read at
   std::string what;
   float secondaryReflectors = 0.0f; // their marking threshold, 0 = off
+  bool denoise = false;             // the frame denoised (render/denoise/), its GPU time counted
 };
 
 // The paper's budget [RTO §4.1]: 8 primary samples x (5 obscurance + 5 shadow rays) per hit.
@@ -74,6 +77,11 @@ const std::vector<Method> kMethods = {
     {"obscurance-paper", false, render::LightSampling::Area, kPaperRays, kPaperSpp,
      "the paper's light sampling (by power, by area), 5+5 rays per hit, 8 spp"},
     {"obscurance-realtime", false, render::LightSampling::Spatial, 1, 1, "spatial, 1+1 rays per hit, 1 spp"},
+    // The window's frames: the same, denoised (one frame alone, no history), error measured.
+    {"obscurance-denoised", false, render::LightSampling::Spatial, kPaperRays, 1,
+     "spatial, 5+5 rays per hit, denoised (a-trous on demodulated terms), 1 spp", 0.0f, true},
+    {"obscurance-realtime-denoised", false, render::LightSampling::Spatial, 1, 1,
+     "spatial, 1+1 rays per hit, denoised, 1 spp", 0.0f, true},
     {"pathtrace", true, render::LightSampling::Spatial, 0, 1, "path tracing, NEE with spatial light sampling + MIS"},
 };
 
@@ -141,6 +149,13 @@ public:
       obscurance_->render();
       r.image = obscurance_->image();
       statsCopy_ = obscurance_->stats();
+      if (m.denoise) {
+        if (!denoiser_) denoiser_ = std::make_unique<render::Denoiser>(context_, *obscurance_);
+        denoiser_->reset(); // each render is a frame of its own
+        denoiser_->denoise(*obscurance_);
+        r.image = denoiser_->image();
+        r.gpuMs += denoiser_->lastGpuMs();
+      }
     }
     stats = &statsCopy_;
     if (stats->truncatedTraversals) throw DeviceError("traversals were truncated; the study would be wrong");
@@ -218,6 +233,7 @@ private:
   const LoadedScene& loaded_;
   const gpu::Context& context_;
   std::unique_ptr<render::ObscuranceRenderer> obscurance_;
+  std::unique_ptr<render::Denoiser> denoiser_; // bound to obscurance_'s frame
   std::unique_ptr<render::PathTracer> pathTracer_;
   scene::Camera camera_;
   std::uint32_t width_ = 0, height_ = 0;

@@ -16,6 +16,7 @@
 #include "gpu/buffer.h"
 #include "io/image_io.h"
 #include "render/aovs.h"
+#include "render/denoise/denoiser.h"
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
 #include "relight/relight_state.h"
@@ -89,7 +90,7 @@ void writeOutputs(const RenderOptions& o, const io::Image& image, const render::
   io::Image selected = selectAovs(image, o.aovs);
   if (io::extensionOf(o.output) == "exr") {
     io::writeExr(o.output, selected);
-  } else if (display && (o.aovs.empty() || o.aovs.front() == "combined")) {
+  } else if (display && (o.aovs.empty() || o.aovs.front() == "combined" || o.aovs.front() == "denoised")) {
     io::writePngRgba8(o.output, image.width, image.height, *display);
   } else {
     std::string first = o.aovs.empty() ? "combined" : o.aovs.front();
@@ -132,11 +133,16 @@ void runRender(RenderOptions& o) {
   std::string ext = io::extensionOf(o.output);
   if (ext != "exr" && ext != "png")
     throw InputError(fmt::format("{}: the output must be .exr or .png", o.output));
+  if (o.denoise && o.method == "pathtrace")
+    throw InputError("--denoise with --method pathtrace: the denoiser filters the obscurance method's direct and "
+                     "ambient terms divided by the albedo, which path tracing does not keep; use --method obscurance");
   static const std::vector<std::string> pathAovs = {"combined"};
-  const auto& known = o.method == "pathtrace" ? pathAovs : render::obscuranceAovNames();
+  std::vector<std::string> known = o.method == "pathtrace" ? pathAovs : render::obscuranceAovNames();
+  if (o.denoise) known.push_back("denoised");
   for (const auto& aov : o.aovs)
     if (std::find(known.begin(), known.end(), aov) == known.end())
-      throw InputError(fmt::format("--aov {}: unknown AOV (known: {})", aov, fmt::join(known, ", ")));
+      throw InputError(fmt::format("--aov {}: unknown AOV (known: {}){}", aov, fmt::join(known, ", "),
+                                   aov == "denoised" ? "; it needs --denoise" : ""));
   checkRenderOptions(o);
   if (!o.metrics.empty()) checkWritable(o.metrics);
 
@@ -174,11 +180,13 @@ void runRender(RenderOptions& o) {
   const std::vector<std::string> wanted = o.aovs.empty() ? (exr ? render::obscuranceAovNames()
                                                                 : std::vector<std::string>{"combined"})
                                                          : o.aovs;
+  // The denoiser's guides and terms are the primary and composed AOVs.
+  const bool keepAll = o.denoise;
   const auto& primaryNames = render::aovNames();
-  settings.primaryAovs = std::any_of(wanted.begin(), wanted.end(), [&](const std::string& a) {
+  settings.primaryAovs = keepAll || std::any_of(wanted.begin(), wanted.end(), [&](const std::string& a) {
     return a != "emission" && std::find(primaryNames.begin(), primaryNames.end(), a) != primaryNames.end();
   });
-  settings.composedAovs = std::any_of(wanted.begin(), wanted.end(), [](const std::string& a) { return a != "combined"; });
+  settings.composedAovs = keepAll || std::any_of(wanted.begin(), wanted.end(), [](const std::string& a) { return a != "combined"; });
   render::ObscuranceRenderer renderer(context, loaded.scene, loaded.bvh, settings);
   renderer.reset();
   renderer.iterate(settings.spp, progress);
@@ -187,7 +195,24 @@ void runRender(RenderOptions& o) {
   io::Image image = renderer.image();
   // The EXR carries one layer per light group (light.<name>), so that a compositor can relight it.
   if (io::extensionOf(o.output) == "exr" && o.aovs.empty()) appendChannels(image, renderer.lightLayers());
-  const std::vector<std::uint32_t> display = renderer.display();
+  std::vector<std::uint32_t> display = renderer.display();
+  nlohmann::json denoiseJson = nullptr;
+  if (o.denoise) {
+    // One frame: the renderer's samples alone (no history), filtered; the EXR gets it as the
+    // `denoised` layer beside the rest (combined stays the sum of the light layers), the PNG of
+    // combined shows it.
+    render::Denoiser denoiser(context, renderer);
+    denoiser.denoise(renderer, o.exposure);
+    io::Image denoised = denoiser.image();
+    denoised.channels = render::aovChannels("denoised");
+    appendChannels(image, denoised);
+    display = denoiser.display();
+    denoiseJson = {{"gpu_ms", denoiser.lastGpuMs()}, {"passes_gpu_ms", denoiser.lastPassMs()},
+                   {"iterations", denoiser.settings().iterations}};
+    std::string passes;
+    for (const auto& [name, ms] : denoiser.lastPassMs()) passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", name, ms);
+    fmt::print(stderr, "denoise: {:.1f} ms GPU ({})\n", denoiser.lastGpuMs(), passes);
+  }
   const glm::vec3 ia = renderer.ambientIntensity(), rAve = renderer.ambient().averageReflectance;
   const glm::vec3 iaGlobal = renderer.ambient().globalIntensity(renderer.emissions());
   fmt::print(stderr, "obscurance: dmax {:.4g}, rho {}, {} sampling, {}; R_ave ({:.4f}, {:.4f}, {:.4f}), "
@@ -212,7 +237,8 @@ void runRender(RenderOptions& o) {
                 {"i_a", {ia.x, ia.y, ia.z}}, {"i_a_global", {iaGlobal.x, iaGlobal.y, iaGlobal.z}},
                 {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
                 {"r_ave", {rAve.x, rAve.y, rAve.z}}, {"ambient_intensity", {ia.x, ia.y, ia.z}},
-                {"lights", renderer.lights().names}, {"bands", renderer.layout().bandCount()}},
+                {"lights", renderer.lights().names}, {"bands", renderer.layout().bandCount()},
+                {"denoise", denoiseJson}},
                &display);
 }
 
@@ -230,6 +256,9 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--save-state", options->saveState,
                   "write the relighting state to this folder (per-light transport as EXR layers + JSON), for "
                   "'obscura relight DIR'");
+  cmd->add_flag("--denoise", options->denoise,
+                 "denoise the obscurance frame (render/denoise/: demodulated direct and ambient terms, edge-aware "
+                 "a-trous filter): the PNG of combined shows it, the EXR gets a `denoised` layer");
   addDeviceOptions(*cmd, options->device);
   cmd->callback([options] { runRender(*options); });
 }

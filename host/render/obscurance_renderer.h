@@ -174,6 +174,8 @@ public:
   std::vector<std::uint32_t> sampleCounts() const;
   const ObscuranceSettings& settings() const { return settings_; }
   const FrameLayout& layout() const { return frame_.layout(); }
+  // The frame's buffers, for passes outside the renderer that read them (the denoiser).
+  const ObscuranceFrame& frame() const { return frame_; }
   bool specular() const { return runSpecular_; }
   // Per-pass GPU ms and rays since the last reset, wall time, memory, truncations, notes.
   RenderStats stats() const;

@@ -427,6 +427,67 @@ OBS_CONST uint kBindingClearSpecularBasis = 3;
 OBS_CONST uint kBindingClearSpecularAmbient = 4;
 OBS_CONST uint kClearBindingCount = 5;
 
+// ---- The denoiser (host/render/denoise/, shaders/denoise_*.comp): SVGF-style filtering (Schied et
+// al., "Spatiotemporal Variance-Guided Filtering", HPG 2017) of the demodulated direct and ambient
+// terms and of the specular paths' light. Its buffers cover the whole frame (gathered from the
+// bands) in RGBA32UI texels, which the filter reads through uniform texel buffers (on lavapipe a
+// texel gathers 16 bytes per lane at once where an SSBO load costs one scalar load per lane and word):
+//   guide  one texel: x = octahedral shading normal (snorm16 x 2), y = depth (float bits; 0 = no
+//          hit), z = albedo r, g (half x 2), w = albedo b (half, low 16 bits), material (high 16)
+//   illum  two texels (2p, 2p + 1): x, y, z = direct rgb then ambient rgb, demodulated, w = their
+//          luminance variances (halves); then specular rgb and its variance (halves, x and y),
+//          z unused, w = the samples the terms count for (float bits)
+struct DenoiseParams {
+  GpuCamera camera;   // 0:   the current view (gpuCamera; up.w unused)
+  GpuCamera previous; // 64:  the view the history was made with
+  uvec4 frame;        // 128: width, height, the most samples a reprojected history counts for,
+                      //      1 when the frame has specular paths (else the specular term is 0)
+  vec4 weights;       // 144: sigma plane (pixels), sigma albedo, sigma luminance, unused
+};                    // 160 bytes (> 128: bound as a storage buffer, not push constants)
+// Demodulation divides by max(albedo, kDenoiseAlbedoFloor) and remodulation multiplies by the same,
+// so a black surface passes through unchanged.
+OBS_CONST float kDenoiseAlbedoFloor = 0.01f;
+OBS_CONST uint kDenoiseNoMaterial = 0xFFFFu; // the guide's material on a pixel without a hit
+OBS_CONST uint kDenoiseIllumTexels = 2;      // texels per pixel of an illum buffer
+
+struct DenoisePush {
+  uvec4 params; // 0: gather: first row of the band, rows, composed slots, unused; a-trous: step, unused...
+};              // 16 bytes
+
+// Bindings, each pass its own set; binding 0 is the DenoiseParams of every pass.
+OBS_CONST uint kBindingDenoiseParams = 0;
+// denoise_gather.comp: the band's composed AOVs, primary AOVs and sample counts -> frame buffers
+OBS_CONST uint kBindingGatherComposed = 1;     // vec4[pixel * slots] (compose.comp)
+OBS_CONST uint kBindingGatherAovs = 2;         // vec4 pairs [pixel * kAovSlots + slot] (primary.comp)
+OBS_CONST uint kBindingGatherSampleCounts = 3; // uint[pixel]
+OBS_CONST uint kBindingGatherGuide = 4;        // uvec4[frame pixel] out: guide
+OBS_CONST uint kBindingGatherIllum = 5;        // uvec4[2 x frame pixel] out: illum, samples = n
+OBS_CONST uint kBindingGatherEmission = 6;     // vec4[frame pixel] out: seen emission (not filtered)
+OBS_CONST uint kGatherBindingCount = 7;
+// denoise_reproject.comp: the history seen from the current camera
+OBS_CONST uint kBindingReprojectGuide = 1;        // texels: the current guide
+OBS_CONST uint kBindingReprojectHistoryGuide = 2; // texels: the history's guide
+OBS_CONST uint kBindingReprojectHistory = 3;      // texels: the history's illum (temporal output)
+OBS_CONST uint kBindingReprojectCarry = 4;        // uvec4[2 x pixel] out: illum, samples = h
+OBS_CONST uint kReprojectBindingCount = 5;
+// denoise_temporal.comp: current mean + carry, and the luminance variances
+OBS_CONST uint kBindingTemporalGuide = 1;  // texels: guide
+OBS_CONST uint kBindingTemporalNoisy = 2;  // texels: the gathered illum
+OBS_CONST uint kBindingTemporalCarry = 3;  // uvec4[2 x pixel]: carry
+OBS_CONST uint kBindingTemporalOut = 4;    // uvec4[2 x pixel] out: illum with variances, samples n + h
+OBS_CONST uint kTemporalBindingCount = 5;
+// denoise_atrous.comp: one wavelet iteration
+OBS_CONST uint kBindingAtrousGuide = 1; // texels: guide
+OBS_CONST uint kBindingAtrousIn = 2;    // texels: illum
+OBS_CONST uint kBindingAtrousOut = 3;   // uvec4[2 x pixel] out: illum
+OBS_CONST uint kAtrousBindingCount = 4;
+// denoise_remodulate.comp: x albedo + specular + emission -> linear combined (tonemap.comp's input)
+OBS_CONST uint kBindingRemodulateGuide = 1;    // texels: guide
+OBS_CONST uint kBindingRemodulateIllum = 2;    // texels: illum
+OBS_CONST uint kBindingRemodulateEmission = 3; // vec4[pixel]
+OBS_CONST uint kBindingRemodulateOut = 4;      // vec4[pixel] out: combined
+OBS_CONST uint kRemodulateBindingCount = 5;
+
 // ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,
 // then its Kahan compensation), so accumulation buffers hold kAccumulatorVec4s vec4 per entry.
 OBS_CONST uint kAccumulatorVec4s = 2;

@@ -10,8 +10,12 @@ TonemapPass::TonemapPass(const gpu::Context& context, std::uint32_t bands)
     : kernel_(context, gpu::storageKernelDesc("tonemap", kSpirv_tonemap, gpu::kTonemapBindingCount, sizeof(gpu::TonemapPush), bands)) {}
 
 void TonemapPass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
-  kernel_.bind(gpu::kBindingTonemapInput, frame.band(band).composed, band);
-  kernel_.bind(gpu::kBindingTonemapOutput, frame.band(band).display, band);
+  bind(band, frame.band(band).composed, frame.band(band).display);
+}
+
+void TonemapPass::bind(std::uint32_t band, const gpu::Buffer& composed, const gpu::Buffer& display) {
+  kernel_.bind(gpu::kBindingTonemapInput, composed, band);
+  kernel_.bind(gpu::kBindingTonemapOutput, display, band);
 }
 
 void TonemapPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
