@@ -71,6 +71,7 @@ struct Viewer::FrameRecord {
   std::uint64_t rays = 0;      // traced this frame: edits, samples
   double gpuMs = 0.0;          // the renderer's GPU time this frame (its passes' timestamps)
   double renderMs = 0.0;       // wall time of the edits, the samples and the compose
+  double denoiseMs = 0.0;      // the denoiser's GPU time (0 when it did not run)
   double presentMs = 0.0;      // wall time of the panel and the presentation
   double frameMs = 0.0;
   std::vector<std::string> actions;
@@ -100,6 +101,7 @@ Viewer::Viewer(const gpu::ContextOptions& device, scene::Scene scene, bvh::Bvh b
   config_.obscurance = settings;
   renderer_ = std::make_unique<render::ObscuranceRenderer>(context_, scenes_.back(), bvhs_.back(), settings);
   renderer_->configure(fullSettings());
+  denoiser_ = std::make_unique<render::Denoiser>(context_, *renderer_);
   const auto& names = renderer_->lights().names;
   for (std::size_t i = 0; i < names.size(); ++i)
     lights_.push_back({.name = names[i], .base = renderer_->emissions()[i]});
@@ -117,7 +119,10 @@ render::ObscuranceSettings Viewer::fullSettings() const {
   return s;
 }
 
-void Viewer::restart(bool preview) {
+void Viewer::restart(bool preview, bool cameraOnly) {
+  // A camera move keeps the denoiser's history (it is reprojected); anything else changed the
+  // image itself.
+  if (!cameraOnly) forgetHistory_ = true;
   render::ObscuranceSettings s = fullSettings();
   if (preview) {
     s.shadowRays = std::min(s.shadowRays, 1u);
@@ -138,6 +143,7 @@ std::size_t Viewer::lightIndex(const std::string& name) const {
 }
 
 void Viewer::updateEmissions() {
+  forgetHistory_ = true;
   std::vector<glm::vec3> emissions;
   for (const auto& l : lights_) emissions.push_back(l.base * l.scale * l.color);
   renderer_->setEmissions(emissions);
@@ -158,6 +164,7 @@ void Viewer::moveObject(std::size_t object, glm::vec3 translate, FrameRecord& re
   // With the preview's rays in the frame, the retrace must use the same; after it the older scenes
   // are no longer referenced.
   record.retraced = renderer_->updateGeometry(scenes_.back(), bvhs_.back(), changed);
+  forgetHistory_ = true;
   while (scenes_.size() > 1) {
     scenes_.pop_front();
     bvhs_.pop_front();
@@ -272,7 +279,7 @@ void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
     if (a.count >= cameras.size())
       throw InputError(fmt::format("camera {}: the scene has {} camera(s)", a.count, cameras.size()));
     camera_.setCamera(cameras[a.count]);
-    restart(false);
+    restart(false, true);
     record.restarted = true;
     record.actions.push_back("camera");
     break;
@@ -289,7 +296,7 @@ void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
     break;
   case Kind::LoadView:
     camera_.setCamera(loadView(a.name));
-    restart(false);
+    restart(false, true);
     record.restarted = true;
     status_ = fmt::format("view loaded from {}", a.name);
     record.actions.push_back("load_view");
@@ -352,7 +359,7 @@ void Viewer::renderStep(FrameRecord& record) {
   }
 
   if (previewShown_ && !record.preview) {
-    restart(false); // the preview is over: full rays from sample 0
+    restart(false, true); // the preview is over: full rays from sample 0, the same view
     record.restarted = true;
   }
   if (renderer_->samples() < maxSamples) {
@@ -399,6 +406,7 @@ PanelState Viewer::panelState() const {
   s.frameMs = lastFrameMs_;
   const auto stats = currentStats();
   s.passes = stats.passes;
+  if (config_.denoise && config_.method == "obscurance") s.passes["denoise (last frame)"] = {denoiser_->lastGpuMs(), 0};
   const double ms = totalGpuMs(stats);
   s.raysPerSecond = ms > 0 ? double(totalRays(stats)) / (ms * 1e-3) : 0.0;
   for (const auto& l : lights_) s.lights.push_back({l.name, l.scale, l.color, l.added, l.light.position});
@@ -426,6 +434,7 @@ void Viewer::writeLog(const FrameRecord& r) {
                          {"rays", r.rays},
                          {"gpu_ms", r.gpuMs},
                          {"render_ms", r.renderMs},
+                         {"denoise_ms", r.denoiseMs},
                          {"present_ms", r.presentMs},
                          {"frame_ms", r.frameMs},
                          {"actions", r.actions}};
@@ -435,6 +444,7 @@ void Viewer::writeLog(const FrameRecord& r) {
 
 io::Image Viewer::shownImage() {
   if (config_.method == "pathtrace") return pathTracer_->image();
+  if (config_.aov == "combined" && config_.denoise) return denoiser_->image();
   renderer_->compose(config_.exposure);
   return renderer_->image();
 }
@@ -523,7 +533,7 @@ void Viewer::run() {
       }
     }
     if (camera_.update(input, seconds)) {
-      restart(true);
+      restart(true, true);
       record.preview = true;
       record.restarted = true;
     }

@@ -21,6 +21,7 @@
 
 #include "bvh/bvh.h"
 #include "gpu/context.h"
+#include "render/denoise/denoiser.h"
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
 #include "scene/scene.h"
@@ -42,7 +43,7 @@ struct ViewerConfig {
   std::string method = "obscurance";     // or "pathtrace"
   std::string aov = "combined";
   float exposure = 0.0f;
-  bool denoise = true;
+  bool denoise = true;                   // the denoiser (render/denoise/) on the combined image
   bool panel = true;
   std::size_t frames = 0;                // frames to show, then exit; 0: until the window closes
   std::string screenshot;                // the last frame, as shown (PNG), or linear (EXR)
@@ -64,8 +65,9 @@ private:
   struct FrameRecord; // what one frame did, for the log and the panel
   void apply(const ViewerAction& action, FrameRecord& record);
   void applyWindowEvent(const ScriptEvent& event);
-  // Restarts accumulation with the current settings (and camera).
-  void restart(bool preview);
+  // Restarts accumulation with the current settings (and camera); `cameraOnly`: only the view
+  // changed (the denoiser's history is then reprojected, not forgotten).
+  void restart(bool preview, bool cameraOnly = false);
   void renderStep(FrameRecord& record);
   std::vector<std::uint32_t> displayBytes();
   // The object under window pixel (x, y), from the primitive AOV; -1 for none.
@@ -99,6 +101,10 @@ private:
   CameraController camera_;
   std::unique_ptr<render::ObscuranceRenderer> renderer_;
   std::unique_ptr<render::PathTracer> pathTracer_; // made when first shown, again after edits
+  // The denoiser of the obscurance frame (on by default): its history follows the camera; any
+  // other change forgets it (forgetHistory_).
+  std::unique_ptr<render::Denoiser> denoiser_;
+  bool forgetHistory_ = true;
 
   struct LightControl {
     std::string name;
