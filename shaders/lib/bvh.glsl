@@ -115,9 +115,9 @@ uint groupChild(uvec2 group, uint octant, out uint bit) {
 // left (StepBudget below), so the sum stays under kMaxTraversalSteps.
 //
 // A pass: the triangle half tests the next triangle of the triangle group; the node half visits
-// the next child of the node group, but only when the triangle group is then empty, because the
-// visited node's leaves become the next triangle group. A node's interior children hit form a
-// new node group; what is left of the old one is pushed.
+// the next child of the node group, as long as the one-deep queue of triangle groups behind it
+// is free, because the visited node's leaf triangles hit become a triangle group. A node's
+// interior children hit form a new node group; what is left of the old one is pushed.
 //
 // The stack: on lavapipe a per-lane, dynamically indexed array costs ~40 ns per 8-lane pass even
 // where no lane touches it (masked gathers/scatters run anyway). So the main loop keeps the top
@@ -142,7 +142,8 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   // The root as the one interior slot (slot 0) of a virtual parent whose first child is node 0.
   const uvec2 kRootGroup = uvec2(0u, (1u << octant) | (1u << 8));
   uvec2 group = kRootGroup;
-  uint triangleBase = 0u, triangleBits = 0u;
+  uint triangleBase = 0u, triangleBits = 0u; // the triangle group being tested
+  uint queuedBase = 0u, queuedBits = 0u;      // the next one (empty while the first is)
   // Register stack: entries e0 (top) .. e7 as (s0.xy, s0.zw, s1.xy, ..., s3.zw).
   uvec4 s0 = uvec4(0u), s1 = uvec4(0u), s2 = uvec4(0u), s3 = uvec4(0u);
   uint stackSize = 0u;
@@ -156,7 +157,12 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     bool onTriangle = triangleBits != 0u;
     uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
     triangleBits &= triangleBits - 1u;
-    bool onNode = (group.y & 0xFFu) != 0u && triangleBits == 0u;
+    if (triangleBits == 0u) { // the queued triangle group moves up
+      triangleBase = queuedBase;
+      triangleBits = queuedBits;
+      queuedBits = 0u;
+    }
+    bool onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
     uint bit;
     uint node = groupChild(group, octant, bit);
     int tb = onTriangle ? int(triangle) : 0;
@@ -186,8 +192,13 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     if (onNode) {
       group.y &= ~bit;
       NodeVisit visit = visitNode(n0, n1, n2, n3, n4, origin, invDir, negative, octant, tmin, hit.t);
-      triangleBase = visit.triangleBase;
-      triangleBits = visit.triangleBits;
+      if (triangleBits == 0u) {
+        triangleBase = visit.triangleBase;
+        triangleBits = visit.triangleBits;
+      } else {
+        queuedBase = visit.triangleBase;
+        queuedBits = visit.triangleBits;
+      }
       if ((visit.group.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
           if (stackSize == kBvhRegisterStack) {
@@ -228,6 +239,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   stackSize = 0u;
   group = kRootGroup;
   triangleBits = 0u;
+  queuedBits = 0u;
   while (overflow) {
     if (hit.steps >= maxSteps) {
       hit.primitive = kTruncatedHit;
@@ -237,7 +249,12 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     bool onTriangle = triangleBits != 0u;
     uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
     triangleBits &= triangleBits - 1u;
-    bool onNode = (group.y & 0xFFu) != 0u && triangleBits == 0u;
+    if (triangleBits == 0u) { // the queued triangle group moves up
+      triangleBase = queuedBase;
+      triangleBits = queuedBits;
+      queuedBits = 0u;
+    }
+    bool onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
     uint bit;
     uint node = groupChild(group, octant, bit);
     int tb = onTriangle ? int(triangle) : 0;
@@ -267,8 +284,13 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     if (onNode) {
       group.y &= ~bit;
       NodeVisit visit = visitNode(n0, n1, n2, n3, n4, origin, invDir, negative, octant, tmin, hit.t);
-      triangleBase = visit.triangleBase;
-      triangleBits = visit.triangleBits;
+      if (triangleBits == 0u) {
+        triangleBase = visit.triangleBase;
+        triangleBits = visit.triangleBits;
+      } else {
+        queuedBase = visit.triangleBase;
+        queuedBits = visit.triangleBits;
+      }
       if ((visit.group.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) stack[stackSize++] = group; // the push site
         group = visit.group;
