@@ -10,8 +10,8 @@
 //   2. buildRange(): per node, decide leaf / SAH split / median split (depth bound) / index split
 //      (no valid SAH split), partition the refs, recurse; big subtrees run on their own thread.
 //      Nodes go into a scratch array at indices that depend only on the range (no locks).
-//   3. flatten(): depth-first walk writing gpu::BvhNode (child 0 right after its parent),
-//      gpu::BvhTriangle in leaf order and the statistics.
+//   3. writeWide(): collapse into 8-wide compressed nodes (gpu::BvhNode, wide_node.h), the
+//      triangles in the order the wide leaves need them, and the statistics.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "bvh/bvh.h"
+#include "bvh/wide_node.h"
 
 namespace obscura::bvh {
 namespace {
@@ -122,8 +123,9 @@ public:
   Bvh run() {
     const auto start = std::chrono::steady_clock::now();
     const std::uint32_t n = static_cast<std::uint32_t>(soup_.size());
-    if (soup_.size() > gpu::kLeafFirstMask)
-      throw std::length_error("bvh::build: too many triangles for the leaf reference encoding");
+    // A triangle's GPU texel index (host_device.h) must fit an int.
+    if (soup_.size() > 0x1FFFFFFFu)
+      throw std::length_error("bvh::build: too many triangles for the GPU layout");
 
     Bvh bvh;
     if (n == 0) {
@@ -133,7 +135,7 @@ public:
       makeRefs(box, centroids);
       nodes_.resize(2 * static_cast<std::size_t>(n) - 1);
       buildRange(0, 0, n, 0, box, centroids, 0);
-      flatten(bvh);
+      writeWide(bvh);
     }
     bvh.stats.medianFallbacks = medianFallbacks_.load();
     bvh.stats.buildSeconds =
@@ -408,99 +410,156 @@ private:
     }
   }
 
-  // ---- 3. GPU layout.
-  static std::uint32_t leafRef(std::uint32_t first, std::uint32_t count) {
-    return gpu::kLeafFlag | ((count - 1) << gpu::kLeafCountShift) | first;
-  }
-  static void setChild(gpu::BvhNode& node, int which, const Aabb& box, std::uint32_t ref) {
-    gpu::vec4& lo = which == 0 ? node.lo0 : node.lo1;
-    gpu::vec4& hi = which == 0 ? node.hi0 : node.hi1;
-    lo = gpu::vec4(box.lo, lo.w);
-    hi = gpu::vec4(box.hi, hi.w);
-    // Both refs ride in child 0's .w components (host_device.h).
-    (which == 0 ? node.lo0.w : node.hi0.w) = std::bit_cast<float>(ref);
-  }
-  // The never-hit child, guarded twice: an inverted box (lo = +inf, hi = -inf), which a slab test
-  // picking near/far planes by the direction's sign always rejects (but a min/max slab test
-  // does NOT: min/max reorder the planes and the box spans everything), and the ref
-  // gpu::kInvalidIndex, which a traversal can test for (shaders/lib/bvh.glsl does). Never a
-  // well-formed leaf ref pointing at triangle 0, which an empty soup does not have.
-  static void setEmptyChild(gpu::BvhNode& node, int which) {
-    setChild(node, which, Aabb{}, gpu::kInvalidIndex);
-  }
-
-  void writeEmptyRoot(Bvh& bvh) const {
-    gpu::BvhNode root{};
-    setEmptyChild(root, 0);
-    setEmptyChild(root, 1);
-    bvh.nodes.push_back(root);
-    bvh.stats.nodeCount = 1;
-    bvh.stats.maxDepth = 0;
-  }
-
-  void flatten(Bvh& bvh) {
-    const std::uint32_t n = static_cast<std::uint32_t>(refs_.size());
-    bvh.triangles.resize(n);
-    bvh.order.resize(n);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      const std::uint32_t id = refs_[i].id;
-      bvh.order[i] = id;
-      bvh.triangles[i].v0 = gpu::vec4(soup_.v0[id], std::bit_cast<float>(id));
-      bvh.triangles[i].v1 = gpu::vec4(soup_.v1[id], 0.0f);
-      bvh.triangles[i].v2 = gpu::vec4(soup_.v2[id], 0.0f);
-    }
-
-    rootArea_ = nodes_[0].box.area();
-    nodes_out_ = &bvh.nodes;
-    stats_ = &bvh.stats;
-    bvh.nodes.reserve(n); // at most n - 1 interior nodes (+ the root of a one-leaf tree)
-    sah_ = 0.0;
-
+  // ---- 3. Wide layout: collapse the binary tree into 8-wide nodes (Ylitie, Karras & Laine
+  // 2017, §3.2, with a greedy rule instead of their dynamic programme: a wide node starts with
+  // its binary node's two children and repeatedly opens the interior child of largest surface
+  // area, as long as its slots allow). Wide nodes are emitted breadth-first, so a node's interior
+  // children are consecutive and come after it (refit walks them backwards), and the triangles
+  // of a node's leaf children are consecutive, in the order the traversal's bit masks need them.
+  void writeWide(Bvh& bvh) {
     const TempNode& root = nodes_[0];
+    rootArea_ = root.box.area();
+    sah_ = 0.0;
+    std::vector<std::uint32_t> pending = {0}; // binary slot of each wide node, by wide index
+    std::vector<std::uint32_t> depth = {0};
+    bvh.triangles.reserve(refs_.size());
+    bvh.order.reserve(refs_.size());
     if (root.count > 0) {
-      // One leaf: a root node with the leaf as child 0 and a never-hit child 1.
-      gpu::BvhNode node{};
-      setChild(node, 0, root.box, leafRef(root.first, root.count));
-      setEmptyChild(node, 1);
-      bvh.nodes.push_back(node);
+      // A one-leaf tree: a root whose only child is the leaf.
+      std::array<WideChild, gpu::kBvhWidth> slots{};
+      slots[0] = leafChild(root, bvh);
+      bvh.nodes.emplace_back();
+      writeWideNode(bvh.nodes[0], slots, 0, 0);
       bvh.stats.leafCount = 1;
       bvh.stats.maxDepth = 1;
       sah_ = double{options_.traversalCost} * areaRatio(root.box) +
              double{options_.intersectionCost} * root.count * areaRatio(root.box);
-    } else {
-      emit(0, 1);
     }
+    for (std::size_t w = 0; w < pending.size() && root.count == 0; ++w) {
+      std::vector<std::uint32_t> children = openChildren(pending[w]);
+      const std::array<int, gpu::kBvhWidth> slotOf = assignOctantSlots(pending[w], children);
+      std::array<WideChild, gpu::kBvhWidth> slots{};
+      const auto firstTriangle = static_cast<std::uint32_t>(bvh.triangles.size());
+      const auto firstChild = static_cast<std::uint32_t>(pending.size());
+      for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
+        if (slotOf[s] < 0) continue;
+        const std::uint32_t c = children[static_cast<std::size_t>(slotOf[s])];
+        if (nodes_[c].count > 0) {
+          slots[s] = leafChild(nodes_[c], bvh);
+          slots[s].triangleOffset = slots[s].triangleOffset - firstTriangle;
+          ++bvh.stats.leafCount;
+          bvh.stats.maxDepth = std::max(bvh.stats.maxDepth, depth[w] + 1);
+        } else {
+          slots[s].kind = WideChild::Kind::Internal;
+          slots[s].box = toBox(nodes_[c].box);
+          pending.push_back(c);
+          depth.push_back(depth[w] + 1);
+        }
+      }
+      if (bvh.nodes.size() < pending.size()) bvh.nodes.resize(pending.size());
+      writeWideNode(bvh.nodes[w], slots, firstChild, firstTriangle);
+    }
+    if (root.count == 0) addBinarySah(0);
     bvh.stats.nodeCount = static_cast<std::uint32_t>(bvh.nodes.size());
     bvh.stats.sahCost = sah_;
+  }
+
+  static Box toBox(const Aabb& a) { return Box{a.lo, a.hi}; }
+
+  // Appends a binary leaf's triangles; returns its slot (triangleOffset = absolute first index).
+  WideChild leafChild(const TempNode& leaf, Bvh& bvh) const {
+    WideChild c;
+    c.kind = WideChild::Kind::Leaf;
+    c.box = toBox(leaf.box);
+    c.triangleOffset = static_cast<std::uint32_t>(bvh.triangles.size());
+    c.triangleCount = leaf.count;
+    for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i) {
+      const std::uint32_t id = refs_[i].id;
+      bvh.order.push_back(id);
+      bvh.triangles.push_back({.v0 = gpu::vec4(soup_.v0[id], std::bit_cast<float>(id)),
+                               .v1 = gpu::vec4(soup_.v1[id], 0.0f),
+                               .v2 = gpu::vec4(soup_.v2[id], 0.0f)});
+    }
+    return c;
+  }
+
+  // The binary nodes that become the children of the wide node made from interior `slot`.
+  std::vector<std::uint32_t> openChildren(std::uint32_t slot) const {
+    std::vector<std::uint32_t> children = {nodes_[slot].child[0], nodes_[slot].child[1]};
+    while (children.size() < gpu::kBvhWidth) {
+      int widest = -1;
+      float widestArea = -1.0f;
+      for (std::size_t i = 0; i < children.size(); ++i) {
+        const TempNode& c = nodes_[children[i]];
+        if (c.count == 0 && c.box.area() > widestArea) {
+          widestArea = c.box.area();
+          widest = static_cast<int>(i);
+        }
+      }
+      if (widest < 0) break;
+      const TempNode& opened = nodes_[children[static_cast<std::size_t>(widest)]];
+      children[static_cast<std::size_t>(widest)] = opened.child[0];
+      children.push_back(opened.child[1]);
+    }
+    return children;
+  }
+
+  // slotOf[s] = index into `children` placed in slot s, or -1. Slot bit k means "on the + side of
+  // axis k" (host_device.h): greedily, the (child, slot) pair whose slot direction best matches
+  // the child's offset from the parent's centre is placed first (Ylitie et al. 2017, §3.2).
+  std::array<int, gpu::kBvhWidth> assignOctantSlots(std::uint32_t parent,
+                                                   const std::vector<std::uint32_t>& children) const {
+    const Aabb& p = nodes_[parent].box;
+    const glm::vec3 centre = 0.5f * (p.lo + p.hi);
+    struct Pair { float cost; int child; int slot; };
+    std::vector<Pair> pairs;
+    for (std::size_t i = 0; i < children.size(); ++i) {
+      const Aabb& b = nodes_[children[i]].box;
+      const glm::vec3 offset = 0.5f * (b.lo + b.hi) - centre;
+      for (int s = 0; s < static_cast<int>(gpu::kBvhWidth); ++s) {
+        const glm::vec3 dir((s & 1) ? 1.0f : -1.0f, (s & 2) ? 1.0f : -1.0f, (s & 4) ? 1.0f : -1.0f);
+        pairs.push_back({-glm::dot(offset, dir), static_cast<int>(i), s});
+      }
+    }
+    std::stable_sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) { return a.cost < b.cost; });
+    std::array<int, gpu::kBvhWidth> slotOf;
+    slotOf.fill(-1);
+    std::vector<bool> placed(children.size(), false);
+    for (const Pair& pr : pairs) {
+      if (placed[static_cast<std::size_t>(pr.child)] || slotOf[static_cast<std::size_t>(pr.slot)] >= 0) continue;
+      placed[static_cast<std::size_t>(pr.child)] = true;
+      slotOf[static_cast<std::size_t>(pr.slot)] = pr.child;
+    }
+    return slotOf;
+  }
+
+  // SAH cost of the binary tree below interior `slot` (the statistic; root area = 1).
+  void addBinarySah(std::uint32_t slot) {
+    std::vector<std::uint32_t> todo = {slot};
+    while (!todo.empty()) {
+      const TempNode& t = nodes_[todo.back()];
+      todo.pop_back();
+      if (t.count > 0) {
+        sah_ += double{options_.intersectionCost} * t.count * areaRatio(t.box);
+        continue;
+      }
+      sah_ += double{options_.traversalCost} * areaRatio(t.box);
+      todo.push_back(t.child[0]);
+      todo.push_back(t.child[1]);
+    }
+  }
+
+  void writeEmptyRoot(Bvh& bvh) const {
+    bvh.nodes.emplace_back();
+    writeWideNode(bvh.nodes[0], {}, 0, 0);
+    bvh.stats.nodeCount = 1;
+    bvh.stats.maxDepth = 0;
   }
 
   // Area relative to the root for the SAH statistic; a zero-area root (all triangles on one line
   // or point) makes every ratio 0/0, counted as 1.
   double areaRatio(const Aabb& b) const {
     return rootArea_ > 0.0 ? static_cast<double>(b.area()) / rootArea_ : 1.0;
-  }
-
-  // Writes scratch interior node `slot` whose children sit at depth `childDepth`; returns its
-  // GPU index. Child 0's subtree follows its parent directly (depth-first order).
-  std::uint32_t emit(std::uint32_t slot, std::uint32_t childDepth) {
-    const TempNode& t = nodes_[slot];
-    const std::uint32_t index = static_cast<std::uint32_t>(nodes_out_->size());
-    nodes_out_->push_back(gpu::BvhNode{});
-    sah_ += double{options_.traversalCost} * areaRatio(t.box);
-    for (int c = 0; c < 2; ++c) {
-      const TempNode& child = nodes_[t.child[c]];
-      std::uint32_t ref;
-      if (child.count > 0) {
-        ref = leafRef(child.first, child.count);
-        ++stats_->leafCount;
-        stats_->maxDepth = std::max(stats_->maxDepth, childDepth);
-        sah_ += double{options_.intersectionCost} * child.count * areaRatio(child.box);
-      } else {
-        ref = emit(t.child[c], childDepth + 1);
-      }
-      setChild((*nodes_out_)[index], c, child.box, ref);
-    }
-    return index;
   }
 
   const TriangleSoup& soup_;
@@ -513,9 +572,7 @@ private:
   std::vector<TempNode> nodes_;
   std::atomic<std::uint32_t> medianFallbacks_{0};
 
-  // flatten() state
-  std::vector<gpu::BvhNode>* nodes_out_ = nullptr;
-  BuildStats* stats_ = nullptr;
+  // writeWide() state
   double sah_ = 0.0;
   double rootArea_ = 0.0;
 };

@@ -1,9 +1,9 @@
 // bvh.h — bounding volume hierarchy over a triangle soup: build, GPU layout, CPU traversal.
 //
 // The builder is binned SAH (Wald, "On fast Construction of SAH-based Bounding Volume
-// Hierarchies", 2007), parallel over subtrees. The GPU layout is a BVH2 whose nodes hold both
-// children's boxes (Aila & Laine 2009), see shaders/shared/host_device.h. The CPU traversal is the
-// reference the GPU is tested against.
+// Hierarchies", 2007), parallel over subtrees, collapsed into 8-wide nodes with 8-bit quantised
+// child boxes (Ylitie, Karras & Laine 2017), see shaders/shared/host_device.h and wide_node.h. The
+// CPU traversal walks the same wide nodes and is the reference the GPU is tested against.
 #pragma once
 #include <cstdint>
 #include <limits>
@@ -20,16 +20,16 @@ struct BuildOptions {
   int bins = 16;                 // SAH bins per axis
   float traversalCost = 1.0f;    // SAH cost of visiting one node, relative to...
   float intersectionCost = 1.0f; // ...the cost of testing one triangle
-  std::uint32_t maxLeafSize = 8; // <= gpu::kLeafMaxTriangles
+  std::uint32_t maxLeafSize = 3; // <= gpu::kLeafMaxTriangles
   unsigned threads = 0;          // 0 = hardware concurrency
 };
 
 struct BuildStats {
   double buildSeconds = 0.0;
-  std::uint32_t nodeCount = 0;   // interior nodes in the GPU layout
-  std::uint32_t leafCount = 0;
-  std::uint32_t maxDepth = 0;    // <= gpu::kBvhMaxDepth, always
-  double sahCost = 0.0;          // total SAH cost with the options' costs (root area = 1)
+  std::uint32_t nodeCount = 0;   // wide nodes in the GPU layout
+  std::uint32_t leafCount = 0;   // leaf children (of 1..maxLeafSize triangles)
+  std::uint32_t maxDepth = 0;    // of the wide tree (root's children: 1); <= gpu::kBvhMaxDepth, always
+  double sahCost = 0.0;          // SAH cost of the binary tree before collapsing (root area = 1)
   std::uint32_t medianFallbacks = 0; // nodes split by median to honour the depth bound
 };
 
@@ -40,14 +40,12 @@ struct TriangleSoup {
 };
 
 struct Bvh {
-  // GPU layout, ready to upload: nodes[0] is the root. A scene of ONE leaf still has a root node
-  // (with an empty second child whose box is inverted, so it is never hit).
-  // The empty child (both children of an empty soup's root) has the box lo = +inf, hi = -inf and
-  // the ref gpu::kInvalidIndex; a traversal must skip a kInvalidIndex ref (a min/max slab test
-  // alone would "hit" the inverted box). Only the root can have empty children. An empty soup
-  // leaves `triangles` empty: pad the GPU buffer, Vulkan buffers cannot have size 0.
+  // GPU layout, ready to upload: nodes[0] is the root, a wide node even for a scene of one leaf
+  // (one used slot) or none (no used slot). A node's interior children are consecutive and
+  // follow it (breadth-first order). An empty soup leaves `triangles` empty: pad the GPU
+  // buffer, Vulkan buffers cannot have size 0.
   std::vector<gpu::BvhNode> nodes;
-  std::vector<gpu::BvhTriangle> triangles; // in leaf order; .v0.w = original index as float bits
+  std::vector<gpu::BvhTriangle> triangles; // in the order leaves need them; .v0.w = original index as float bits
   std::vector<std::uint32_t> order;        // order[i] = original index of triangles[i]
   BuildStats stats;
 };
@@ -57,7 +55,7 @@ struct Bvh {
 Bvh build(const TriangleSoup& soup, const BuildOptions& options = {});
 
 // Refits `bvh` to the moved vertices of the same triangles (`soup` indexed as when it was built):
-// the tree keeps its topology, every box is recomputed bottom-up. Linear in the size, so an object
+// the tree keeps its topology, every box is recomputed bottom-up and quantised again. Linear in the size, so an object
 // edit updates the structure without a rebuild; the tree's quality degrades with large moves
 // (measured in docs/BENCHMARKS.md), and a rebuild restores it.
 void refit(Bvh& bvh, const TriangleSoup& soup);

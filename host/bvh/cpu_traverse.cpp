@@ -1,8 +1,9 @@
-// cpu_traverse.cpp — reference traversal of the GPU-layout BVH, and the brute-force oracle.
+// cpu_traverse.cpp — reference traversal of the wide BVH, and the brute-force oracle.
 //
-// Stack traversal of a BVH2 whose nodes hold both children's boxes (Aila & Laine, "Understanding
-// the Efficiency of Ray Traversal on GPUs", 2009): test both boxes, continue with the nearer hit
-// child, push the farther. Each interior node on the path pushes at most one entry, so a stack of
+// The child boxes are tested exactly as shaders/lib/bvh.glsl tests them (wide_node.h:
+// hitChildren), and interior children are visited in the same octant order; the GPU's pass
+// structure (one node and one triangle per loop pass) is its own business. Each node visited
+// pushes at most one entry (a node group: first child, pending slots), so a stack of
 // kBvhStackSize >= kBvhMaxDepth entries cannot overflow.
 #include <bit>
 #include <cmath>
@@ -10,120 +11,61 @@
 
 #include "bvh/bvh.h"
 #include "bvh/triangle_intersect.h"
+#include "bvh/wide_node.h"
 
 namespace obscura::bvh {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
+// Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013: the far distance of a box is scaled by
+// 1 + 2 gamma(3) inside hitChildren(), which makes the float slab test conservative; we pass the
+// current best t itself, so a triangle lying on its box's face whose t equals the best t (a tie,
+// won by the lower primitive id) is not culled by rounding.
 
-// Pharr, Jakob & Humphreys, "Physically Based Rendering" 3rd ed. §3.9.1: gamma(n) bounds the
-// relative error of n chained float operations.
-constexpr float gamma(int n) {
-  constexpr float e = std::numeric_limits<float>::epsilon() * 0.5f;
-  return static_cast<float>(n) * e / (1.0f - static_cast<float>(n) * e);
-}
-// Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013: scaling the far distance by 1 + 2 gamma(3)
-// makes the slab test conservative, so a box is never missed by a ray that hits a triangle in it.
-// We scale the current best t by the same factor, so that a triangle lying on its box's face
-// whose t equals the best t (a tie, won by the lower primitive id) is not culled by rounding.
-constexpr float kFarScale = 1.0f + 2.0f * gamma(3);
-
-struct BoxRay {
-  glm::vec3 origin;
-  glm::vec3 invDir;  // 1/d, +-inf for zero components
-  int nearIsHi[3];   // per axis: is the near plane the box's hi side?
+// A node group: interior children of node `node` not visited yet, as a bit mask over visit
+// order (bit k = slot k ^ octant), as the GPU keeps it.
+struct Group {
+  std::uint32_t node;
+  std::uint32_t pending;
 };
 
-BoxRay makeBoxRay(const Ray& ray) {
-  BoxRay r;
-  r.origin = ray.origin;
-  for (int a = 0; a < 3; ++a) {
-    r.invDir[a] = 1.0f / ray.direction[a];
-    // The sign bit, not a comparison, so that -0 (inverse -inf) picks hi as the near plane.
-    r.nearIsHi[a] = std::signbit(r.invDir[a]) ? 1 : 0;
-  }
-  return r;
-}
-
-// Slab test with near/far planes picked by the direction's sign (Williams, Barrus, Morley &
-// Shirley, "An Efficient and Robust Ray-Box Intersection Algorithm", 2005). Picking by sign, not
-// by min/max of the two plane distances, is what makes the inverted box (lo = +inf, hi = -inf) of
-// an empty child miss every ray. A zero direction component with the origin exactly on a slab
-// plane gives 0 * inf = NaN; the comparisons below ignore a NaN, i.e. treat that axis as not
-// constraining (the origin is on the box's boundary in it). Returns the entry distance or +inf.
-float boxEntry(const BoxRay& r, const glm::vec4& lo, const glm::vec4& hi, float tmin, float tmax) {
-  float tNear = tmin;
-  float tFar = tmax;
-  for (int a = 0; a < 3; ++a) {
-    const float nearPlane = r.nearIsHi[a] ? hi[a] : lo[a];
-    const float farPlane = r.nearIsHi[a] ? lo[a] : hi[a];
-    const float t0 = (nearPlane - r.origin[a]) * r.invDir[a];
-    const float t1 = (farPlane - r.origin[a]) * r.invDir[a] * kFarScale;
-    tNear = t0 > tNear ? t0 : tNear;
-    tFar = t1 < tFar ? t1 : tFar;
-  }
-  return tNear <= tFar ? tNear : kInf;
-}
-
-struct StackEntry {
-  std::uint32_t ref;
-  float tEntry;
-};
-
-bool isLeaf(std::uint32_t ref) { return (ref & gpu::kLeafFlag) != 0; }
-
-// Shared traversal loop: visit(first, count) tests a leaf's triangles and returns true to stop;
-// tCull() is the current far limit for boxes (already scaled).
+// Shared traversal loop: visit(first, mask) tests the triangles first + i for the bits i of
+// `mask` and returns true to stop; tCull() is the current far limit for boxes.
 template <class Visit, class Cull>
 void traverse(const Bvh& bvh, const Ray& ray, Visit&& visit, Cull&& tCull) {
   if (bvh.nodes.empty()) return;
-  const BoxRay boxRay = makeBoxRay(ray);
-  StackEntry stack[gpu::kBvhStackSize];
+  const BoxRay boxRay = makeBoxRay(ray.origin, ray.direction);
+  Group stack[gpu::kBvhStackSize];
   unsigned sp = 0;
-  std::uint32_t ref = 0; // the root, an interior node
+  std::uint32_t current = 0; // the root
   for (;;) {
-    if (isLeaf(ref)) {
-      const std::uint32_t first = ref & gpu::kLeafFirstMask;
-      const std::uint32_t count = ((ref >> gpu::kLeafCountShift) & gpu::kLeafCountMask) + 1;
-      if (visit(first, count)) return;
-    } else {
-      const gpu::BvhNode& node = bvh.nodes[ref];
-      const float limit = tCull();
-      const float t0 = boxEntry(boxRay, node.lo0, node.hi0, ray.tmin, limit);
-      const float t1 = boxEntry(boxRay, node.lo1, node.hi1, ray.tmin, limit);
-      const std::uint32_t ref0 = std::bit_cast<std::uint32_t>(node.lo0.w);
-      const std::uint32_t ref1 = std::bit_cast<std::uint32_t>(node.hi0.w);
-      // The empty child of a one-leaf root has an inverted box, which boxEntry() already
-      // rejects, and the ref kInvalidIndex, checked too, as the GPU traversal does.
-      const bool hit0 = t0 != kInf && ref0 != gpu::kInvalidIndex;
-      const bool hit1 = t1 != kInf && ref1 != gpu::kInvalidIndex;
-      if (hit0 && hit1) {
-        // Nearer first; the farther waits on the stack with its entry distance.
-        const bool firstIs0 = t0 <= t1;
-        stack[sp++] = firstIs0 ? StackEntry{ref1, t1} : StackEntry{ref0, t0};
-        ref = firstIs0 ? ref0 : ref1;
-        continue;
-      }
-      if (hit0 || hit1) {
-        ref = hit0 ? ref0 : ref1;
-        continue;
-      }
+    const gpu::BvhNode& node = bvh.nodes[current];
+    const std::uint32_t hits = hitChildren(node, boxRay, ray.tmin, tCull());
+    std::uint32_t triangleBits = 0, pending = 0;
+    const std::uint32_t imask = internalMask(node);
+    for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
+      if (!(hits >> s & 1u)) continue;
+      const std::uint32_t meta = slotMeta(node, s);
+      if (imask >> s & 1u) pending |= 1u << (s ^ boxRay.octant);
+      else triangleBits |= ((1u << (meta & 3u)) - 1u) << (meta >> 2 & 31u);
     }
-    // Pop, skipping entries that a hit found since they were pushed has made too far.
-    for (;;) {
-      if (sp == 0) return;
-      const StackEntry e = stack[--sp];
-      if (e.tEntry <= tCull()) {
-        ref = e.ref;
-        break;
-      }
+    if (triangleBits != 0 && visit(firstTriangle(node), triangleBits)) return;
+    if (pending != 0) {
+      // Descend into the first pending child in visit order; the rest wait on the stack.
+      const unsigned key = static_cast<unsigned>(std::countr_zero(pending));
+      pending &= pending - 1;
+      const std::uint32_t child = childNodeIndex(node, key ^ boxRay.octant);
+      if (pending != 0) stack[sp++] = {current, pending};
+      current = child;
+      continue;
     }
+    if (sp == 0) return;
+    Group& top = stack[sp - 1];
+    const gpu::BvhNode& parent = bvh.nodes[top.node];
+    const unsigned key = static_cast<unsigned>(std::countr_zero(top.pending));
+    top.pending &= top.pending - 1;
+    current = childNodeIndex(parent, key ^ boxRay.octant);
+    if (top.pending == 0) --sp;
   }
-}
-
-// The closest-hit rule shared by the BVH and brute force: smaller t, ties to the lower id.
-bool closer(float t, std::uint32_t primitive, const Hit& best) {
-  return t < best.t || (t == best.t && primitive < best.primitive);
 }
 
 } // namespace
@@ -134,22 +76,22 @@ Hit closestHit(const Bvh& bvh, const Ray& ray) {
   float tmax = ray.tmax; // closed bound passed to the triangle test: best t once there is a hit
   traverse(
       bvh, ray,
-      [&](std::uint32_t first, std::uint32_t count) {
-        for (std::uint32_t i = first; i < first + count; ++i) {
-          const gpu::BvhTriangle& tri = bvh.triangles[i];
+      [&](std::uint32_t first, std::uint32_t mask) {
+        for (; mask != 0; mask &= mask - 1) {
+          const gpu::BvhTriangle& tri = bvh.triangles[first + static_cast<std::uint32_t>(std::countr_zero(mask))];
           float t, u, v;
           if (!intersectTriangle(wr, glm::vec3(tri.v0), glm::vec3(tri.v1), glm::vec3(tri.v2),
                                  ray.tmin, tmax, t, u, v))
             continue;
           const std::uint32_t primitive = std::bit_cast<std::uint32_t>(tri.v0.w);
-          if (closer(t, primitive, best)) {
+          if (t < best.t || (t == best.t && primitive < best.primitive)) {
             best = Hit{t, u, v, primitive};
             tmax = t;
           }
         }
         return false;
       },
-      [&] { return tmax * kFarScale; });
+      [&] { return tmax; });
   return best;
 }
 
@@ -158,9 +100,9 @@ bool anyHit(const Bvh& bvh, const Ray& ray) {
   bool found = false;
   traverse(
       bvh, ray,
-      [&](std::uint32_t first, std::uint32_t count) {
-        for (std::uint32_t i = first; i < first + count; ++i) {
-          const gpu::BvhTriangle& tri = bvh.triangles[i];
+      [&](std::uint32_t first, std::uint32_t mask) {
+        for (; mask != 0; mask &= mask - 1) {
+          const gpu::BvhTriangle& tri = bvh.triangles[first + static_cast<std::uint32_t>(std::countr_zero(mask))];
           float t, u, v;
           // The triangle test is closed at tmax; anyHit's interval is open there.
           if (intersectTriangle(wr, glm::vec3(tri.v0), glm::vec3(tri.v1), glm::vec3(tri.v2),
@@ -172,7 +114,7 @@ bool anyHit(const Bvh& bvh, const Ray& ray) {
         }
         return false;
       },
-      [&] { return ray.tmax * kFarScale; });
+      [&] { return ray.tmax; });
   return found;
 }
 
@@ -185,7 +127,7 @@ Hit closestHitBruteForce(const TriangleSoup& soup, const Ray& ray) {
     if (!intersectTriangle(wr, soup.v0[i], soup.v1[i], soup.v2[i], ray.tmin, tmax, t, u, v))
       continue;
     const std::uint32_t primitive = static_cast<std::uint32_t>(i);
-    if (closer(t, primitive, best)) {
+    if (t < best.t || (t == best.t && primitive < best.primitive)) {
       best = Hit{t, u, v, primitive};
       tmax = t;
     }

@@ -1,12 +1,16 @@
-// bvh.glsl — BVH2 traversal (closest hit and any hit) over the item layout of
-// shared/host_device.h. Needs scene_bindings.glsl and intersect.glsl.
+// bvh.glsl — wide-BVH traversal (closest hit and any hit) over the texel layout of
+// shared/host_device.h: 8-wide nodes with 8-bit quantised child boxes (Ylitie, Karras & Laine,
+// "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG 2017). Needs
+// scene_bindings.glsl and intersect.glsl. The CPU twin is host/bvh/cpu_traverse.cpp.
 //
 // Shaped for lavapipe, which runs 8 lanes in lock-step and executes both sides of every branch
 // (docs/ARCHITECTURE.md, "lavapipe"):
-// - ONE loop handles one node or one triangle per pass, so a group of lanes pays for the maximum
-//   of their work, not the sum of separate node and triangle loops;
-// - ONE fetch path: every pass fetches the 4 texels of one item, a node or a triangle;
-// - one push site and one pop site for the (per-lane, dynamically indexed) stack.
+// - ONE loop; each pass tests one triangle of the current triangle group AND visits one node of
+//   the current node group, since a lane pays for both halves of the pass anyway;
+// - a node group is the paper's compact stack entry: the node index of a wide node's first
+//   interior child, and a mask of its interior children still to visit (in octant order) with
+//   the node's interior mask, which turns a child's slot into its node index;
+// - one push site and one pop site for the stack.
 #ifndef OBSCURA_BVH_GLSL
 #define OBSCURA_BVH_GLSL
 
@@ -17,11 +21,100 @@ struct RayHit {
   float u;          // barycentric of v1
   float v;          // barycentric of v2
   uint primitive;   // original triangle index; kInvalidIndex on miss; kTruncatedHit if cut off
-  uint item;        // item index of the hit triangle in bvhItems, valid when hit
+  uint item;        // texel of the hit triangle's v0 in bvhItems (triangleTexel), valid when hit
   uint steps;       // loop passes used (for tests and statistics)
 };
 
 bool rayHitValid(RayHit h) { return h.primitive < kTruncatedHit; }
+
+// The texel of the hit triangle's first vertex; v1 and v2 follow it.
+int triangleTexel(RayHit hit) { return int(hit.item); }
+
+// Bits i of the 4 slots 4h..4h+3 (h: which word of each pair) whose decoded boxes the ray meets
+// within [tmin, tmax]. `nearWords` / `farWords`: per axis, the q word of the planes the ray
+// enters / leaves through (lo or hi, picked by the direction's sign, so an empty slot's
+// all-zero point box at the origin is just a box; empty slots are masked by the caller).
+// plane = fma(q, 2^e, origin) is exact to what the host evaluated when it rounded the boxes
+// outward (host/bvh/wide_node.cpp); the slab test after it is the robust one of intersectBox.
+uint hitQuad(uvec3 nearWords, uvec3 farWords, vec3 nodeOrigin, vec3 scale, vec3 rayOrigin, vec3 invDir,
+             float tmin, float tmax) {
+  const uvec4 kShift = uvec4(0u, 8u, 16u, 24u);
+  precise vec4 nx = fma(vec4(ivec4((uvec4(nearWords.x) >> kShift) & 0xFFu)), vec4(scale.x), vec4(nodeOrigin.x));
+  precise vec4 ny = fma(vec4(ivec4((uvec4(nearWords.y) >> kShift) & 0xFFu)), vec4(scale.y), vec4(nodeOrigin.y));
+  precise vec4 nz = fma(vec4(ivec4((uvec4(nearWords.z) >> kShift) & 0xFFu)), vec4(scale.z), vec4(nodeOrigin.z));
+  precise vec4 fx = fma(vec4(ivec4((uvec4(farWords.x) >> kShift) & 0xFFu)), vec4(scale.x), vec4(nodeOrigin.x));
+  precise vec4 fy = fma(vec4(ivec4((uvec4(farWords.y) >> kShift) & 0xFFu)), vec4(scale.y), vec4(nodeOrigin.y));
+  precise vec4 fz = fma(vec4(ivec4((uvec4(farWords.z) >> kShift) & 0xFFu)), vec4(scale.z), vec4(nodeOrigin.z));
+  precise vec4 tNear = max(max((nx - rayOrigin.x) * invDir.x, (ny - rayOrigin.y) * invDir.y),
+                           max((nz - rayOrigin.z) * invDir.z, vec4(tmin)));
+  precise vec4 tFar = min(min((fx - rayOrigin.x) * invDir.x, (fy - rayOrigin.y) * invDir.y),
+                          min((fz - rayOrigin.z) * invDir.z, vec4(tmax))) * kBoxFarScale;
+  bvec4 h = lessThanEqual(tNear, tFar);
+  return (h.x ? 1u : 0u) | (h.y ? 2u : 0u) | (h.z ? 4u : 0u) | (h.w ? 8u : 0u);
+}
+
+// Moves bit s of an 8-bit slot mask to bit s ^ octant: the order in which a ray of that octant
+// visits the slots (host_device.h: slot bit k = the + side of axis k).
+uint slotsToVisitOrder(uint m, uint octant) {
+  m = (octant & 1u) != 0u ? ((m & 0x55u) << 1) | ((m >> 1) & 0x55u) : m;
+  m = (octant & 2u) != 0u ? ((m & 0x33u) << 2) | ((m >> 2) & 0x33u) : m;
+  m = (octant & 4u) != 0u ? ((m & 0x0Fu) << 4) | ((m >> 4) & 0x0Fu) : m;
+  return m;
+}
+
+// What one node visit yields: the leaf triangles hit (a triangle group) and the interior
+// children hit (a node group).
+struct NodeVisit {
+  uint triangleBase;  // texel of the node's first leaf triangle
+  uint triangleBits;  // bit i: test the triangle at triangleBase + 3 i
+  uvec2 group;        // x: node index of the first interior child; y: pending (visit order) | interior mask << 8
+};
+
+NodeVisit visitNode(vec4 n0, vec4 n1, vec4 n2, vec4 n3, vec4 n4, vec3 rayOrigin, vec3 invDir, bvec3 negative,
+                    uint octant, float tmin, float tmax) {
+  uint bits = floatBitsToUint(n0.w);
+  vec3 scale = uintBitsToFloat(uvec3(bits & 0xFFu, (bits >> 8) & 0xFFu, (bits >> 16) & 0xFFu) << 23);
+  uint imask = bits >> 24;
+  uvec4 refs = floatBitsToUint(n1);
+  // Per axis: .xy = the q words of the planes the ray enters through, .zw = those it leaves by.
+  uvec4 qx = floatBitsToUint(n2), qy = floatBitsToUint(n3), qz = floatBitsToUint(n4);
+  qx = negative.x ? qx.zwxy : qx;
+  qy = negative.y ? qy.zwxy : qy;
+  qz = negative.z ? qz.zwxy : qz;
+  uint slots = hitQuad(uvec3(qx.x, qy.x, qz.x), uvec3(qx.z, qy.z, qz.z), n0.xyz, scale, rayOrigin, invDir, tmin, tmax) |
+               (hitQuad(uvec3(qx.y, qy.y, qz.y), uvec3(qx.w, qy.w, qz.w), n0.xyz, scale, rayOrigin, invDir, tmin, tmax) << 4);
+  // Leaf slots: meta = count | offset << 2 gives the triangles' bits; interior and empty slots
+  // (count 0) give none.
+  const uvec4 kShift = uvec4(0u, 8u, 16u, 24u);
+  uvec4 m0 = (uvec4(refs.z) >> kShift) & 0xFFu, m1 = (uvec4(refs.w) >> kShift) & 0xFFu;
+  uvec4 b0 = ((uvec4(1u) << (m0 & 3u)) - 1u) << ((m0 >> 2) & 31u);
+  uvec4 b1 = ((uvec4(1u) << (m1 & 3u)) - 1u) << ((m1 >> 2) & 31u);
+  uvec4 lo = uvec4(1u, 2u, 4u, 8u);
+  b0 = mix(uvec4(0u), b0, notEqual(uvec4(slots) & lo, uvec4(0u)));
+  b1 = mix(uvec4(0u), b1, notEqual(uvec4(slots) & (lo << 4), uvec4(0u)));
+  uvec4 b = b0 | b1;
+  NodeVisit v;
+  v.triangleBase = refs.y;
+  v.triangleBits = (b.x | b.y) | (b.z | b.w);
+  v.group = uvec2(refs.x, slotsToVisitOrder(slots & imask, octant) | (imask << 8));
+  return v;
+}
+
+// Bits set in an 8-bit value, by SWAR additions: lavapipe (Mesa 22.3) does not enable the
+// CPU's vector popcount, and bitCount() measured slower.
+uint bitCount8(uint x) {
+  x = x - ((x >> 1) & 0x55u);
+  x = (x & 0x33u) + ((x >> 2) & 0x33u);
+  return (x + (x >> 4)) & 0x0Fu;
+}
+
+// The node index of the next child of a group (its lowest pending bit), and that bit.
+uint groupChild(uvec2 group, uint octant, out uint bit) {
+  uint key = uint(findLSB(group.y & 0xFFu));
+  bit = 1u << key;
+  uint slot = key ^ octant;
+  return group.x + bitCount8((group.y >> 8) & ((1u << slot) - 1u));
+}
 
 // Closest hit when anyHit is false (ties in t go to the lower primitive id), else the first hit
 // found with t < tmax (occlusion). Stops after `maxSteps` passes and reports kTruncatedHit:
@@ -29,18 +122,23 @@ bool rayHitValid(RayHit h) { return h.primitive < kTruncatedHit; }
 // loop off silently. A shader that traces several rays passes each the budget its earlier rays
 // left (StepBudget below), so the sum stays under kMaxTraversalSteps.
 //
+// A pass: the triangle half tests the next triangle of the triangle group; the node half visits
+// the next child of the node group, as long as the one-deep queue of triangle groups behind it
+// is free, because the visited node's leaf triangles hit become a triangle group. A node's
+// interior children hit form a new node group; what is left of the old one is pushed.
+//
 // The stack: on lavapipe a per-lane, dynamically indexed array costs ~40 ns per 8-lane pass even
-// where no lane touches it (masked gathers/scatters run anyway), about a third of a pass. So the
-// main loop keeps the top kBvhRegisterStack (12) entries in three uvec4 registers (a push or pop
-// shifts them: 24 vector selects) and never touches memory. (Measured: 8 entries send too many
-// Sponza rays to the slow path, 16 or more cost registers and selects on every pass.) A ray
-// whose stack would grow deeper stops
-// there and is finished by a second loop with the array stack, restarting from the root with the
-// hit found so far (re-testing a triangle never changes the result, so this is exact). That loop
-// costs every 8-lane group one (masked) pass when no ray overflowed.
+// where no lane touches it (masked gathers/scatters run anyway). So the main loop keeps the top
+// kBvhRegisterStack (8) groups in four uvec4 registers (a push or pop shifts them) and never
+// touches memory. A ray whose stack would grow deeper stops there and is finished by a second
+// loop with an array stack, restarting from the root with the hit found so far (re-testing a
+// triangle never changes the result, so this is exact). That loop costs every 8-lane group one
+// (masked) pass when no ray overflowed.
 RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit, uint maxSteps) {
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);
+  bvec3 negative = lessThan(direction, vec3(0.0)); // as safeReciprocal picks the sign
+  uint octant = (negative.x ? 1u : 0u) | (negative.y ? 2u : 0u) | (negative.z ? 4u : 0u);
   RayHit hit;
   hit.t = tmax;
   hit.u = 0.0;
@@ -49,10 +147,14 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   hit.item = kInvalidIndex;
   hit.steps = 0u;
 
-  uvec4 top0 = uvec4(0u), top1 = uvec4(0u), top2 = uvec4(0u); // top0.x = top; kBvhRegisterStack = 12
+  // The root as the one interior slot (slot 0) of a virtual parent whose first child is node 0.
+  const uvec2 kRootGroup = uvec2(0u, (1u << octant) | (1u << 8));
+  uvec2 group = kRootGroup;
+  uint triangleBase = 0u, triangleBits = 0u; // the triangle group being tested
+  uint queuedBase = 0u, queuedBits = 0u;      // the next one (empty while the first is)
+  // Register stack: entries e0 (top) .. e7 as (s0.xy, s0.zw, s1.xy, ..., s3.zw).
+  uvec4 s0 = uvec4(0u), s1 = uvec4(0u), s2 = uvec4(0u), s3 = uvec4(0u);
   uint stackSize = 0u;
-  uint node = 0u;                 // next interior node to visit; kInvalidIndex = pop next
-  uint triNext = 0u, triEnd = 0u; // pending triangle items of the current leaf
   bool overflow = false;
   for (;;) {
     if (hit.steps >= maxSteps) {
@@ -60,121 +162,153 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
       break;
     }
     hit.steps++;
-    bool onTriangle = triNext < triEnd;
-    int base = int((onTriangle ? triNext : node) * kTexelsPerItem);
-    vec4 a = texelFetch(bvhItems, base);
-    vec4 b = texelFetch(bvhItems, base + 1);
-    vec4 c = texelFetch(bvhItems, base + 2);
-    vec4 d = texelFetch(bvhItems, base + 3);
+    bool onTriangle = triangleBits != 0u;
+    uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
+    triangleBits &= triangleBits - 1u;
+    if (triangleBits == 0u) { // the queued triangle group moves up
+      triangleBase = queuedBase;
+      triangleBits = queuedBits;
+      queuedBits = 0u;
+    }
+    bool onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
+    uint bit;
+    uint node = groupChild(group, octant, bit);
+    int tb = onTriangle ? int(triangle) : 0;
+    vec4 p0 = texelFetch(bvhItems, tb);
+    vec4 p1 = texelFetch(bvhItems, tb + 1);
+    vec4 p2 = texelFetch(bvhItems, tb + 2);
+    int nb = onNode ? int(node * kTexelsPerNode) : 0;
+    vec4 n0 = texelFetch(bvhItems, nb);
+    vec4 n1 = texelFetch(bvhItems, nb + 1);
+    vec4 n2 = texelFetch(bvhItems, nb + 2);
+    vec4 n3 = texelFetch(bvhItems, nb + 3);
+    vec4 n4 = texelFetch(bvhItems, nb + 4);
     if (onTriangle) {
       float t, u, v;
-      if (intersectTriangle(wr, a.xyz, b.xyz, c.xyz, tmin, hit.t, t, u, v)) {
-        uint primitive = floatBitsToUint(a.w);
+      if (intersectTriangle(wr, p0.xyz, p1.xyz, p2.xyz, tmin, hit.t, t, u, v)) {
+        uint primitive = floatBitsToUint(p0.w);
         if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
           hit.t = t;
           hit.u = u;
           hit.v = v;
           hit.primitive = primitive;
-          hit.item = triNext;
+          hit.item = triangle;
           if (anyHit) break;
         }
       }
-      triNext++;
-    } else {
-      // Interior node: a/b = child 0 box, c/d = child 1 box, refs in a.w and b.w.
-      uint ref0 = floatBitsToUint(a.w), ref1 = floatBitsToUint(b.w);
-      vec2 s0 = intersectBox(a.xyz, b.xyz, origin, invDir, tmin, hit.t);
-      vec2 s1 = intersectBox(c.xyz, d.xyz, origin, invDir, tmin, hit.t);
-      bool hit0 = s0.x <= s0.y && ref0 != kInvalidIndex;
-      bool hit1 = s1.x <= s1.y && ref1 != kInvalidIndex;
-      bool nearFirst = s0.x <= s1.x;
-      node = hit0 ? (hit1 && !nearFirst ? ref1 : ref0) : (hit1 ? ref1 : kInvalidIndex);
-      if (hit0 && hit1) { // the push site
-        if (stackSize == kBvhRegisterStack) {
-          overflow = true; // finished by the second loop
-          break;
+    }
+    if (onNode) {
+      group.y &= ~bit;
+      NodeVisit visit = visitNode(n0, n1, n2, n3, n4, origin, invDir, negative, octant, tmin, hit.t);
+      if (triangleBits == 0u) {
+        triangleBase = visit.triangleBase;
+        triangleBits = visit.triangleBits;
+      } else {
+        queuedBase = visit.triangleBase;
+        queuedBits = visit.triangleBits;
+      }
+      if ((visit.group.y & 0xFFu) != 0u) {
+        if ((group.y & 0xFFu) != 0u) { // the push site
+          if (stackSize == kBvhRegisterStack) {
+            overflow = true; // finished by the second loop
+            break;
+          }
+          s3 = uvec4(s2.zw, s3.xy);
+          s2 = uvec4(s1.zw, s2.xy);
+          s1 = uvec4(s0.zw, s1.xy);
+          s0 = uvec4(group, s0.xy);
+          stackSize++;
         }
-        top2 = uvec4(top1.w, top2.xyz);
-        top1 = uvec4(top0.w, top1.xyz);
-        top0 = uvec4(nearFirst ? ref1 : ref0, top0.xyz);
-        stackSize++;
+        group = visit.group;
       }
     }
-    if (triNext >= triEnd) {
-      if (node == kInvalidIndex) {
-        if (stackSize == 0u) break;
-        node = top0.x; // the pop site
-        top0 = uvec4(top0.yzw, top1.x);
-        top1 = uvec4(top1.yzw, top2.x);
-        top2 = uvec4(top2.yzw, 0u);
+    if ((group.y & 0xFFu) == 0u) {
+      if (stackSize == 0u) {
+        if (triangleBits == 0u) break;
+      } else { // the pop site
+        group = s0.xy;
+        s0 = uvec4(s0.zw, s1.xy);
+        s1 = uvec4(s1.zw, s2.xy);
+        s2 = uvec4(s2.zw, s3.xy);
+        s3 = uvec4(s3.zw, 0u, 0u);
         stackSize--;
-      }
-      if ((node & kLeafFlag) != 0u) { // a leaf becomes the pending triangle range
-        triNext = node & kLeafFirstMask;
-        triEnd = triNext + ((node >> kLeafCountShift) & kLeafCountMask) + 1u;
-        node = kInvalidIndex;
       }
     }
   }
 
-  // The second loop repeats the first one's pass with an array stack. Factoring the common pass
-  // into a function (with an early return for any hit) measured 15 % slower on lavapipe (Sponza
-  // closest hit, ratio to Embree 0.330 -> 0.284), so the body is written twice on purpose.
-  // lavapipe's loop limiter counts the passes of both loops of the 8-lane group,
-  // which ran the first loop for as many passes as its longest ray: an overflowed ray continues
+  // The second loop repeats the first one's pass with an array stack (the body is written twice
+  // on purpose: a function for the common pass measured 15 % slower on lavapipe with the binary
+  // BVH). lavapipe's loop limiter counts the passes of both loops of the 8-lane group, which
+  // ran the first loop for as many passes as its longest ray: an overflowed ray continues
   // counting from there, so the group stays within kMaxTraversalSteps passes in total.
   uint groupSteps = subgroupMax(hit.steps);
   if (overflow) hit.steps = groupSteps;
-  uint stack[kBvhStackSize];
+  uvec2 stack[kBvhStackSize];
   stackSize = 0u;
-  node = 0u;
-  triNext = 0u;
-  triEnd = 0u;
+  group = kRootGroup;
+  triangleBits = 0u;
+  queuedBits = 0u;
   while (overflow) {
     if (hit.steps >= maxSteps) {
       hit.primitive = kTruncatedHit;
       break;
     }
     hit.steps++;
-    bool onTriangle = triNext < triEnd;
-    int base = int((onTriangle ? triNext : node) * kTexelsPerItem);
-    vec4 a = texelFetch(bvhItems, base);
-    vec4 b = texelFetch(bvhItems, base + 1);
-    vec4 c = texelFetch(bvhItems, base + 2);
-    vec4 d = texelFetch(bvhItems, base + 3);
+    bool onTriangle = triangleBits != 0u;
+    uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
+    triangleBits &= triangleBits - 1u;
+    if (triangleBits == 0u) { // the queued triangle group moves up
+      triangleBase = queuedBase;
+      triangleBits = queuedBits;
+      queuedBits = 0u;
+    }
+    bool onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
+    uint bit;
+    uint node = groupChild(group, octant, bit);
+    int tb = onTriangle ? int(triangle) : 0;
+    vec4 p0 = texelFetch(bvhItems, tb);
+    vec4 p1 = texelFetch(bvhItems, tb + 1);
+    vec4 p2 = texelFetch(bvhItems, tb + 2);
+    int nb = onNode ? int(node * kTexelsPerNode) : 0;
+    vec4 n0 = texelFetch(bvhItems, nb);
+    vec4 n1 = texelFetch(bvhItems, nb + 1);
+    vec4 n2 = texelFetch(bvhItems, nb + 2);
+    vec4 n3 = texelFetch(bvhItems, nb + 3);
+    vec4 n4 = texelFetch(bvhItems, nb + 4);
     if (onTriangle) {
       float t, u, v;
-      if (intersectTriangle(wr, a.xyz, b.xyz, c.xyz, tmin, hit.t, t, u, v)) {
-        uint primitive = floatBitsToUint(a.w);
+      if (intersectTriangle(wr, p0.xyz, p1.xyz, p2.xyz, tmin, hit.t, t, u, v)) {
+        uint primitive = floatBitsToUint(p0.w);
         if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
           hit.t = t;
           hit.u = u;
           hit.v = v;
           hit.primitive = primitive;
-          hit.item = triNext;
+          hit.item = triangle;
           if (anyHit) break;
         }
       }
-      triNext++;
-    } else {
-      uint ref0 = floatBitsToUint(a.w), ref1 = floatBitsToUint(b.w);
-      vec2 s0 = intersectBox(a.xyz, b.xyz, origin, invDir, tmin, hit.t);
-      vec2 s1 = intersectBox(c.xyz, d.xyz, origin, invDir, tmin, hit.t);
-      bool hit0 = s0.x <= s0.y && ref0 != kInvalidIndex;
-      bool hit1 = s1.x <= s1.y && ref1 != kInvalidIndex;
-      bool nearFirst = s0.x <= s1.x;
-      node = hit0 ? (hit1 && !nearFirst ? ref1 : ref0) : (hit1 ? ref1 : kInvalidIndex);
-      if (hit0 && hit1) stack[stackSize++] = nearFirst ? ref1 : ref0; // the push site
     }
-    if (triNext >= triEnd) {
-      if (node == kInvalidIndex) {
-        if (stackSize == 0u) break;
-        node = stack[--stackSize]; // the pop site
+    if (onNode) {
+      group.y &= ~bit;
+      NodeVisit visit = visitNode(n0, n1, n2, n3, n4, origin, invDir, negative, octant, tmin, hit.t);
+      if (triangleBits == 0u) {
+        triangleBase = visit.triangleBase;
+        triangleBits = visit.triangleBits;
+      } else {
+        queuedBase = visit.triangleBase;
+        queuedBits = visit.triangleBits;
       }
-      if ((node & kLeafFlag) != 0u) {
-        triNext = node & kLeafFirstMask;
-        triEnd = triNext + ((node >> kLeafCountShift) & kLeafCountMask) + 1u;
-        node = kInvalidIndex;
+      if ((visit.group.y & 0xFFu) != 0u) {
+        if ((group.y & 0xFFu) != 0u) stack[stackSize++] = group; // the push site
+        group = visit.group;
+      }
+    }
+    if ((group.y & 0xFFu) == 0u) {
+      if (stackSize == 0u) {
+        if (triangleBits == 0u) break;
+      } else {
+        group = stack[--stackSize]; // the pop site
       }
     }
   }

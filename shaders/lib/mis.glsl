@@ -23,7 +23,7 @@ float powerHeuristic(float pa, float pb) {
 // The solid-angle density with which light sampling at vertex (p, n) would have picked the point
 // `y` where a BSDF-sampled ray along `direction` hit an emitter of light group `light`.
 float emitterHitLightPdf(uint light, vec3 p, vec3 n, uint lightCount, RayHit hit, vec3 y, vec3 direction) {
-  int base = int(hit.item * kTexelsPerItem);
+  int base = triangleTexel(hit);
   vec3 v0 = texelFetch(bvhItems, base).xyz;
   vec3 v1 = texelFetch(bvhItems, base + 1).xyz;
   vec3 v2 = texelFetch(bvhItems, base + 2).xyz;

@@ -15,7 +15,7 @@ struct Surface {
 
 Surface surfaceAt(RayHit hit, vec3 origin, vec3 direction) {
   Surface s;
-  int base = int(hit.item * kTexelsPerItem);
+  int base = triangleTexel(hit);
   vec3 p0 = texelFetch(bvhItems, base).xyz;
   vec3 p1 = texelFetch(bvhItems, base + 1).xyz;
   vec3 p2 = texelFetch(bvhItems, base + 2).xyz;

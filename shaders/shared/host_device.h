@@ -33,18 +33,16 @@ static_assert(kWorkgroupSizeX * kWorkgroupSizeY == kWorkgroupSize1D, "lists are 
 #endif
 
 // ---- BVH limits. The builder guarantees depth <= kBvhMaxDepth for ANY input (it falls back to
-// median splits near the limit), so a traversal stack of kBvhStackSize entries never overflows.
+// median splits near the limit), so a traversal stack of kBvhStackSize entries never overflows:
+// a wide node is never deeper than the binary node it was collapsed from, and each wide node on
+// the path pushes at most one stack entry.
 OBS_CONST uint kBvhMaxDepth = 48;
 OBS_CONST uint kBvhStackSize = 48;
 // Stack entries traversal keeps in registers (shaders/lib/bvh.glsl); deeper stacks take a slower path.
-OBS_CONST uint kBvhRegisterStack = 12;
-// A child reference is either an interior node index (bit 31 clear) or a leaf:
-// bit 31 set | (triangleCount - 1) << kLeafCountShift | firstTriangle (in BVH order).
-OBS_CONST uint kLeafFlag = 0x80000000u;
-OBS_CONST uint kLeafCountShift = 27u;
-OBS_CONST uint kLeafCountMask = 0xFu;        // up to 16 triangles per leaf
-OBS_CONST uint kLeafFirstMask = 0x07FFFFFFu; // up to 134M triangles
-OBS_CONST uint kLeafMaxTriangles = 16u;
+OBS_CONST uint kBvhRegisterStack = 8;
+// Wide BVH: up to 8 children per node; a leaf child holds 1..kLeafMaxTriangles triangles.
+OBS_CONST uint kBvhWidth = 8;
+OBS_CONST uint kLeafMaxTriangles = 3u;
 OBS_CONST uint kInvalidIndex = 0xFFFFFFFFu;
 
 // lavapipe's loop limiter silently ends every loop of one 8-lane SIMD group after 65,535 passes
@@ -52,29 +50,37 @@ OBS_CONST uint kInvalidIndex = 0xFFFFFFFFu;
 // reports the ray as truncated, so a cut-off can never go unnoticed.
 OBS_CONST uint kMaxTraversalSteps = 60000u;
 
-// ---- BVH on the GPU: ONE RGBA32F texel buffer of 64-byte items (4 texels each): the interior
-// nodes [0, nodeCount) followed by the triangles in leaf order. A leaf reference's
-// `firstTriangle` is an ITEM index into this array. Nodes and triangles share one fetch path:
-// each traversal pass fetches 4 texels at one item index, whichever kind it is, because lavapipe
-// executes both sides of a branch and separate fetch paths would pay for both
-// (docs/ARCHITECTURE.md, "lavapipe").
-OBS_CONST uint kTexelsPerItem = 4;
+// ---- BVH on the GPU: ONE RGBA32F texel buffer: the wide nodes [0, nodeCount) of
+// kTexelsPerNode texels each, then the triangles in the order the leaves need them, of
+// kTexelsPerTriangle texels each. A hit's `item` is the texel of its triangle's v0.
+OBS_CONST uint kTexelsPerNode = 5;
+OBS_CONST uint kTexelsPerTriangle = 3;
 
-// Interior node: the bounds of both children live in the parent (Aila & Laine, "Understanding
-// the Efficiency of Ray Traversal on GPUs", 2009), so one fetch tests two boxes.
+// Wide node with compressed child boxes (Ylitie, Karras & Laine, "Efficient Incoherent Ray
+// Traversal on GPUs Through Compressed Wide BVHs", HPG 2017): each child box is stored as 8-bit
+// integers q on a per-node grid, plane = origin + q * 2^e per axis, rounded OUTWARD (the decoded
+// box strictly contains the exact one: host/bvh/wide_node.cpp). Child slots are ordered by
+// octant: slot bit k set = the child lies on the + side of axis k, so a ray visits the children
+// in the order slot ^ (its direction's sign bits) and meets near children first.
+// Uints ride in the float components as bits (uintBitsToFloat).
 struct BvhNode {
-  vec4 lo0; // 0:  child 0 min xyz, w = child 0 ref (uintBitsToFloat)
-  vec4 hi0; // 16: child 0 max xyz, w = child 1 ref (uintBitsToFloat)
-  vec4 lo1; // 32: child 1 min xyz, w = unused
-  vec4 hi1; // 48: child 1 max xyz, w = unused
-};          // 64 bytes
+  vec4 origin; // 0:  grid origin xyz; w = exponent byte x | y << 8 | z << 16 | internal-child mask << 24
+  vec4 refs;   // 16: x = node index of the first internal child (internal children follow in
+               //     slot order); y = first triangle of the leaf children (triangle index; a
+               //     texel index on the GPU); z, w = meta bytes of slots 0-3 and 4-7:
+               //     0 = empty, 0x80 = internal, else a leaf: count (1..3) | triangle offset << 2,
+               //     so ((1 << (meta & 3)) - 1) << (meta >> 2 & 31) is its triangles' bit mask
+  vec4 qx;     // 32: x axis: lo bytes of slots 0-3, lo 4-7, hi 0-3, hi 4-7
+  vec4 qy;     // 48: y axis, same
+  vec4 qz;     // 64: z axis, same
+};             // 80 bytes = kTexelsPerNode texels
 
-// Triangle for intersection, in leaf order.
+// Triangle for intersection, in the order the leaves need them.
 struct BvhTriangle {
   vec4 v0; // 0:  xyz, w = original triangle index (uintBitsToFloat)
   vec4 v1; // 16: xyz, w = unused
   vec4 v2; // 32: xyz, w = unused
-};         // 48 bytes on the host; padded to one 64-byte item on the GPU
+};         // 48 bytes = kTexelsPerTriangle texels
 
 // ---- Shading attributes of a triangle, indexed by the ORIGINAL triangle index; read once per
 // hit, never during traversal.

@@ -3,6 +3,8 @@
 // t, then primitive id) and t within 1e-5 relative. Also: the loop limiter cannot cut a traversal
 // off unnoticed.
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <random>
 #include <thread>
@@ -10,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "bvh/bvh.h"
+#include "bvh/wide_node.h"
 #include "gpu_test.h"
 #include "render/test_scenes.h"
 #include "loop_limit_test.spv.h"
@@ -162,28 +165,71 @@ TEST_F(GpuTraversal, LongTraversalIsReportedNotTruncatedSilently) {
 }
 
 // Stacks deeper than the registers hold (gpu::kBvhRegisterStack) take the second, array-stack
-// loop of shaders/lib/bvh.glsl. Triangles at x = 2^i make binned SAH peel off the farthest one
-// per level, a chain of depth ~n; a ray along +x overlaps every box, so it pushes at every level.
-// All but the last triangle miss the x axis (their boxes contain it).
-TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
-  const int n = 100;
+// loop of shaders/lib/bvh.glsl. A wide tree built by hand makes every level push: "spine" node k
+// has the next spine node in slot 0 and a "rib" node in slot 1, every box spans the whole scene,
+// so a ray along +x descends the spine first and leaves one rib group per level on the stack.
+// Ribs hold triangles that miss the x axis; the spine ends in the one triangle the rays hit.
+struct Comb {
   bvh::TriangleSoup soup;
-  for (int i = 0; i < n; ++i) {
-    float x = std::ldexp(1.0f, i);
-    if (i + 1 < n) {
-      soup.v0.push_back({x, -0.9f, 1.1f});
-      soup.v1.push_back({x, 1.1f, 1.1f});
-      soup.v2.push_back({x, 1.1f, -0.9f});
-    } else {
-      soup.v0.push_back({x, -1.0f, -1.0f});
-      soup.v1.push_back({x, 3.0f, -1.0f});
-      soup.v2.push_back({x, -1.0f, 3.0f});
-    }
+  bvh::Bvh tree;
+};
+
+Comb comb(std::uint32_t levels) {
+  Comb c;
+  auto add = [&](glm::vec3 a, glm::vec3 b, glm::vec3 d) {
+    c.soup.v0.push_back(a);
+    c.soup.v1.push_back(b);
+    c.soup.v2.push_back(d);
+  };
+  for (std::uint32_t k = 0; k < levels; ++k) {
+    const float x = static_cast<float>(k + 1);
+    add({x, -0.9f, 1.1f}, {x, 1.1f, 1.1f}, {x, 1.1f, -0.9f}); // rib k: misses the axis
   }
-  scene::Scene s = soupScene(soup);
-  bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-  ASSERT_GT(tree.stats.maxDepth, gpu::kBvhRegisterStack + 2) << "the scene no longer exercises the deep-stack path";
-  render::SceneBuffers buffers(context(), s, tree);
+  add({levels + 5.0f, -1.0f, -1.0f}, {levels + 5.0f, 3.0f, -1.0f}, {levels + 5.0f, -1.0f, 3.0f});
+  bvh::Box all;
+  for (std::size_t i = 0; i < c.soup.size(); ++i)
+    for (const glm::vec3& p : {c.soup.v0[i], c.soup.v1[i], c.soup.v2[i]}) all.grow(p);
+  // Node indices: spine k at 2k - 1 (the root is 0), rib k at 2k + 2; triangles in the order the
+  // leaves are written: rib k's triangle is k, the spine's end is `levels`.
+  const std::uint32_t nodes = 2 * levels + 1;
+  c.tree.nodes.resize(nodes);
+  auto leaf = [&](std::uint32_t triangle) {
+    std::array<bvh::WideChild, gpu::kBvhWidth> slots{};
+    slots[0] = {.kind = bvh::WideChild::Kind::Leaf, .box = all, .triangleOffset = 0, .triangleCount = 1};
+    return std::pair{slots, triangle};
+  };
+  for (std::uint32_t k = 0; k <= levels; ++k) {
+    const std::uint32_t spine = k == 0 ? 0 : 2 * k - 1;
+    if (k == levels) {
+      auto [slots, t] = leaf(levels);
+      bvh::writeWideNode(c.tree.nodes[spine], slots, 0, t);
+      continue;
+    }
+    std::array<bvh::WideChild, gpu::kBvhWidth> slots{};
+    slots[0] = {.kind = bvh::WideChild::Kind::Internal, .box = all};
+    slots[1] = {.kind = bvh::WideChild::Kind::Internal, .box = all};
+    bvh::writeWideNode(c.tree.nodes[spine], slots, 2 * k + 1, 0);
+    auto [ribSlots, t] = leaf(k);
+    bvh::writeWideNode(c.tree.nodes[2 * k + 2], ribSlots, 0, t);
+  }
+  for (std::uint32_t i = 0; i < c.soup.size(); ++i) {
+    c.tree.order.push_back(i);
+    c.tree.triangles.push_back({.v0 = glm::vec4(c.soup.v0[i], std::bit_cast<float>(i)),
+                                .v1 = glm::vec4(c.soup.v1[i], 0.0f),
+                                .v2 = glm::vec4(c.soup.v2[i], 0.0f)});
+  }
+  c.tree.stats.nodeCount = nodes;
+  c.tree.stats.leafCount = levels + 1;
+  c.tree.stats.maxDepth = levels + 1;
+  return c;
+}
+
+TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
+  const std::uint32_t levels = 20;
+  static_assert(20 > gpu::kBvhRegisterStack + 2 && 20 < gpu::kBvhStackSize);
+  Comb c = comb(levels);
+  scene::Scene s = soupScene(c.soup);
+  render::SceneBuffers buffers(context(), s, c.tree);
   render::RayTracer tracer(context(), buffers);
   std::vector<gpu::GpuRay> rays;
   std::mt19937 rng(3);
@@ -191,20 +237,22 @@ TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
   for (int i = 0; i < 64; ++i)
     rays.push_back({glm::vec4(0.5f, jitter(rng), jitter(rng), 0.0f), glm::vec4(1.0f, 0.0f, 0.0f, INFINITY)});
   auto result = tracer.trace(rays, render::TraceMode::Closest, true);
-  auto cpu = bruteForce(render::triangleSoup(s), rays);
+  auto cpu = bruteForce(c.soup, rays);
   for (std::size_t i = 0; i < rays.size(); ++i) {
     EXPECT_EQ(result.hits[i].primitive, cpu[i].primitive) << i;
     EXPECT_EQ(result.hits[i].t, cpu[i].t) << i;
+    // Every node is visited: the spine and the ribs (the overflow restarts from the root).
+    EXPECT_GE(result.steps[i], 2 * levels) << i;
   }
-  EXPECT_EQ(result.hits[0].primitive, static_cast<std::uint32_t>(n - 1));
+  EXPECT_EQ(result.hits[0].primitive, levels);
   // Any hit: not occluded short of the last triangle's plane, occluded beyond it.
-  for (auto& r : rays) r.direction.w = std::ldexp(1.0f, n - 1) - 1.0f;
+  for (auto& r : rays) r.direction.w = static_cast<float>(levels) + 4.0f; // the hit is at t = levels + 4.5
   auto blocked = tracer.trace(rays, render::TraceMode::Any);
   for (auto& r : rays) r.direction.w = INFINITY;
   auto open = tracer.trace(rays, render::TraceMode::Any);
   for (std::size_t i = 0; i < rays.size(); ++i) {
     EXPECT_EQ(blocked.hits[i].primitive, gpu::kInvalidIndex) << i;
-    EXPECT_EQ(open.hits[i].primitive, static_cast<std::uint32_t>(n - 1)) << i;
+    EXPECT_EQ(open.hits[i].primitive, levels) << i;
   }
   EXPECT_EQ(buffers.truncatedTraversals(), 0u);
 }

@@ -13,8 +13,8 @@
 #include "shared/host_device.h"
 
 namespace obscura::gpu {
-static_assert(sizeof(BvhNode) == 64 && offsetof(BvhNode, hi1) == 48);
-static_assert(sizeof(BvhTriangle) == 48);
+static_assert(sizeof(BvhNode) == 80 && offsetof(BvhNode, qz) == 64 && sizeof(BvhNode) == kTexelsPerNode * 16);
+static_assert(sizeof(BvhTriangle) == 48 && sizeof(BvhTriangle) == kTexelsPerTriangle * 16);
 static_assert(sizeof(TriangleShading) == 80 && offsetof(TriangleShading, uv2) == 64);
 static_assert(sizeof(GpuMaterial) == 80 && offsetof(GpuMaterial, textures) == 48 &&
               offsetof(GpuMaterial, meanAlbedo) == 64);
@@ -52,7 +52,7 @@ struct LayoutBlock {
   gpu::GpuLight light;
   gpu::GpuEmitter emitter;
 };
-static_assert(sizeof(LayoutBlock) == 180 * 4);
+static_assert(sizeof(LayoutBlock) == 184 * 4);
 
 class HostDeviceLayout : public GpuTest {};
 
@@ -67,8 +67,7 @@ TEST_F(HostDeviceLayout, GlslWritesEveryFieldWhereCppReadsIt) {
   out.download(context(), &block, sizeof(block));
   // Word i holds the value i (as float, int or uint as the field's type says).
   const auto* words = reinterpret_cast<const std::uint32_t*>(&block);
-  const std::size_t intWords[] = {60,  61,  62,  63,  68,  69,  70,  71,  83,  136, 137, 138, 139, 140,
-                                  141, 142, 143, 144, 145, 146, 147, 156, 157, 158, 159};
+  const std::size_t intWords[] = {64, 65, 66, 67, 72, 73, 74, 75, 87, 140, 141, 142, 143, 144, 145, 146, 147, 148, 149, 150, 151, 160, 161, 162, 163};
   for (std::size_t i = 0; i < sizeof(LayoutBlock) / 4; ++i) {
     bool isInt = std::find(std::begin(intWords), std::end(intWords), i) != std::end(intWords);
     if (isInt) {
@@ -79,14 +78,14 @@ TEST_F(HostDeviceLayout, GlslWritesEveryFieldWhereCppReadsIt) {
       EXPECT_EQ(f, static_cast<float>(i)) << "word " << i;
     }
   }
-  EXPECT_EQ(block.hit.primitive, 83u);
-  EXPECT_EQ(block.material.textures.w, 63);
-  EXPECT_EQ(block.material.meanAlbedo.x, 64.0f);
-  EXPECT_EQ(block.primaryPush.frame.x, 136u);
-  EXPECT_EQ(block.gtexel.emission.w, 119.0f);
-  EXPECT_EQ(block.primaryPush.band.w, 143u);
-  EXPECT_EQ(block.light.info.x, 156u);
-  EXPECT_EQ(block.emitter.radiance.w, 179.0f);
+  EXPECT_EQ(block.hit.primitive, 87u);
+  EXPECT_EQ(block.material.textures.w, 67);
+  EXPECT_EQ(block.material.meanAlbedo.x, 68.0f);
+  EXPECT_EQ(block.primaryPush.frame.x, 140u);
+  EXPECT_EQ(block.gtexel.emission.w, 123.0f);
+  EXPECT_EQ(block.primaryPush.band.w, 147u);
+  EXPECT_EQ(block.light.info.x, 160u);
+  EXPECT_EQ(block.emitter.radiance.w, 183.0f);
 }
 
 } // namespace

@@ -25,17 +25,17 @@ vec4 f4(float base) { return vec4(base, base + 1.0, base + 2.0, base + 3.0); }
 uvec4 u4(uint base) { return uvec4(base, base + 1u, base + 2u, base + 3u); }
 
 void main() {
-  node = BvhNode(f4(0.0), f4(4.0), f4(8.0), f4(12.0));
-  triangle = BvhTriangle(f4(16.0), f4(20.0), f4(24.0));
-  shading = TriangleShading(f4(28.0), f4(32.0), f4(36.0), f4(40.0), f4(44.0));
-  material = GpuMaterial(f4(48.0), f4(52.0), f4(56.0), ivec4(60, 61, 62, 63), f4(64.0));
-  texture = GpuTexture(u4(68u));
-  ray = GpuRay(f4(72.0), f4(76.0));
-  hit = GpuHit(80.0, 81.0, 82.0, 83u);
-  camera = GpuCamera(f4(84.0), f4(88.0), f4(92.0), f4(96.0));
-  gtexel = GBufferTexel(f4(100.0), f4(104.0), f4(108.0), f4(112.0), f4(116.0));
-  primaryPush = PrimaryPush(GpuCamera(f4(120.0), f4(124.0), f4(128.0), f4(132.0)), u4(136u), u4(140u));
-  tracePush = TracePush(u4(144u));
-  light = GpuLight(f4(148.0), f4(152.0), u4(156u), f4(160.0));
-  emitter = GpuEmitter(f4(164.0), f4(168.0), f4(172.0), f4(176.0));
+  node = BvhNode(f4(0.0), f4(4.0), f4(8.0), f4(12.0), f4(16.0));
+  triangle = BvhTriangle(f4(20.0), f4(24.0), f4(28.0));
+  shading = TriangleShading(f4(32.0), f4(36.0), f4(40.0), f4(44.0), f4(48.0));
+  material = GpuMaterial(f4(52.0), f4(56.0), f4(60.0), ivec4(64, 65, 66, 67), f4(68.0));
+  texture = GpuTexture(u4(72u));
+  ray = GpuRay(f4(76.0), f4(80.0));
+  hit = GpuHit(84.0, 85.0, 86.0, 87u);
+  camera = GpuCamera(f4(88.0), f4(92.0), f4(96.0), f4(100.0));
+  gtexel = GBufferTexel(f4(104.0), f4(108.0), f4(112.0), f4(116.0), f4(120.0));
+  primaryPush = PrimaryPush(GpuCamera(f4(124.0), f4(128.0), f4(132.0), f4(136.0)), u4(140u), u4(144u));
+  tracePush = TracePush(u4(148u));
+  light = GpuLight(f4(152.0), f4(156.0), u4(160u), f4(164.0));
+  emitter = GpuEmitter(f4(168.0), f4(172.0), f4(176.0), f4(180.0));
 }

@@ -50,28 +50,21 @@ void widenBox(glm::vec4& lo, glm::vec4& hi) {
   }
 }
 
-std::vector<gpu::BvhNode> bvhItems(const bvh::Bvh& bvh) {
-  const auto nodeCount = static_cast<std::uint32_t>(bvh.nodes.size());
-  std::vector<gpu::BvhNode> items;
-  items.reserve(bvh.nodes.size() + bvh.triangles.size());
-  auto rebase = [nodeCount](float refBits) {
-    std::uint32_t ref = std::bit_cast<std::uint32_t>(refBits);
-    if (ref != gpu::kInvalidIndex && (ref & gpu::kLeafFlag)) {
-      std::uint32_t first = (ref & gpu::kLeafFirstMask) + nodeCount;
-      if (first > gpu::kLeafFirstMask) throw DeviceError("the scene has too many triangles for the BVH item layout");
-      ref = (ref & ~gpu::kLeafFirstMask) | first;
-    }
-    return std::bit_cast<float>(ref);
-  };
+std::vector<gpu::vec4> bvhTexels(const bvh::Bvh& bvh) {
+  const std::size_t nodeTexels = bvh.nodes.size() * gpu::kTexelsPerNode;
+  const std::size_t total = nodeTexels + bvh.triangles.size() * gpu::kTexelsPerTriangle;
+  if (total > 0x7FFFFFFFu) throw DeviceError("the scene has too many triangles for the BVH texel layout");
+  std::vector<gpu::vec4> texels;
+  texels.reserve(std::max<std::size_t>(total, 1));
   for (gpu::BvhNode node : bvh.nodes) {
-    node.lo0.w = rebase(node.lo0.w);
-    node.hi0.w = rebase(node.hi0.w);
-    widenBox(node.lo0, node.hi0); // .w is not touched
-    widenBox(node.lo1, node.hi1);
-    items.push_back(node);
+    const auto first = std::bit_cast<std::uint32_t>(node.refs.y);
+    node.refs.y = std::bit_cast<float>(static_cast<std::uint32_t>(nodeTexels + std::size_t{first} * gpu::kTexelsPerTriangle));
+    for (const gpu::vec4& t : {node.origin, node.refs, node.qx, node.qy, node.qz}) texels.push_back(t);
   }
-  for (const auto& t : bvh.triangles) items.push_back({.lo0 = t.v0, .hi0 = t.v1, .lo1 = t.v2, .hi1 = glm::vec4(0.0f)});
-  return items;
+  for (const auto& t : bvh.triangles)
+    for (const gpu::vec4& v : {t.v0, t.v1, t.v2}) texels.push_back(v);
+  if (texels.empty()) texels.emplace_back(0.0f); // Vulkan buffers cannot be empty
+  return texels;
 }
 
 namespace {
@@ -124,9 +117,9 @@ void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char
 SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh)
     : context_(&context) {
   using Usage = vk::BufferUsageFlagBits;
-  auto items = bvhItems(bvh);
-  checkTexelLimit(context, items.size() * gpu::kTexelsPerItem, "BVH nodes and triangles");
-  items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::BvhNode), "scene.bvhItems");
+  auto items = bvhTexels(bvh);
+  checkTexelLimit(context, items.size(), "BVH nodes and triangles");
+  items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::vec4), "scene.bvhItems");
 
   auto shading = shadingData(scene, reflectors_);
   shading_ = gpu::Buffer(context, shading.size() * sizeof(gpu::TriangleShading), Usage::eStorageBuffer, "scene.shading");
@@ -165,16 +158,16 @@ void SceneBuffers::setSecondaryReflectors(const scene::Scene& scene, std::vector
 }
 
 bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh) {
-  auto items = bvhItems(bvh);
+  auto items = bvhTexels(bvh);
   auto shading = shadingData(scene, reflectors_);
-  const std::size_t itemBytes = items.size() * sizeof(gpu::BvhNode);
+  const std::size_t itemBytes = items.size() * sizeof(gpu::vec4);
   const std::size_t shadingBytes = shading.size() * sizeof(gpu::TriangleShading);
   if (itemBytes == items_.buffer().size() && shadingBytes == shading_.size()) {
     items_.upload(*context_, items.data(), itemBytes);
     shading_.upload(*context_, shading);
     return false;
   }
-  checkTexelLimit(*context_, items.size() * gpu::kTexelsPerItem, "BVH nodes and triangles");
+  checkTexelLimit(*context_, items.size(), "BVH nodes and triangles");
   bytes_ -= items_.buffer().size() + shading_.size();
   items_ = gpu::TexelBuffer(*context_, items.data(), itemBytes, "scene.bvhItems");
   shading_ = gpu::Buffer(*context_, shadingBytes, vk::BufferUsageFlagBits::eStorageBuffer, "scene.shading");

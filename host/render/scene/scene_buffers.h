@@ -25,13 +25,14 @@ glm::vec3 materialMeanAlbedo(const scene::Material& material);
 
 // Widens a box outward by one ulp on every face (conservative: never loses a hit). The GPU slab
 // test needs it for rays with a zero direction component whose origin lies exactly on a face
-// (see safeReciprocal in shaders/lib/intersect.glsl).
+// (see safeReciprocal in shaders/lib/intersect.glsl); the BVH's quantised boxes are built
+// strictly outside their contents for the same reason (host/bvh/wide_node.cpp).
 void widenBox(glm::vec4& lo, glm::vec4& hi);
 
-// The GPU item array of shared/host_device.h: the BVH's nodes, then its triangles padded to 64
-// bytes, with leaf references rebased from triangle indices to item indices and child boxes
-// widened (widenBox).
-std::vector<gpu::BvhNode> bvhItems(const bvh::Bvh& bvh);
+// The GPU texel array of shared/host_device.h: the BVH's wide nodes (kTexelsPerNode texels),
+// then its triangles (kTexelsPerTriangle texels), with each node's first triangle rebased from a
+// triangle index to a texel index.
+std::vector<gpu::vec4> bvhTexels(const bvh::Bvh& bvh);
 
 class SceneBuffers {
 public:
