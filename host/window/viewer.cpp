@@ -369,10 +369,16 @@ void Viewer::renderStep(FrameRecord& record) {
 
   if (!needsCompose_) return;
   needsCompose_ = false;
-  if (config_.aov == "combined") {
+  if (config_.aov == "combined" && config_.denoise) {
+    if (forgetHistory_) denoiser_->reset();
+    forgetHistory_ = false;
+    renderer_->compose(config_.exposure);
+    denoiser_->denoise(*renderer_, config_.exposure);
+    record.denoiseMs = denoiser_->lastGpuMs();
+    shown_ = denoiser_->display();
+  } else if (config_.aov == "combined") {
     renderer_->composeDisplay(config_.exposure);
     shown_ = renderer_->display();
-
   } else {
     renderer_->compose(config_.exposure);
     const io::Image image = renderer_->image();

@@ -61,6 +61,36 @@ TEST_F(CliView, ScreenshotEqualsTheHeadlessRenderOfTheSameSettings) {
   EXPECT_LE(maxLevelDifference(io::readImage(path("view.png")), io::readImage(path("render.png"))), 2.0f);
 }
 
+TEST_F(CliView, DenoisedScreenshotEqualsTheHeadlessDenoisedRender) {
+  // The denoiser is on by default in the window; headless it is asked for. The window's history
+  // stays while the camera does, so its frame after 4 samples is the headless one's.
+  const auto shown = view("--spp 4 --frames 4 --no-panel --screenshot " + path("view.png") + " --log " +
+                          path("frames.jsonl"));
+  ASSERT_EQ(shown.exitCode, 0) << shown.output;
+  const auto denoised = runObscura("render " + cornellBox() + " --width 48 --height 48 --spp 4 --denoise -o " +
+                                   path("denoised.png"));
+  ASSERT_EQ(denoised.exitCode, 0) << denoised.output;
+  const auto raw = runObscura("render " + cornellBox() + " --width 48 --height 48 --spp 4 -o " + path("raw.png"));
+  ASSERT_EQ(raw.exitCode, 0) << raw.output;
+  const io::Image view = io::readImage(path("view.png"));
+  EXPECT_LE(maxLevelDifference(view, io::readImage(path("denoised.png"))), 1.0f);
+  EXPECT_GT(maxLevelDifference(view, io::readImage(path("raw.png"))), 8.0f) << "the denoiser ran";
+  for (const auto& frame : log()) EXPECT_GT(frame["denoise_ms"].get<double>(), 0.0);
+}
+
+TEST_F(CliView, DenoisedCameraMoveReprojectsWithoutValidationMessages) {
+  writeScript(json::array({{{"frame", 2}, {"drag", {12, 4}}, {"button", "left"}},
+                           {{"frame", 3}, {"drag", {12, 4}}, {"button", "left"}}}));
+  const auto r = view("--spp 8 --frames 6 --no-panel --script " + path("events.json") + " --log " +
+                      path("frames.jsonl") + " --screenshot " + path("moved.png"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const auto frames = log();
+  ASSERT_EQ(frames.size(), 6u);
+  EXPECT_TRUE(frames[2]["preview"]);
+  EXPECT_TRUE(frames[3]["preview"]);
+  for (const auto& frame : frames) EXPECT_GT(frame["denoise_ms"].get<double>(), 0.0);
+}
+
 TEST_F(CliView, ScriptedLightEditIsOneComposeThatTracesNothing) {
   // Four samples, then (frame 5) the lamp at twice its power: the frame must be the compose of the
   // same transport with the new emission, which `relight --edits` computes headless.
