@@ -81,9 +81,18 @@ std::vector<ConfidenceImage> filterConfidences(const std::vector<std::vector<glm
     if (options.minFilter) image = minFilter(image, 2);
     if (options.lowerSmoothing) image = lowerSmoothing(image, 2);
   }
+  std::vector<ConfidenceImage> beforeOutlier = k;
   if (options.outlier) outlierTest(estimates, k, options.outlierConfidence, options.outlierDistance);
   if (options.finalSmoothing)
-    for (auto& image : k) image = smoothing(image, 1);
+    for (std::size_t i = 0; i < k.size(); ++i) {
+      const ConfidenceImage afterOutlier = k[i];
+      k[i] = smoothing(k[i], 1);
+      // OURS: a rejected estimate stays rejected. The paper's smoothing gives the rim of a
+      // rejected region (a lamp fixture) a third of a photo's weight back, and an outlier 10
+      // times the reflectance shows through at that weight.
+      for (std::size_t p = 0; p < k[i].k.size(); ++p)
+        if (beforeOutlier[i].k[p] > 0.0f && afterOutlier.k[p] == 0.0f) k[i].k[p] = 0.0f;
+    }
   return k;
 }
 

@@ -8,7 +8,8 @@
 //   2. 5x5 smoothing, lowering only   K := min(K, mean of 5x5): smooth transitions between photos
 //   3. outlier test across photos     per pixel, mu = median of the R_i with K_i > eps1; any photo
 //                                     with |R_i - mu| > eps2 (largest channel) gets K_i = 0
-//   4. 3x3 smoothing                  K := mean of 3x3, so the merge blends photos smoothly
+//   4. 3x3 smoothing                  K := mean of 3x3, so the merge blends photos smoothly;
+//                                     OURS: pixels step 3 rejected stay 0 (see the .cpp)
 // Windows are clipped at the image border (the mean is over the pixels inside).
 #pragma once
 #include <cstdint>

@@ -66,5 +66,22 @@ TEST(ConfidenceFilters, MergeIsTheConfidenceWeightedMean) {
   EXPECT_EQ(m.confidence[1], 0.0f);
 }
 
+TEST(ConfidenceFilters, FinalSmoothingDoesNotGiveRejectedEstimatesWeightBack) {
+  // Three photos of a 5x5 image agree at 0.5 but for photo 0's 3x3 centre (a fixture at 5.0):
+  // the outlier test rejects it, and the 3x3 smoothing must not bring it back at the rim.
+  std::vector<std::vector<glm::vec3>> r(3, std::vector<glm::vec3>(25, glm::vec3(0.5f)));
+  for (int y = 1; y <= 3; ++y)
+    for (int x = 1; x <= 3; ++x) r[0][std::size_t(y) * 5 + x] = glm::vec3(5.0f);
+  FilterOptions o;
+  o.minFilter = o.lowerSmoothing = false;
+  const auto k = filterConfidences(r, {filled(5, 5, 1.0f), filled(5, 5, 1.0f), filled(5, 5, 1.0f)}, o);
+  for (int y = 1; y <= 3; ++y)
+    for (int x = 1; x <= 3; ++x) EXPECT_EQ(k[0].at(x, y), 0.0f) << x << "," << y;
+  EXPECT_FLOAT_EQ(k[0].at(0, 0), 3.0f / 4.0f); // outside: smoothed with the rejected neighbour
+  EXPECT_FLOAT_EQ(k[1].at(2, 2), 1.0f);
+  const Merged m = mergeEstimates(r, k);
+  for (std::size_t p = 0; p < 25; ++p) EXPECT_NEAR(m.reflectance[p].x, 0.5f, 1e-6f) << p;
+}
+
 } // namespace
 } // namespace obscura::recover
