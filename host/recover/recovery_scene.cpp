@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -82,6 +83,7 @@ void checkLamps(const scene::Scene& room, const bvh::Bvh& bvh, const PhotoSet& p
     for (int y = -1; y <= 1; ++y)
       for (int z = -1; z <= 1; ++z)
         if (x != 0 || y != 0 || z != 0) directions.push_back(glm::normalize(glm::vec3(x, y, z)));
+  const std::vector<std::uint32_t> objects = triangleObjects(room);
   for (std::size_t i = 0; i < photos.shots.size(); ++i) {
     const Shot& shot = photos.shots[i];
     const float limit = std::max(shot.radius, touching);
@@ -90,26 +92,30 @@ void checkLamps(const scene::Scene& room, const bvh::Bvh& bvh, const PhotoSet& p
       const float d = pointTriangleDistance(shot.position, room.positions[tri.x], room.positions[tri.y],
                                             room.positions[tri.z]);
       if (d < limit) {
-        const auto objects = triangleObjects(room);
         throw InputError(fmt::format("{}: shots entry {}: the lamp at ({}, {}, {}) is inside geometry: it is {:.4g} "
                                      "from object '{}', closer than its radius {}",
                                      photos.file, i, shot.position.x, shot.position.y, shot.position.z, d,
-                                     room.objects.empty() ? std::string("?") : room.objects[objects[t]].name, shot.radius));
+                                     room.objects[objects[t]].name, shot.radius));
       }
     }
-    std::size_t backFaces = 0;
+    // Inside a closed object: at least 3/4 of the rays meet the back of one object first (an
+    // object open at the bottom, standing on the floor, still counts). Walls that are separate
+    // objects do not trip it whichever way they face.
+    std::map<std::uint32_t, std::size_t> backFaces;
     for (const auto& dir : directions) {
       const bvh::Hit hit = bvh::closestHit(bvh, bvh::Ray{shot.position, dir});
-      if (!hit.hit()) break;
+      if (!hit.hit()) continue;
       const glm::uvec3 tri = room.triangles[hit.primitive];
       const glm::vec3 n = glm::cross(room.positions[tri.y] - room.positions[tri.x],
                                      room.positions[tri.z] - room.positions[tri.x]);
-      if (glm::dot(n, dir) > 0.0f) ++backFaces;
+      if (glm::dot(n, dir) > 0.0f) ++backFaces[objects[hit.primitive]];
     }
-    if (backFaces == directions.size())
-      throw InputError(fmt::format("{}: shots entry {}: the lamp at ({}, {}, {}) is inside geometry: every ray from "
-                                   "it meets the back of a surface first (inside a closed object)",
-                                   photos.file, i, shot.position.x, shot.position.y, shot.position.z));
+    for (const auto& [object, count] : backFaces)
+      if (4 * count >= 3 * directions.size())
+        throw InputError(fmt::format("{}: shots entry {}: the lamp at ({}, {}, {}) is inside geometry: inside object "
+                                     "'{}' (the rays from it meet its back faces first)",
+                                     photos.file, i, shot.position.x, shot.position.y, shot.position.z,
+                                     room.objects[object].name));
   }
 }
 

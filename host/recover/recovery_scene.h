@@ -24,8 +24,8 @@ scene::Scene recoveryScene(const scene::Scene& room, const std::vector<Shot>& sh
 std::vector<std::uint32_t> triangleObjects(const scene::Scene& scene);
 
 // InputError naming `photos.file` and the shot when a lamp is inside geometry: its sphere (or,
-// for radius 0, the point) touches a triangle, or it lies inside a closed object (every ray from
-// it first meets a back face).
+// for radius 0, the point) touches a triangle, or it lies inside a closed object (3/4 of the rays
+// from it first meet the back faces of one object).
 void checkLamps(const scene::Scene& room, const bvh::Bvh& bvh, const PhotoSet& photos);
 
 // The distance from p to triangle (a, b, c).
