@@ -235,7 +235,11 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   }
 
   // Pixels no filtered confidence reaches: first the photos' raw visibilities (the filters
-  // removed a pixel some lamp still lights), then, lit by no lamp at all, the object's mean.
+  // removed a pixel some lamp still lights), less the estimates the outlier test rejects on them,
+  // then, lit by no lamp at all, the object's mean.
+  std::vector<ConfidenceImage> fillWeights = lighting.visibility;
+  if (options.filters.outlier)
+    outlierTest(out.estimates, fillWeights, options.filters.outlierConfidence, options.filters.outlierDistance);
   out.visibility = lighting.visibility;
   out.direct = lighting.direct;
   out.object = lighting.geometry.object;
@@ -248,8 +252,8 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
     glm::vec3 sum(0.0f);
     float weight = 0.0f;
     for (std::size_t i = 0; i < out.estimates.size(); ++i) {
-      sum += out.visibility[i].k[p] * out.estimates[i][p];
-      weight += out.visibility[i].k[p];
+      sum += fillWeights[i].k[p] * out.estimates[i][p];
+      weight += fillWeights[i].k[p];
     }
     if (weight > 0.0f) {
       out.reflectance[p] = sum / weight;
