@@ -1,10 +1,12 @@
 // obscura recover — reflectance from photographs of one view, one lamp per shot [IVR §4]:
 //   obscura recover SCENE --photos lights.json -o DIR [--camera N] [--debug] [--png]
 // writes DIR/reflectance.exr (R, G, B, confidence.K = sum of the filtered K_i, filled.id),
-// DIR/recover.json (how the estimate converged, what was filled, times), with --debug one
+// DIR/recover.json (how the estimate converged, what was filled, times), DIR/state (a relighting
+// state of the photographed room with the recovered albedo, for `obscura relight`), with --debug one
 // DIR/shot-NNN.exr per photo (its estimate R_i, V_i, filtered K_i, direct and indirect light per
 // unit reflectance) and with --png reflectance.png and confidence.png.
 // Everything is read and checked before the folder is made: bad input writes nothing.
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -177,6 +179,12 @@ void runRecover(RecoverOptions& o) {
                accuracy["shadow"]["rmse"].get<double>(), accuracy["all"]["rmse"].get<double>());
   }
   writeOutputs(o, r, photos, accuracy);
+  const auto stateStart = std::chrono::steady_clock::now();
+  recover::saveRecoveredState((fs::path(o.output) / "state").string(), context, loaded.scene, loaded.bvh, camera,
+                              photos, r, rec);
+  fmt::print(stderr, "recover: relighting state (lights shot0..shot{}) in {:.1f} s -> {}/state\n",
+             photos.shots.size() - 1,
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - stateStart).count(), o.output);
   fmt::print(stderr, "recover: {} photos, {}x{}, {} iterations; {} pixels filled from visibility, {} from their object's "
                      "mean; {:.1f} s -> {}\n",
              photos.shots.size(), r.width, r.height, r.iterations.size() - 1, r.filledFromVisibility, r.filledFromObject,

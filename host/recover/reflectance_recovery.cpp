@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "recover/recovery_scene.h"
+#include "relight/relight_state.h"
 #include "render/obscurance_renderer.h"
 
 namespace obscura::recover {
@@ -34,6 +35,39 @@ glm::vec3 pixel3(const io::Image& image, std::size_t p, int first) {
 // Reflectances the renderer may use: above 0 so that dividing by the albedo AOV recovers the
 // lighting, below 1 so that I_a (1 / (1 - R_ave)) stays finite.
 glm::vec3 renderable(const glm::vec3& r) { return glm::clamp(r, glm::vec3(0.02f), glm::vec3(0.95f)); }
+
+render::ObscuranceSettings recoverySettings(const PhotoSet& photos, const scene::Camera& camera,
+                                            const RecoveryOptions& options) {
+  render::ObscuranceSettings settings;
+  settings.width = static_cast<std::uint32_t>(photos.width);
+  settings.height = static_cast<std::uint32_t>(photos.height);
+  settings.spp = options.spp;
+  settings.seed = options.seed;
+  settings.camera = camera;
+  settings.obscuranceRays = options.obscuranceRays;
+  settings.dMax = options.dMax;
+  settings.shadowSampling = render::ShadowSampling::PerLight; // each lamp alone, one exact ray to a point
+  settings.ambient = options.ambient;
+  return settings;
+}
+
+// The recovery scene with `objectReflectance` per object, rendered once (the renderer keeps a
+// pointer to the scene, so both live here).
+struct RoomRender {
+  scene::Scene scene;
+  std::unique_ptr<render::ObscuranceRenderer> renderer;
+
+  RoomRender(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh, const scene::Camera& camera,
+             const PhotoSet& photos, const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options) {
+    std::vector<glm::vec3> materials;
+    for (const auto& r : objectReflectance) materials.push_back(renderable(r));
+    scene = recoveryScene(room, photos.shots, materials);
+    renderer = std::make_unique<render::ObscuranceRenderer>(context, scene, bvh, recoverySettings(photos, camera, options));
+    renderer->render();
+    if (renderer->stats().truncatedTraversals > 0)
+      throw DeviceError("traversals ran out of steps (kMaxTraversalSteps); the lighting would be wrong");
+  }
+};
 
 std::vector<std::vector<glm::vec3>> estimatesWith(const PhotoSet& photos, const Lighting& lighting,
                                                   const std::vector<std::vector<glm::vec3>>& indirect) {
@@ -93,23 +127,8 @@ Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, co
                        const scene::Camera& camera, const PhotoSet& photos,
                        const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options) {
   const auto start = Clock::now();
-  std::vector<glm::vec3> materials;
-  for (const auto& r : objectReflectance) materials.push_back(renderable(r));
-  const scene::Scene scene = recoveryScene(room, photos.shots, materials);
-  render::ObscuranceSettings settings;
-  settings.width = static_cast<std::uint32_t>(photos.width);
-  settings.height = static_cast<std::uint32_t>(photos.height);
-  settings.spp = options.spp;
-  settings.seed = options.seed;
-  settings.camera = camera;
-  settings.obscuranceRays = options.obscuranceRays;
-  settings.dMax = options.dMax;
-  settings.shadowSampling = render::ShadowSampling::PerLight; // each lamp alone, one exact ray to a point
-  settings.ambient = options.ambient;
-  render::ObscuranceRenderer renderer(context, scene, bvh, settings);
-  renderer.render();
-  if (renderer.stats().truncatedTraversals > 0)
-    throw DeviceError("traversals ran out of steps (kMaxTraversalSteps); the lighting would be wrong");
+  const RoomRender roomRender(context, room, bvh, camera, photos, objectReflectance, options);
+  const render::ObscuranceRenderer& renderer = *roomRender.renderer;
   const render::Transport transport = renderer.transport();
   const io::Image aov = renderer.image();
   const int albedo = channel(aov, "albedo.R"), normal = channel(aov, "normal.X"),
@@ -164,6 +183,25 @@ Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, co
   }
   out.seconds = secondsSince(start);
   return out;
+}
+
+void saveRecoveredState(const std::string& dir, const gpu::Context& context, const scene::Scene& room,
+                        const bvh::Bvh& bvh, const scene::Camera& camera, const PhotoSet& photos,
+                        const Recovery& recovery, const RecoveryOptions& options) {
+  const RoomRender roomRender(context, room, bvh, camera, photos, recovery.iterations.back().objectReflectance, options);
+  const render::ObscuranceRenderer& renderer = *roomRender.renderer;
+  render::Transport transport = renderer.transport();
+  const io::Image aov = renderer.image();
+  const int albedo = channel(aov, "albedo.R");
+  for (std::size_t p = 0; p < transport.pixels(); ++p) {
+    const glm::vec3 rho = pixel3(aov, p, albedo);
+    glm::vec3 scale(0.0f);
+    for (int c = 0; c < 3; ++c)
+      if (rho[c] >= 1e-4f) scale[c] = recovery.reflectance[p][c] / rho[c];
+    for (auto& direct : transport.direct) direct[p] *= scale;
+    transport.ambient[p] = glm::vec4(glm::vec3(transport.ambient[p]) * scale, transport.ambient[p].w);
+  }
+  relight::saveState(dir, renderer, transport, room.sourcePath);
 }
 
 Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,

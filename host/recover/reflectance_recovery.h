@@ -97,6 +97,14 @@ Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, co
                        const scene::Camera& camera, const PhotoSet& photos,
                        const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options);
 
+// Writes `dir` as a relighting state (relight/relight_state.h) of the photographed room whose
+// albedo is `recovery`'s reflectance: rendered with each object at its mean recovered reflectance
+// (which sets I_a), then D_s and A scaled per pixel by R / albedo. Its lights are the shots'
+// lamps, "shot<i>", so `obscura relight DIR --light shot2=0.5` relights the photographed room.
+void saveRecoveredState(const std::string& dir, const gpu::Context& context, const scene::Scene& room,
+                        const bvh::Bvh& bvh, const scene::Camera& camera, const PhotoSet& photos,
+                        const Recovery& recovery, const RecoveryOptions& options);
+
 // IVR eq. 2 per pixel: C / (direct + indirect), 0 where nothing lights the pixel.
 std::vector<glm::vec3> estimateReflectance(const std::vector<glm::vec3>& photo, const std::vector<glm::vec3>& direct,
                                            const std::vector<glm::vec3>& indirect);

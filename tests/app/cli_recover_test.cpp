@@ -1,7 +1,8 @@
 // `obscura recover` as a user runs it: a run on two of the Cycles photographs writes the
-// reflectance (with its confidence layer), the report and, with --debug/--png, the per-photo
-// images; bad input (photos of different sizes, a lamp inside geometry, another camera, an
+// reflectance (with its confidence layer), the report, a relighting state whose albedo is the
+// recovered one and, with --debug/--png, the per-photo images; bad input (photos of different sizes, a lamp inside geometry, another camera, an
 // unreadable image, a missing field) is a clear error naming the file, exit 2, nothing written.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -29,6 +30,7 @@ protected:
     for (auto& s : doc["shots"]) s["image"] = photosDir() + "/" + s["image"].get<std::string>();
     return doc;
   }
+  static json doc0() { return lights(1); }
   std::string write(const json& doc, const std::string& name = "lights.json") {
     std::ofstream(path(name)) << doc.dump(1);
     return path(name);
@@ -53,7 +55,8 @@ TEST_F(CliRecover, WritesReflectanceWithConfidenceAndThePerPhotoImages) {
   EXPECT_EQ(image.width, 256);
   EXPECT_GE(image.channelIndex("R"), 0);
   EXPECT_GE(image.channelIndex("confidence.K"), 0);
-  for (const char* f : {"recover.json", "reflectance.png", "confidence.png", "shot-000.exr", "shot-001.exr"})
+  for (const char* f : {"recover.json", "reflectance.png", "confidence.png", "shot-000.exr", "shot-001.exr",
+                        "state/state.json", "state/transport.exr"})
     EXPECT_TRUE(fs::exists(path(std::string("out/") + f))) << f;
   EXPECT_FALSE(fs::exists(path("out/shot-002.exr")));
   std::ifstream in(path("out/recover.json"));
@@ -61,6 +64,27 @@ TEST_F(CliRecover, WritesReflectanceWithConfidenceAndThePerPhotoImages) {
   EXPECT_EQ(report["photos"], 2);
   EXPECT_EQ(report["iterations"].size(), 2u);
   EXPECT_GT(report["accuracy"]["lit"]["pixels"].get<int>(), 0);
+
+  // The relighting state: `relight` composes it, and its direct light for shot 0 is the recovered
+  // reflectance times the lamp's direct light per unit reflectance (what the estimate divided by).
+  const auto relit = runObscura("relight " + path("out/state") + " --light shot0=0.5 -o " + path("relit.exr"));
+  ASSERT_EQ(relit.exitCode, 0) << relit.output;
+  const io::Image transport = io::readImage(path("out/state/transport.exr"));
+  const io::Image shot = io::readImage(path("out/shot-000.exr"));
+  const int d = transport.channelIndex("D.shot0.R"), direct = shot.channelIndex("direct.R"), k = shot.channelIndex("confidence.K");
+  ASSERT_GE(d, 0);
+  ASSERT_GE(direct, 0);
+  const float intensity = doc0()["shots"][0]["gltf_light"]["intensity"].get<float>();
+  int checked = 0, agree = 0;
+  for (int y = 0; y < 256; y += 4)
+    for (int x = 0; x < 256; x += 4) {
+      if (shot.at(x, y, k) < 0.99f || shot.at(x, y, direct) < 0.05f) continue; // interior, lit
+      ++checked;
+      const float expected = image.at(x, y, 0) * shot.at(x, y, direct);
+      agree += std::abs(transport.at(x, y, d) * intensity - expected) <= 0.01f * expected ? 1 : 0;
+    }
+  EXPECT_GT(checked, 500);
+  EXPECT_GE(agree, checked * 95 / 100) << agree << " of " << checked;
 }
 
 TEST_F(CliRecover, PhotosOfDifferentSizesAreRefusedNamingTheImage) {

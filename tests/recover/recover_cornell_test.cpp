@@ -63,9 +63,11 @@ TEST_F(RecoverCornell, GatheredIndirectLightMeetsTheGoalsAndConverges) {
     EXPECT_LT(r.iterations[i].rmsChange, r.iterations[i - 1].rmsChange / 3.0) << "iteration " << i;
   EXPECT_LT(r.iterations.back().rmsChange, 0.005);
   // The white objects' means come out white (0.725, 0.71, 0.68) to 3 %, the red wall red.
-  for (std::size_t o = 0; o < r.objectNames.size(); ++o)
-    if (r.objectNames[o] == "cube_1" || r.objectNames[o] == "rectangle_1")
+  for (std::size_t o = 0; o < r.objectNames.size(); ++o) {
+    if (r.objectNames[o] == "cube_1" || r.objectNames[o] == "rectangle_1") {
       EXPECT_NEAR(r.iterations.back().objectReflectance[o].x, 0.725f, 0.02f) << r.objectNames[o];
+    }
+  }
 }
 
 TEST_F(RecoverCornell, GatheredIndirectLightBeatsThePapersConstantAmbient) {
