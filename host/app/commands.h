@@ -21,5 +21,6 @@ void addConvergeCommand(CLI::App& app);
 void addRelightCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
+void addRecoverCommand(CLI::App& app);
 
 } // namespace obscura::app

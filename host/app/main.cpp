@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   obscura::app::addRelightCommand(app);
   obscura::app::addCompareCommand(app);
   obscura::app::addViewCommand(app);
+  obscura::app::addRecoverCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -57,6 +57,11 @@ std::string lightTypeName(std::uint32_t gpuType) {
 }
 
 void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const std::string& scenePath) {
+  saveState(dir, renderer, renderer.transport(), scenePath);
+}
+
+void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const render::Transport& transport,
+               const std::string& scenePath) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec || !fs::is_directory(dir)) throw InputError(fmt::format("{}: cannot create the state folder", dir));
@@ -78,7 +83,7 @@ void saveState(const std::string& dir, const render::ObscuranceRenderer& rendere
     json["lights"].push_back({{"name", lights.names[i]}, {"type", lightTypeName(lights.lights[i].info.x)},
                               {"emission", vec3Json(renderer.emissions()[i])},
                               {"ambient_weight", vec3Json(renderer.ambient().weight[i])}});
-  io::writeExr((fs::path(dir) / "transport.exr").string(), renderer.transport().toImage());
+  io::writeExr((fs::path(dir) / "transport.exr").string(), transport.toImage());
   const std::string path = (fs::path(dir) / "state.json").string(), temp = path + ".tmp";
   {
     std::ofstream out(temp);

@@ -43,6 +43,10 @@ std::string lightTypeName(std::uint32_t gpuType);
 // Writes DIR (created when missing). The files are written under temporary names and renamed,
 // so an interrupted write leaves no half state.
 void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const std::string& scenePath);
+// The same with `transport` in place of the renderer's own (same lights and size): a transport
+// whose albedo was replaced (`recover`'s recovered reflectance).
+void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const render::Transport& transport,
+               const std::string& scenePath);
 
 // Reads DIR; InputError naming the file for a missing, truncated, foreign-version or inconsistent
 // state.

@@ -1,0 +1,77 @@
+// photo_gather.h — the indirect light at each pixel gathered from the photographs themselves
+// (OURS, replacing the paper's constant ambient [IVR §4.2]; the paper's future work):
+//
+//   B_i(P) = 1/pi  int L_i(Q) cos dw  ~  1/N sum_k L_i(Q_k)     (N cosine-distributed rays from P)
+//
+// where Q_k is the first surface a ray meets and L_i(Q) its radiance in photo i. Where the camera
+// sees Q (the pixel Q projects to shows the same object on the same plane), L_i(Q) is the
+// photograph's pixel: measured radiance, with every bounce in it, no model. Elsewhere (hidden
+// from the camera) it is modelled as R_o (F V E_i(Q) + b_i): the current mean reflectance of Q's
+// object, the lamp's direct light (a CPU shadow ray) and the current mean indirect light b_i.
+// Rays that leave the scene see nothing (the photographs' world is black).
+//
+// The rays depend on the geometry only: they are traced once (CPU BVH), and each recovery
+// iteration (new R_o, b_i) re-sums them without a ray.
+//
+// The estimate's variance comes from bright spots (near a lamp the walls are 30x the median) met
+// by few rays. Indirect light varies slowly over a surface, so B_i is then averaged over a
+// (2 radius + 1)^2 window of pixels that see the same object with the same normal (dot > 0.95):
+// the window's rays pool, and edges between surfaces stay sharp.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bvh/bvh.h"
+#include "recover/photo_set.h"
+#include "scene/scene.h"
+
+namespace obscura::recover {
+
+// What the camera sees per pixel (the renderer's AOVs): the point, its normal facing the camera,
+// and the object (-1 for none).
+struct PixelGeometry {
+  int width = 0, height = 0;
+  std::vector<glm::vec3> position, normal;
+  std::vector<std::int32_t> object;
+};
+
+class PhotoGather {
+public:
+  PhotoGather(const scene::Scene& room, const bvh::Bvh& bvh, const scene::Camera& camera, const PixelGeometry& pixels,
+              const std::vector<Shot>& shots, std::uint32_t raysPerPixel, std::uint32_t seed, int smoothRadius);
+
+  // B_i per pixel for every shot (per unit reflectance, radiance units), with the photographs'
+  // radiance where the camera sees the hit, and objectReflectance / hiddenAmbient[i] elsewhere.
+  std::vector<std::vector<glm::vec3>> indirect(const std::vector<Shot>& shots,
+                                               const std::vector<glm::vec3>& objectReflectance,
+                                               const std::vector<glm::vec3>& hiddenAmbient) const;
+  // Fractions of the rays whose hit the camera sees, that are hidden, and that leave the scene.
+  double seenFraction() const { return double(seen_.size()) / double(rays_); }
+  double hiddenFraction() const { return double(hiddenObject_.size()) / double(rays_); }
+  std::uint64_t rays() const { return rays_; }
+
+private:
+  const PixelGeometry* geometry_;
+  int smoothRadius_ = 0;
+  std::size_t pixels_ = 0, shots_ = 0;
+  std::uint32_t raysPerPixel_ = 0;
+  std::uint64_t rays_ = 0;
+  // Per pixel p, its seen hits are seen_[seenStart_[p] .. seenStart_[p + 1]) (pixel indices), its
+  // hidden hits hiddenObject_/hiddenDirect_ likewise (hiddenDirect_: shots_ values per hit, the
+  // lamp's unit-reflectance direct light F V I / pi at the hit, without the lamp's colour).
+  std::vector<std::uint32_t> seenStart_, seen_;
+  std::vector<std::uint32_t> hiddenStart_, hiddenObject_;
+  std::vector<float> hiddenDirect_;
+};
+
+// `image` averaged over the (2 radius + 1)^2 window's pixels that see the same object as the
+// centre with a normal within dot 0.95 of its own.
+std::vector<glm::vec3> smoothOnSurfaces(const std::vector<glm::vec3>& image, const PixelGeometry& pixels, int radius);
+
+// The pixel a world point projects to in `camera` at width x height (as camera.glsl makes the
+// primary rays), or -1 when it is behind the camera or outside the image.
+std::int64_t projectToPixel(const scene::Camera& camera, int width, int height, const glm::vec3& point);
+
+} // namespace obscura::recover

@@ -1,0 +1,310 @@
+// reflectance_recovery.cpp — see reflectance_recovery.h.
+#include "recover/reflectance_recovery.h"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include <fmt/format.h>
+#include <glm/gtc/constants.hpp>
+
+#include "core/error.h"
+#include "recover/recovery_scene.h"
+#include "relight/relight_state.h"
+#include "render/obscurance_renderer.h"
+
+namespace obscura::recover {
+namespace {
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+int channel(const io::Image& image, const std::string& name) {
+  const int c = image.channelIndex(name);
+  if (c < 0) throw std::logic_error("recover: the renderer's image lacks " + name);
+  return c;
+}
+
+glm::vec3 pixel3(const io::Image& image, std::size_t p, int first) {
+  const float* v = &image.pixels[p * image.channels.size() + std::size_t(first)];
+  return {v[0], v[1], v[2]};
+}
+
+// Reflectances the renderer may use: above 0 so that dividing by the albedo AOV recovers the
+// lighting, below 1 so that I_a (1 / (1 - R_ave)) stays finite.
+glm::vec3 renderable(const glm::vec3& r) { return glm::clamp(r, glm::vec3(0.02f), glm::vec3(0.95f)); }
+
+render::ObscuranceSettings recoverySettings(const PhotoSet& photos, const scene::Camera& camera,
+                                            const RecoveryOptions& options) {
+  render::ObscuranceSettings settings;
+  settings.width = static_cast<std::uint32_t>(photos.width);
+  settings.height = static_cast<std::uint32_t>(photos.height);
+  settings.spp = options.spp;
+  settings.seed = options.seed;
+  settings.camera = camera;
+  settings.obscuranceRays = options.obscuranceRays;
+  settings.dMax = options.dMax;
+  settings.shadowSampling = render::ShadowSampling::PerLight; // each lamp alone, one exact ray to a point
+  settings.ambient = options.ambient;
+  return settings;
+}
+
+// The recovery scene with `objectReflectance` per object, rendered once (the renderer keeps a
+// pointer to the scene, so both live here).
+struct RoomRender {
+  scene::Scene scene;
+  std::unique_ptr<render::ObscuranceRenderer> renderer;
+
+  RoomRender(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh, const scene::Camera& camera,
+             const PhotoSet& photos, const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options) {
+    std::vector<glm::vec3> materials;
+    for (const auto& r : objectReflectance) materials.push_back(renderable(r));
+    scene = recoveryScene(room, photos.shots, materials);
+    renderer = std::make_unique<render::ObscuranceRenderer>(context, scene, bvh, recoverySettings(photos, camera, options));
+    renderer->render();
+    if (renderer->stats().truncatedTraversals > 0)
+      throw DeviceError("traversals ran out of steps (kMaxTraversalSteps); the lighting would be wrong");
+  }
+};
+
+std::vector<std::vector<glm::vec3>> estimatesWith(const PhotoSet& photos, const Lighting& lighting,
+                                                  const std::vector<std::vector<glm::vec3>>& indirect) {
+  std::vector<std::vector<glm::vec3>> r;
+  for (std::size_t i = 0; i < photos.shots.size(); ++i)
+    r.push_back(estimateReflectance(photos.shots[i].radiance, lighting.direct[i], indirect[i]));
+  return r;
+}
+
+} // namespace
+
+std::vector<glm::vec3> estimateReflectance(const std::vector<glm::vec3>& photo, const std::vector<glm::vec3>& direct,
+                                           const std::vector<glm::vec3>& indirect) {
+  std::vector<glm::vec3> r(photo.size(), glm::vec3(0.0f));
+  for (std::size_t p = 0; p < photo.size(); ++p) {
+    const glm::vec3 light = direct[p] + indirect[p];
+    for (int c = 0; c < 3; ++c)
+      if (light[c] > 1e-8f) r[p][c] = photo[p][c] / light[c];
+  }
+  return r;
+}
+
+std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, const std::vector<std::int32_t>& object,
+                                       float k) {
+  glm::dvec3 sum(0.0);
+  std::size_t n = 0;
+  for (std::size_t p = 0; p < photo.size(); ++p)
+    if (object[p] >= 0) {
+      sum += glm::dvec3(photo[p]);
+      ++n;
+    }
+  const glm::vec3 mean = n > 0 ? glm::vec3(sum / static_cast<double>(n)) : glm::vec3(0.0f);
+  return std::vector<glm::vec3>(photo.size(), k * mean);
+}
+
+std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
+                                   const std::vector<std::int32_t>& object, std::size_t objects) {
+  std::vector<glm::dvec3> sum(objects, glm::dvec3(0.0));
+  std::vector<double> weight(objects, 0.0);
+  glm::dvec3 all(0.0);
+  double allWeight = 0.0;
+  for (std::size_t p = 0; p < reflectance.size(); ++p) {
+    if (object[p] < 0 || confidence[p] <= 0.0f) continue;
+    const auto o = static_cast<std::size_t>(object[p]);
+    sum[o] += double(confidence[p]) * glm::dvec3(reflectance[p]);
+    weight[o] += confidence[p];
+    all += double(confidence[p]) * glm::dvec3(reflectance[p]);
+    allWeight += confidence[p];
+  }
+  const glm::vec3 fallback = allWeight > 0.0 ? glm::vec3(all / allWeight) : glm::vec3(0.5f);
+  std::vector<glm::vec3> means(objects);
+  for (std::size_t o = 0; o < objects; ++o) means[o] = weight[o] > 0.0 ? glm::vec3(sum[o] / weight[o]) : fallback;
+  return means;
+}
+
+Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
+                       const scene::Camera& camera, const PhotoSet& photos,
+                       const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options) {
+  const auto start = Clock::now();
+  const RoomRender roomRender(context, room, bvh, camera, photos, objectReflectance, options);
+  const render::ObscuranceRenderer& renderer = *roomRender.renderer;
+  const render::Transport transport = renderer.transport();
+  const io::Image aov = renderer.image();
+  const int albedo = channel(aov, "albedo.R"), normal = channel(aov, "normal.X"),
+            position = channel(aov, "position.X"), primitive = channel(aov, "primitive.id");
+  const std::vector<std::uint32_t> objectOf = triangleObjects(room);
+  const std::size_t pixels = photos.pixels();
+  Lighting out;
+  out.geometry.width = photos.width;
+  out.geometry.height = photos.height;
+  out.geometry.object.assign(pixels, -1);
+  out.geometry.position.assign(pixels, glm::vec3(0.0f));
+  out.geometry.normal.assign(pixels, glm::vec3(0.0f));
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const float id = aov.pixels[p * aov.channels.size() + std::size_t(primitive)];
+    if (id < 0.0f) continue;
+    out.geometry.object[p] = static_cast<std::int32_t>(objectOf.at(static_cast<std::size_t>(id)));
+    // The pixel's mean point and normal, the normal turned to face the camera (as shading does).
+    const glm::vec3 P = pixel3(aov, p, position);
+    glm::vec3 n = pixel3(aov, p, normal);
+    if (glm::dot(n, camera.position - P) < 0.0f) n = -n;
+    out.geometry.position[p] = P;
+    out.geometry.normal[p] = n;
+  }
+  const std::vector<glm::vec3>& emissions = renderer.emissions();
+  for (std::size_t i = 0; i < photos.shots.size(); ++i) {
+    const Shot& shot = photos.shots[i];
+    const std::size_t s = renderer.lightIndex(fmt::format("shot{}", i));
+    const glm::vec3 ambientWeight = renderer.ambient().weight.at(s) * emissions[s];
+    std::vector<glm::vec3> direct(pixels, glm::vec3(0.0f)), indirect(pixels, glm::vec3(0.0f));
+    ConfidenceImage visibility{photos.width, photos.height, std::vector<float>(pixels, 0.0f)};
+    for (std::size_t p = 0; p < pixels; ++p) {
+      const glm::vec3 rho = pixel3(aov, p, albedo);
+      if (out.geometry.object[p] < 0 || glm::any(glm::lessThan(rho, glm::vec3(1e-4f)))) continue;
+      // D_s and A hold the albedo of the surface (its current estimate): divided out, they are
+      // the light per unit reflectance.
+      direct[p] = transport.direct[s][p] * emissions[s] / rho;
+      indirect[p] = ambientWeight * glm::vec3(transport.ambient[p]) / rho;
+      // V = rendered direct / the unoccluded point-light formula I cos(theta) / (pi d^2) at the
+      // pixel's mean point and normal.
+      const glm::vec3 n = out.geometry.normal[p];
+      const glm::vec3 toLamp = shot.position - out.geometry.position[p];
+      const float d2 = glm::dot(toLamp, toLamp);
+      const float cosine = glm::dot(n, toLamp) / std::sqrt(d2);
+      const float unoccluded = shot.intensity * (shot.color.x + shot.color.y + shot.color.z) / 3.0f * cosine /
+                               (glm::pi<float>() * d2);
+      const float rendered = (direct[p].x + direct[p].y + direct[p].z) / 3.0f;
+      visibility.k[p] = cosine > 1e-3f && unoccluded > 0.0f ? std::clamp(rendered / unoccluded, 0.0f, 1.0f) : 0.0f;
+    }
+    out.direct.push_back(std::move(direct));
+    out.indirect.push_back(std::move(indirect));
+    out.visibility.push_back(std::move(visibility));
+  }
+  out.seconds = secondsSince(start);
+  return out;
+}
+
+void saveRecoveredState(const std::string& dir, const gpu::Context& context, const scene::Scene& room,
+                        const bvh::Bvh& bvh, const scene::Camera& camera, const PhotoSet& photos,
+                        const Recovery& recovery, const RecoveryOptions& options) {
+  const RoomRender roomRender(context, room, bvh, camera, photos, recovery.iterations.back().objectReflectance, options);
+  const render::ObscuranceRenderer& renderer = *roomRender.renderer;
+  render::Transport transport = renderer.transport();
+  const io::Image aov = renderer.image();
+  const int albedo = channel(aov, "albedo.R");
+  for (std::size_t p = 0; p < transport.pixels(); ++p) {
+    const glm::vec3 rho = pixel3(aov, p, albedo);
+    glm::vec3 scale(0.0f);
+    for (int c = 0; c < 3; ++c)
+      if (rho[c] >= 1e-4f) scale[c] = recovery.reflectance[p][c] / rho[c];
+    for (auto& direct : transport.direct) direct[p] *= scale;
+    transport.ambient[p] = glm::vec4(glm::vec3(transport.ambient[p]) * scale, transport.ambient[p].w);
+  }
+  relight::saveState(dir, renderer, transport, room.sourcePath);
+}
+
+Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
+                            const scene::Camera& camera, const PhotoSet& photos, const RecoveryOptions& options,
+                            const RecoveryLog& log) {
+  const auto start = Clock::now();
+  const std::size_t objects = room.objects.size();
+  Recovery out;
+  out.width = photos.width;
+  out.height = photos.height;
+  for (const auto& o : room.objects) out.objectNames.push_back(o.name);
+
+  // The start: grey materials (the direct light per unit reflectance does not depend on them)
+  // and the paper's constant ambient.
+  auto stepStart = Clock::now();
+  Lighting lighting = traceLighting(context, room, bvh, camera, photos, std::vector<glm::vec3>(objects, glm::vec3(0.5f)),
+                                    options);
+  std::vector<std::vector<glm::vec3>> ambient;
+  for (const auto& shot : photos.shots)
+    ambient.push_back(constantAmbient(shot.radiance, lighting.geometry.object, options.constantReflectance));
+  out.estimates = estimatesWith(photos, lighting, ambient);
+  out.indirect = ambient;
+  out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters);
+  Merged merged = mergeEstimates(out.estimates, out.confidences);
+  out.iterations.push_back({0, secondsSince(stepStart), 0.0, objectMeans(merged.reflectance, merged.confidence, lighting.geometry.object, objects)});
+  if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
+
+  std::unique_ptr<PhotoGather> gather;
+  if (options.indirect == IndirectModel::Gather) {
+    stepStart = Clock::now();
+    gather = std::make_unique<PhotoGather>(room, bvh, camera, lighting.geometry, photos.shots, options.gatherRays,
+                                           options.seed, options.gatherSmoothing);
+    out.gatherSeen = gather->seenFraction();
+    out.gatherHidden = gather->hiddenFraction();
+    if (log)
+      log(fmt::format("recover: gather: {} rays, {:.1f} % seen by the camera, {:.1f} % hidden, {:.1f} s", gather->rays(),
+                      100.0 * out.gatherSeen, 100.0 * out.gatherHidden, secondsSince(stepStart)));
+  }
+  if (options.indirect != IndirectModel::Constant) {
+    for (std::uint32_t it = 1; it <= options.iterations; ++it) {
+      stepStart = Clock::now();
+      const std::vector<glm::vec3>& means = out.iterations.back().objectReflectance;
+      if (gather) {
+        // Hidden surfaces get the mean indirect light of the last estimate.
+        std::vector<glm::vec3> hiddenAmbient;
+        for (const auto& b : out.indirect) hiddenAmbient.push_back(constantAmbient(b, lighting.geometry.object, 1.0f).front());
+        out.indirect = gather->indirect(photos.shots, means, hiddenAmbient);
+      } else {
+        lighting = traceLighting(context, room, bvh, camera, photos, means, options);
+        out.indirect = lighting.indirect;
+      }
+      out.estimates = estimatesWith(photos, lighting, out.indirect);
+      out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters);
+      Merged next = mergeEstimates(out.estimates, out.confidences);
+      double sum = 0.0;
+      std::size_t n = 0;
+      for (std::size_t p = 0; p < next.reflectance.size(); ++p)
+        if (next.confidence[p] > 0.0f && merged.confidence[p] > 0.0f) {
+          const glm::vec3 d = next.reflectance[p] - merged.reflectance[p];
+          sum += glm::dot(d, d) / 3.0;
+          ++n;
+        }
+      merged = std::move(next);
+      const double change = n > 0 ? std::sqrt(sum / double(n)) : 0.0;
+      out.iterations.push_back({it, secondsSince(stepStart), change,
+                                objectMeans(merged.reflectance, merged.confidence, lighting.geometry.object, objects)});
+      if (log) log(fmt::format("recover: iteration {}: RMS change of R {:.5f}, {:.1f} s", it, change, secondsSince(stepStart)));
+    }
+  }
+
+  // Pixels no filtered confidence reaches: first the photos' raw visibilities (the filters
+  // removed a pixel some lamp still lights), less the estimates the outlier test rejects on them,
+  // then, lit by no lamp at all, the object's mean.
+  std::vector<ConfidenceImage> fillWeights = lighting.visibility;
+  if (options.filters.outlier)
+    outlierTest(out.estimates, fillWeights, options.filters.outlierConfidence, options.filters.outlierDistance);
+  out.visibility = lighting.visibility;
+  out.direct = lighting.direct;
+  out.object = lighting.geometry.object;
+  out.reflectance = merged.reflectance;
+  out.confidence = merged.confidence;
+  out.filled.assign(merged.reflectance.size(), 0);
+  const std::vector<glm::vec3> means = out.iterations.back().objectReflectance;
+  for (std::size_t p = 0; p < out.reflectance.size(); ++p) {
+    if (out.confidence[p] > 0.0f || out.object[p] < 0) continue;
+    glm::vec3 sum(0.0f);
+    float weight = 0.0f;
+    for (std::size_t i = 0; i < out.estimates.size(); ++i) {
+      sum += fillWeights[i].k[p] * out.estimates[i][p];
+      weight += fillWeights[i].k[p];
+    }
+    if (weight > 0.0f) {
+      out.reflectance[p] = sum / weight;
+      out.filled[p] = 1;
+      ++out.filledFromVisibility;
+    } else {
+      out.reflectance[p] = means[static_cast<std::size_t>(out.object[p])];
+      out.filled[p] = 2;
+      ++out.filledFromObject;
+    }
+  }
+  out.seconds = secondsSince(start);
+  return out;
+}
+
+} // namespace obscura::recover

@@ -1,0 +1,121 @@
+// reflectance_recovery.h — per-pixel diffuse reflectance from photographs of one view, each lit
+// by one lamp [IVR §4.2-4.3, SPEC §2]:
+//
+//   R_i = C_i / (F V E_i + B_i)     per photo i and pixel (IVR eq. 2, camera response linear)
+//   K_i = V_i, filtered (confidence_filters.h);  R = sum K_i R_i / sum K_i  (IVR eq. 3)
+//
+// F V E_i, the direct light per unit reflectance, comes from the obscurance renderer's shadow
+// rays to the lamp (a point light, ShadowSampling::PerLight). B_i, the indirect light per unit
+// reflectance, is one of
+//   Constant    the paper's ambient: B_i = k * (mean of photo i over the pixels that see a
+//               surface), k a user's average reflectance;
+//   Obscurance  the obscurance term I_a W_c [RTO eqs. 6, 12] computed with the current estimate:
+//               each object's material is given its mean recovered reflectance, which sets both
+//               R(Q) in W_c and R_ave in I_a; rendered again each iteration;
+//   Gather      OURS (photo_gather.h): gathered from the photographs' own radiance where the
+//               camera sees the surface, from the current estimate where it does not.
+// The iterated ones start from the Constant estimate, then: estimate R, per-object means,
+// B_i again, re-estimate.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bvh/bvh.h"
+#include "gpu/context.h"
+#include "recover/confidence_filters.h"
+#include "recover/photo_gather.h"
+#include "recover/photo_set.h"
+#include "render/scene/ambient.h"
+#include "scene/scene.h"
+
+namespace obscura::recover {
+
+enum class IndirectModel { Constant, Obscurance, Gather };
+
+struct RecoveryOptions {
+  std::uint32_t spp = 16;            // primary samples per pixel (and shadow/obscurance rays with them)
+  std::uint32_t obscuranceRays = 8;  // per sample
+  std::uint32_t seed = 1;
+  float dMax = 0.0f;                 // 0 = the renderer's default
+  IndirectModel indirect = IndirectModel::Gather;
+  std::uint32_t iterations = 3;      // estimates after the Constant start
+  std::uint32_t gatherRays = 64;     // Gather: rays per pixel
+  int gatherSmoothing = 3;           // Gather: window radius of the surface-aware smoothing of B
+  float constantReflectance = 0.5f;  // Constant: k
+  render::AmbientModel ambient = render::AmbientModel::Reached;
+  FilterOptions filters;
+};
+
+// One render's lighting per photo, per unit reflectance, and what the pixels see.
+struct Lighting {
+  std::vector<std::vector<glm::vec3>> direct;   // [shot][pixel] F V E_i
+  std::vector<std::vector<glm::vec3>> indirect; // [shot][pixel] B_i (the obscurance term)
+  std::vector<ConfidenceImage> visibility;      // [shot] V_i in [0, 1]
+  PixelGeometry geometry;                       // what each pixel sees
+  double seconds = 0.0;
+};
+
+struct IterationReport {
+  std::uint32_t iteration = 0;      // 0 = the Constant estimate
+  double seconds = 0.0;             // render + estimate
+  double rmsChange = 0.0;           // RMS over confident pixels of R - previous R (0 for the first)
+  std::vector<glm::vec3> objectReflectance; // the per-object means the next render uses
+};
+
+struct Recovery {
+  int width = 0, height = 0;
+  std::vector<glm::vec3> reflectance;            // merged and filled
+  std::vector<float> confidence;                 // sum of the filtered K_i (0: filled)
+  std::vector<std::uint8_t> filled;              // 0 merged, 1 filled from visibility, 2 from the object's mean
+  std::vector<std::vector<glm::vec3>> estimates; // [shot] R_i
+  std::vector<ConfidenceImage> visibility;       // [shot] V_i
+  std::vector<std::vector<glm::vec3>> direct;    // [shot] F V E_i of the last render
+  std::vector<std::vector<glm::vec3>> indirect;  // [shot] B_i the last estimate used
+  std::vector<ConfidenceImage> confidences;      // [shot] filtered K_i
+  std::vector<std::int32_t> object;
+  std::vector<std::string> objectNames;
+  double gatherSeen = 0.0, gatherHidden = 0.0; // Gather: fractions of its rays (photo_gather.h)
+  std::vector<IterationReport> iterations;
+  std::size_t filledFromVisibility = 0, filledFromObject = 0;
+  double seconds = 0.0;
+};
+
+using RecoveryLog = std::function<void(const std::string&)>;
+
+// The whole recovery. `room` and `bvh` are the glTF as loaded (its own emitters are switched off
+// here), `camera` the glTF camera the photos were taken with.
+Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
+                            const scene::Camera& camera, const PhotoSet& photos, const RecoveryOptions& options,
+                            const RecoveryLog& log = nullptr);
+
+// One render of the recovery scene with `objectReflectance` per object.
+Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
+                       const scene::Camera& camera, const PhotoSet& photos,
+                       const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options);
+
+// Writes `dir` as a relighting state (relight/relight_state.h) of the photographed room whose
+// albedo is `recovery`'s reflectance: rendered with each object at its mean recovered reflectance
+// (which sets I_a), then D_s and A scaled per pixel by R / albedo. Its lights are the shots'
+// lamps, "shot<i>", so `obscura relight DIR --light shot2=0.5` relights the photographed room.
+void saveRecoveredState(const std::string& dir, const gpu::Context& context, const scene::Scene& room,
+                        const bvh::Bvh& bvh, const scene::Camera& camera, const PhotoSet& photos,
+                        const Recovery& recovery, const RecoveryOptions& options);
+
+// IVR eq. 2 per pixel: C / (direct + indirect), 0 where nothing lights the pixel.
+std::vector<glm::vec3> estimateReflectance(const std::vector<glm::vec3>& photo, const std::vector<glm::vec3>& direct,
+                                           const std::vector<glm::vec3>& indirect);
+
+// The paper's ambient B_i: k times the photo's mean over the pixels that see a surface.
+std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, const std::vector<std::int32_t>& object,
+                                       float k);
+
+// The confidence-weighted mean reflectance of each object's pixels; objects with no confident
+// pixel get the mean over all confident pixels.
+std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
+                                   const std::vector<std::int32_t>& object, std::size_t objects);
+
+} // namespace obscura::recover

@@ -1,0 +1,141 @@
+// `obscura recover` as a user runs it: a run on two of the Cycles photographs writes the
+// reflectance (with its confidence layer), the report, a relighting state whose albedo is the
+// recovered one and, with --debug/--png, the per-photo images; bad input (photos of different sizes, a lamp inside geometry, another camera, an
+// unreadable image, a missing field) is a clear error naming the file, exit 2, nothing written.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "app/cli_runner.h"
+#include "gpu_test.h"
+#include "io/image_io.h"
+
+namespace obscura::test {
+namespace {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+class CliRecover : public CliTest {
+protected:
+  static std::string photosDir() { return sharedScene("../photos/cornell-box"); }
+  static std::string scene() { return sharedScene("cornell-box/cornell-box.gltf"); }
+  // The photographs' JSON with its first `shots` shots, images as absolute paths.
+  static json lights(std::size_t shots) {
+    std::ifstream in(photosDir() + "/lights.json");
+    json doc = json::parse(in);
+    doc["shots"].erase(doc["shots"].begin() + static_cast<std::ptrdiff_t>(shots), doc["shots"].end());
+    for (auto& s : doc["shots"]) s["image"] = photosDir() + "/" + s["image"].get<std::string>();
+    return doc;
+  }
+  static json doc0() { return lights(1); }
+  std::string write(const json& doc, const std::string& name = "lights.json") {
+    std::ofstream(path(name)) << doc.dump(1);
+    return path(name);
+  }
+  // Runs recover on `doc` (plus `extra`) and expects a clear error mentioning `mention`, exit
+  // 2 and no output folder.
+  void expectBadInput(const json& doc, const std::string& mention, const std::string& extra = "") {
+    const std::string file = write(doc);
+    const auto r = runObscura("recover " + scene() + " --photos " + file + " -o " + path("out") + " --spp 1 " + extra);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_CONTAINS(r.output, mention);
+    EXPECT_FALSE(fs::exists(path("out"))) << "a failed recover wrote its folder";
+  }
+};
+
+TEST_F(CliRecover, WritesReflectanceWithConfidenceAndThePerPhotoImages) {
+  const std::string file = write(lights(2));
+  const auto r = runObscura("recover " + scene() + " --photos " + file + " -o " + path("out") +
+                            " --spp 1 --gather-rays 8 --iterations 1 --debug --png --truth " + photosDir() + "/albedo.exr");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const io::Image image = io::readImage(path("out/reflectance.exr"));
+  EXPECT_EQ(image.width, 256);
+  EXPECT_GE(image.channelIndex("R"), 0);
+  EXPECT_GE(image.channelIndex("confidence.K"), 0);
+  for (const char* f : {"recover.json", "reflectance.png", "confidence.png", "shot-000.exr", "shot-001.exr",
+                        "state/state.json", "state/transport.exr"})
+    EXPECT_TRUE(fs::exists(path(std::string("out/") + f))) << f;
+  EXPECT_FALSE(fs::exists(path("out/shot-002.exr")));
+  std::ifstream in(path("out/recover.json"));
+  const json report = json::parse(in);
+  EXPECT_EQ(report["photos"], 2);
+  EXPECT_EQ(report["iterations"].size(), 2u);
+  EXPECT_GT(report["accuracy"]["lit"]["pixels"].get<int>(), 0);
+
+  // The relighting state: `relight` composes it, and its direct light for shot 0 is the recovered
+  // reflectance times the lamp's direct light per unit reflectance (what the estimate divided by).
+  const auto relit = runObscura("relight " + path("out/state") + " --light shot0=0.5 -o " + path("relit.exr"));
+  ASSERT_EQ(relit.exitCode, 0) << relit.output;
+  const io::Image transport = io::readImage(path("out/state/transport.exr"));
+  const io::Image shot = io::readImage(path("out/shot-000.exr"));
+  const int d = transport.channelIndex("D.shot0.R"), direct = shot.channelIndex("direct.R"), k = shot.channelIndex("confidence.K");
+  ASSERT_GE(d, 0);
+  ASSERT_GE(direct, 0);
+  const float intensity = doc0()["shots"][0]["gltf_light"]["intensity"].get<float>();
+  int checked = 0, agree = 0;
+  for (int y = 0; y < 256; y += 4)
+    for (int x = 0; x < 256; x += 4) {
+      if (shot.at(x, y, k) < 0.99f || shot.at(x, y, direct) < 0.05f) continue; // interior, lit
+      ++checked;
+      const float expected = image.at(x, y, 0) * shot.at(x, y, direct);
+      agree += std::abs(transport.at(x, y, d) * intensity - expected) <= 0.01f * expected ? 1 : 0;
+    }
+  EXPECT_GT(checked, 500);
+  EXPECT_GE(agree, checked * 95 / 100) << agree << " of " << checked;
+}
+
+TEST_F(CliRecover, PhotosOfDifferentSizesAreRefusedNamingTheImage) {
+  io::Image small;
+  small.width = small.height = 8;
+  small.channels = {"R", "G", "B"};
+  small.pixels.assign(8 * 8 * 3, 0.5f);
+  io::writeExr(path("small.exr"), small);
+  json doc = lights(2);
+  doc["shots"][1]["image"] = path("small.exr");
+  expectBadInput(doc, "small.exr: the image is 8x8");
+}
+
+TEST_F(CliRecover, AnUnreadableImageIsRefusedNamingIt) {
+  std::ofstream(path("broken.exr")) << "not an image";
+  json doc = lights(2);
+  doc["shots"][0]["image"] = path("broken.exr");
+  expectBadInput(doc, "broken.exr: cannot read image");
+}
+
+TEST_F(CliRecover, AMissingFieldIsRefusedNamingTheJsonShotAndField) {
+  json doc = lights(2);
+  doc["shots"][1].erase("position");
+  expectBadInput(doc, "lights.json: shots: entry 1: 'position' is missing");
+  doc = lights(2);
+  doc.erase("camera");
+  expectBadInput(doc, "lights.json: 'camera'");
+}
+
+TEST_F(CliRecover, ALampInsideGeometryIsRefused) {
+  json doc = lights(2);
+  doc["shots"][1]["position"] = {0.0, 0.02, 0.0}; // 0.02 above the floor, radius 0.04
+  expectBadInput(doc, "shots entry 1: the lamp at (0, 0.02, 0) is inside geometry");
+  doc = lights(2);
+  doc["shots"][0]["position"] = {0.33, 0.3, 0.37}; // inside the short box
+  doc["shots"][0]["radius"] = 0.0;
+  expectBadInput(doc, "shots entry 0: the lamp at (0.33, 0.3, 0.37) is inside geometry");
+}
+
+TEST_F(CliRecover, ACameraOtherThanTheGltfsIsRefused) {
+  json doc = lights(2);
+  doc["camera"]["gltf_camera"] = 3;
+  expectBadInput(doc, "gltf_camera 3 does not exist");
+  doc = lights(2);
+  doc["camera"]["yfov"] = 0.5;
+  expectBadInput(doc, "yfov 0.5 differs from the glTF camera 0");
+  doc = lights(2);
+  doc["camera"]["width"] = 320;
+  expectBadInput(doc, "the image is 256x256"); // the photos are not the camera's size
+  expectBadInput(lights(2), "--camera 1: the photographs", "--camera 1");
+}
+
+} // namespace
+} // namespace obscura::test
