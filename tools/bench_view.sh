@@ -16,26 +16,32 @@ run() { if [ -n "${DISPLAY:-}" ]; then "$@"; else xvfb-run -a -s "-screen 0 1280
 bench() { # name scene light [options...]
   local name=$1 scene=$2 light=$3
   shift 3
-  # Frames 0-4 progressive, 5-8 dragged (previews), 9 the first full frame after, 10 a light edit.
-  cat > "$work/events.json" <<JSON
-[{"frame": 5, "drag": [4, 0]}, {"frame": 6, "drag": [4, 0]}, {"frame": 7, "drag": [4, 0]}, {"frame": 8, "drag": [4, 0]},
- {"frame": 10, "panel": {"light": "$light", "scale": 0.5}}]
+  # Frames 0-4 progressive, 5-8 dragged (previews). Then a light edit on a finished frame: one
+  # sample (frame 0), the edit at frame 2, when nothing is traced any more.
+  cat > "$work/move.json" <<JSON
+[{"frame": 5, "drag": [4, 0]}, {"frame": 6, "drag": [4, 0]}, {"frame": 7, "drag": [4, 0]}, {"frame": 8, "drag": [4, 0]}]
+JSON
+  cat > "$work/edit.json" <<JSON
+[{"frame": 2, "panel": {"light": "$light", "scale": 0.5}}]
 JSON
   for denoise in --no-denoise ""; do
-    run "$obscura" view "$scene" --width "$width" --height "$height" --frames 11 --no-panel $denoise \
-      --script "$work/events.json" --log "$work/frames.jsonl" "$@" >/dev/null 2>&1
-    python3 - "$work/frames.jsonl" "$name" "${width}x${height}" "${denoise:-denoised}" <<'PY'
+    run "$obscura" view "$scene" --width "$width" --height "$height" --frames 9 --no-panel $denoise \
+      --script "$work/move.json" --log "$work/frames.jsonl" "$@" >/dev/null 2>&1
+    run "$obscura" view "$scene" --width "$width" --height "$height" --frames 3 --spp 1 --no-panel $denoise \
+      --script "$work/edit.json" --log "$work/edit.jsonl" "$@" >/dev/null 2>&1
+    python3 - "$work/frames.jsonl" "$work/edit.jsonl" "$name" "${width}x${height}" "${denoise:-denoised}" <<'PY'
 import json, statistics, sys
 frames = [json.loads(l) for l in open(sys.argv[1])]
-name, size, mode = sys.argv[2:5]
+edit = [json.loads(l) for l in open(sys.argv[2])][2]
+name, size, mode = sys.argv[3:6]
 def med(rows, key): return statistics.median(r[key] for r in rows)
-progressive = [f for f in frames[1:5]]
+progressive = frames[1:5]
 preview = [f for f in frames if f["preview"]]
-edit = frames[10]
-def cell(rows): return "%.0f ms (%.1f fps), GPU %.0f ms, %.2f Mrays/s" % (
-    med(rows, "frame_ms"), 1000.0 / med(rows, "frame_ms"), med(rows, "gpu_ms"),
-    med(rows, "rays") / med(rows, "gpu_ms") / 1e3 if med(rows, "gpu_ms") > 0 else 0)
-print("| %s | %s | %s | %s | %s | %.0f ms (rays %d) |" % (name, size, mode.replace("--no-denoise", "raw"),
+def cell(rows):
+    text = "%.0f ms (%.2f fps), GPU %.0f ms" % (med(rows, "frame_ms"), 1000.0 / med(rows, "frame_ms"), med(rows, "gpu_ms"))
+    if med(rows, "denoise_ms") > 0: text += " + denoise %.0f ms" % med(rows, "denoise_ms")
+    return text + ", %.2f Mrays/s" % (med(rows, "rays") / med(rows, "gpu_ms") / 1e3)
+print("| %s | %s | %s | %s | %s | %.0f ms (%d rays) |" % (name, size, mode.replace("--no-denoise", "raw"),
       cell(progressive), cell(preview), edit["frame_ms"], edit["rays"]))
 PY
   done

@@ -61,11 +61,12 @@ TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   while (std::getline(csv, line)) ++rows[line.substr(0, line.find(','))];
   const std::map<std::string, int> expected = {
       {"obscurance", 4}, {"obscurance-paper", 4}, {"obscurance-realtime", 4}, {"obscurance-reflectors", 4},
-      {"pathtrace", 4}}; // 1, 2, 4, 8 spp
+      {"obscurance-denoised", 4}, {"obscurance-realtime-denoised", 4}, {"pathtrace", 4}}; // 1, 2, 4, 8 spp
   EXPECT_EQ(rows, expected);
   std::ifstream json(path("study/cornell-box.convergence.json"));
   std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
   for (const char* key : {"\"obscurance-paper\"", "\"obscurance-realtime\"", "\"obscurance-reflectors\"",
+                          "\"obscurance-denoised\"", "\"obscurance-realtime-denoised\"",
                           "\"bias_floor_obscurance-reflectors\"", "\"equal_noise_speedup\"",
                           "\"mean_ratio\"", "\"crossover_ms\"", "\"rmse_trimmed\""})
     EXPECT_CONTAINS(text, key);

@@ -4,6 +4,9 @@
 // current frame writes, one the history holds; `parity` says which is which.
 #pragma once
 #include <cstdint>
+#include <initializer_list>
+#include <span>
+#include <string>
 
 #include "gpu/buffer.h"
 #include "gpu/context.h"

@@ -53,9 +53,11 @@ public:
   // Forgets the history: the next denoise() uses the current frame alone. Call it after anything
   // but a camera move changed the image (a light or geometry edit, other render settings).
   void reset();
-  // Denoises the renderer's frame as its last compose() left it, seen with the renderer's current
-  // camera (settings().camera), which it remembers for the next reprojection; tonemaps with
-  // `exposureStops` for display().
+  // Denoises the renderer's frame as its last compose() left it (composeDisplay() does not write
+  // the composed terms it reads), seen with the renderer's current camera (settings().camera),
+  // which it remembers for the next reprojection; tonemaps with `exposureStops` for display().
+  // After a camera move the history is reprojected once and blended with the new frame by sample
+  // counts; while the camera stays, the renderer's own accumulation does the temporal work.
   void denoise(const ObscuranceRenderer& renderer, float exposureStops = 0.0f);
 
   // The tonemapped denoised combined image, RGBA8 per pixel (R in the low byte), row by row.
