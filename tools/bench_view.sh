@@ -43,6 +43,9 @@ def cell(rows):
     return text + ", %.2f Mrays/s" % (med(rows, "rays") / med(rows, "gpu_ms") / 1e3)
 print("| %s | %s | %s | %s | %s | %.0f ms (%d rays) |" % (name, size, mode.replace("--no-denoise", "raw"),
       cell(progressive), cell(preview), edit["frame_ms"], edit["rays"]))
+passes = sorted({p for f in progressive + preview for p in f["pass_ms"]})
+def per_pass(rows): return ", ".join("%s %.0f" % (p, statistics.median(r["pass_ms"].get(p, 0.0) for r in rows)) for p in passes)
+print("|  |  | GPU ms per pass |  %s | %s |  |" % (per_pass(progressive), per_pass(preview)))
 PY
   done
 }

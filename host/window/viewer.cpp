@@ -72,6 +72,7 @@ struct Viewer::FrameRecord {
   double gpuMs = 0.0;          // the renderer's GPU time this frame (its passes' timestamps)
   double renderMs = 0.0;       // wall time of the edits, the samples and the compose
   double denoiseMs = 0.0;      // the denoiser's GPU time (0 when it did not run)
+  std::map<std::string, double> passMs; // the renderer's GPU ms per pass this frame
   double presentMs = 0.0;      // wall time of the panel and the presentation
   double frameMs = 0.0;
   std::vector<std::string> actions;
@@ -441,6 +442,7 @@ void Viewer::writeLog(const FrameRecord& r) {
                          {"gpu_ms", r.gpuMs},
                          {"render_ms", r.renderMs},
                          {"denoise_ms", r.denoiseMs},
+                         {"pass_ms", r.passMs},
                          {"present_ms", r.presentMs},
                          {"frame_ms", r.frameMs},
                          {"actions", r.actions}};
@@ -548,6 +550,11 @@ void Viewer::run() {
     // A restart zeroes the renderer's counters: then all it counts is this frame's.
     record.rays = totalRays(after) - (record.restarted ? 0 : totalRays(before));
     record.gpuMs = totalGpuMs(after) - (record.restarted ? 0.0 : totalGpuMs(before));
+    for (const auto& [name, pass] : after.passes) {
+      const auto was = before.passes.find(name);
+      const double ms = pass.gpuMs - (record.restarted || was == before.passes.end() ? 0.0 : was->second.gpuMs);
+      if (ms > 0.0) record.passMs[name] = ms;
+    }
     const auto presentStart = Clock::now();
     record.renderMs = std::chrono::duration<double, std::milli>(presentStart - renderStart).count();
 
