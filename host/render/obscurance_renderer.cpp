@@ -404,7 +404,10 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
   }
   // The retraced pixels' G-buffer now holds the last sample; the others' still hold theirs.
   if (retraced > 0 && gbufferSample_ + 1 != samples_) gbufferSample_ = kNoSample;
-  markResolveStale(0, true);
+  // Only the listed pixels changed: where the rest is resolved, the next light mix resolves them
+  // alone (the lists stay until the next edit, so a second edit before it resolves everything).
+  if (resolveFrom_ >= lightCount && !resolveAmbient_ && !resolveDirty_) resolveDirty_ = retraced > 0;
+  else markResolveStale(0, true);
   return retraced;
 }
 
@@ -476,13 +479,15 @@ void ObscuranceRenderer::composeDisplay(float exposureStops) {
   const glm::vec3 ia = ambientIntensity();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
   const bool resolve = resolveFrom_ < lightCount || resolveAmbient_;
+  const bool resolveDirty = !resolve && resolveDirty_;
   const std::uint32_t slots = frame_.lightCapacity();
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
-    if (resolve) {
+    if (resolve || resolveDirty) {
       timestamps_.begin(cmd, "resolve");
       for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
-        resolve_.record(cmd, b, layout, lightCount, slots, runSpecular_, resolveFrom_, resolveAmbient_);
+        resolve_.record(cmd, b, layout, lightCount, slots, runSpecular_, resolveDirty ? 0u : resolveFrom_,
+                        resolveDirty || resolveAmbient_, resolveDirty);
       timestamps_.end(cmd, "resolve");
       gpu::computeBarrier(cmd);
     }
@@ -493,6 +498,7 @@ void ObscuranceRenderer::composeDisplay(float exposureStops) {
   timestamps_.collect();
   resolveFrom_ = lightCount;
   resolveAmbient_ = false;
+  resolveDirty_ = false;
   wallSeconds_ += secondsSince(start);
 }
 

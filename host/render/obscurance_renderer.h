@@ -275,6 +275,8 @@ private:
   // resolveAmbient_); a new sample makes all of it stale, an added light only itself.
   std::uint32_t resolveFrom_ = 0;
   bool resolveAmbient_ = true;
+  // A geometry edit's retrace left only the pixels of the dirty lists stale (the rest is current).
+  bool resolveDirty_ = false;
   void markResolveStale(std::uint32_t fromLight, bool ambient);
 
   gpu::CommandStream stream_;

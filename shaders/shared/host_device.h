@@ -372,7 +372,9 @@ struct ResolvePush {
   uvec4 frame;     // 0:  width, rows (of the band), unused (samples are counted per pixel), light count
   uvec4 flags;     // 16: x = 1 when the specular buffers hold data, y = first light to resolve (the
                    //     ones before are current), z = 1 to resolve the ambient too
-  uvec4 capacity;  // 32: x = light slots of the frame (A_t lives after them)
+  uvec4 capacity;  // 32: x = light slots of the frame (A_t lives after them), y = 1 to resolve only
+                   //     the pixels of the band's dirty list (after a geometry edit), dispatched
+                   //     indirectly; the others are current
 };                 // 48 bytes
 OBS_CONST uint kBindingResolveBasis = 0;           // vec4 pairs [light][pixel]: D_s
 OBS_CONST uint kBindingResolveEmissionBasis = 1;   // vec4 pairs [light][pixel]: M_s
@@ -381,7 +383,8 @@ OBS_CONST uint kBindingResolveAmbient = 3;         // vec4 pairs [pixel]: A
 OBS_CONST uint kBindingResolveSpecularAmbient = 4; // vec4 pairs [pixel]: A^spec
 OBS_CONST uint kBindingResolveOutput = 5;          // uint [(slots + 1) * resolvedStride(pixels)], RGB9E5
 OBS_CONST uint kBindingResolveSampleCounts = 6;    // uint[pixel] (primary.comp)
-OBS_CONST uint kResolveBindingCount = 7;
+OBS_CONST uint kBindingResolveDirty = 7;           // uint[]: the dirty mask and list (capacity.y)
+OBS_CONST uint kResolveBindingCount = 8;
 
 struct LightMixPush {
   uvec4 frame;     // 0:  width, rows (of the band), light count, light slots (A_t lives after them)
