@@ -29,6 +29,7 @@ void main() {
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;
+  if (beginProbe() && skipClean(pixel)) return; // a probe: this candidate is dirty already
   GBufferTexel g = gbuffer[pixel];
   if (g.albedo.a == 0.0) return;
 
@@ -36,7 +37,9 @@ void main() {
   uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x9e3779b9u);
   gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
   StepBudget budget = newStepBudget();
-  OBS_ACCUMULATE(ambient, pixel, gatherObscurance(sp, rng, budget, pixel, bp.count))
-  atomicAdd(status[kStatusObscuranceRays], pc.counts.z);
+  const vec4 gathered = gatherObscurance(sp, rng, budget, pixel, bp.count); // a probe too: not in the macro
+  OBS_ACCUMULATE(ambient, pixel, gathered)
+  if (kProbe) endProbe(pixel);
+  else atomicAdd(status[kStatusObscuranceRays], pc.counts.z);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

@@ -16,10 +16,16 @@ layout(std430, binding = kBindingResolveAmbient) readonly buffer Ambient { vec4 
 layout(std430, binding = kBindingResolveSpecularAmbient) readonly buffer SpecularAmbient { vec4 specularAmbient[]; };
 layout(std430, binding = kBindingResolveOutput) writeonly buffer Resolved { uint resolved[]; };
 layout(std430, binding = kBindingResolveSampleCounts) readonly buffer SampleCounts { uint sampleCounts[]; };
+layout(std430, binding = kBindingResolveDirty) readonly buffer Dirty { uint dirty[]; };
 
 void main() {
   uint pixel = gl_GlobalInvocationID.x;
   uint pixelCount = pc.frame.x * pc.frame.y;
+  if (pc.capacity.y != 0u) { // the dirty list's pixels only (a geometry edit's retrace)
+    const uint base = dirtyListBase(pixelCount);
+    if (pixel >= dirty[base + kQueueCount]) return;
+    pixel = dirty[base + kQueueHeader + pixel];
+  }
   if (pixel >= pixelCount) return;
   float inv = 1.0 / float(max(sampleCounts[pixel], 1u));
   const bool withSpecular = pc.flags.x != 0u;

@@ -31,10 +31,14 @@ void main() {
   uvec2 p = bp.frame;
   uint pixel = bp.index;
   uint pixelCount = bp.count;
+  if (beginProbe() && skipClean(pixel)) return; // a probe: this candidate is dirty already
   GBufferTexel g = gbuffer[pixel];
   if (g.albedo.a == 0.0) return; // no hit: nothing to light
 
   ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);
+  // A probe whose shafts from the hit to the lights all miss the boxes draws no light sample.
+  const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, pc.counts.x);
+  if (!drawn) return;
   uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x5bd1e995u);
   StepBudget budget = newStepBudget();
   const vec4 lightShift = rngNext4(rng); // the hit's light samples: one shifted low-discrepancy set
@@ -43,11 +47,12 @@ void main() {
     uint taken;
     vec3 direct = directLightFromOne(sp, light, lightShift, budget, taken);
     OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(direct, 0.0))
-    atomicAdd(status[kStatusShadowRays], taken);
+    if (kProbe) endProbe(pixel);
+    else atomicAdd(status[kStatusShadowRays], taken);
     if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
     return;
   }
-  uint count = pc.counts.y;
+  uint count = drawn ? pc.counts.y : 0u;
   float invCount = 1.0 / float(count);
   float misSamples = (pc.counts.w & kFlagGlossyMis) != 0u ? float(count) : 0.0;
   for (uint k = 0u; k < count; ++k) {
@@ -57,6 +62,7 @@ void main() {
     directLightSample(sp, u, pc.counts.x, misSamples, budget, contribution, light);
     OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(contribution * invCount, 0.0))
   }
-  atomicAdd(status[kStatusShadowRays], count);
+  if (kProbe) endProbe(pixel);
+  else atomicAdd(status[kStatusShadowRays], count);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

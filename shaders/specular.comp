@@ -17,6 +17,9 @@
 // what is gathered along it. Only that light is gathered, alone as in shadow.comp (no MIS, its
 // emission counted after mirror bounces only), and the hit box is left as it was. With
 // kShadeFlagNoDirect no light is gathered (those per-light dispatches do it), only the ambient.
+// With kShadeFlagProbe (a geometry edit's dirty test, lib/probe.glsl) the same paths are followed
+// in the edited scene: the lobe rays are traced, every other ray only tested against the changed
+// boxes, nothing is summed, and the pixel is marked dirty when one meets a box.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -65,6 +68,7 @@ void main() {
   BandPixel bp = bandPixelFromIndex(pixel, size, pc.band.xy);
   uvec2 p = bp.frame;
   uint pixelCount = bp.count;
+  beginProbe(); // the queue holds only the candidates not yet found dirty (skipClean)
   const uint lightCount = pc.counts.x;
   const uint shadowRays = lightCount > 0u ? pc.counts.y : 0u;
   const uint maxDepth = uint(pc.params.w);
@@ -96,14 +100,15 @@ void main() {
     throughput *= weight;
     if (all(equal(throughput, vec3(0.0)))) break;
     vec3 origin = offsetRayOrigin(sp.position, sp.ng);
-    RayHit h = traceWithBudget(budget, origin, wi, 0.0, 1.0 / 0.0, false);
+    RayHit h = traceFollowed(budget, origin, wi, 0.0, 1.0 / 0.0); // traced even when probing
     ++rays;
+    if (gProbeMet) break; // a probe that met a changed box: the pixel is dirty, the rest is moot
     if (!rayHitValid(h) || h.primitive == kInvalidIndex) {
       escaped = true;
       // The sky along the lobe: whole after a mirror, MIS-weighted after a glossy bounce.
       uint sky = findBackgroundLight(lightCount);
       if ((oneLight && sky != addedLight) || noDirect) sky = kInvalidIndex;
-      if (h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || (glossyMis && !oneLight))) { // a miss, not a truncation
+      if (!kProbe && h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || (glossyMis && !oneLight))) { // a miss, not a truncation
         float w = delta ? 1.0 : powerHeuristic(lobePdf, float(shadowRays) * backgroundLightPdf(sky, previous, previousNormal, lightCount, wi));
         OBS_ACCUMULATE(specularBasis, sky * pixelCount + pixel, vec4(w * throughput, 0.0))
       }
@@ -115,7 +120,7 @@ void main() {
     GpuMaterial m = materials[s.material];
     vec3 baseColor = materialBaseColor(m, s.uv).rgb;
     const bool counted = oneLight ? delta && s.lightGroup == addedLight : !noDirect && (delta || glossyMis);
-    if (counted && s.lightGroup != kInvalidIndex && s.lightGroup < lightCount) {
+    if (!kProbe && counted && s.lightGroup != kInvalidIndex && s.lightGroup < lightCount) {
       float w = 1.0;
       if (!delta) {
         float lightPdf = emitterHitLightPdf(s.lightGroup, previous, previousNormal, lightCount, h, s.position, wi);
@@ -130,14 +135,17 @@ void main() {
     // MIS only where a lobe sample follows from this vertex (the loop goes on past it).
     float misSamples = glossyMis && depth + 1u < maxDepth ? float(shadowRays) : 0.0;
     const vec4 lightShift = rngNext4(rng); // this vertex's light samples: one shifted low-discrepancy set
+    // A probe whose shafts from the vertex to the lights all miss the boxes draws no light sample.
+    const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, lightCount);
     if (oneLight) {
-      uint taken;
-      vec3 direct = directLightFromOne(sp, addedLight, lightShift, budget, taken);
+      uint taken = 0u;
+      vec3 direct = vec3(0.0);
+      if (drawn) direct = directLightFromOne(sp, addedLight, lightShift, budget, taken);
       OBS_ACCUMULATE(specularBasis, addedLight * pixelCount + pixel, vec4(throughput * direct, 0.0))
       rays += taken;
       continue;
     }
-    for (uint k = 0u; k < (noDirect ? 0u : shadowRays); ++k) {
+    for (uint k = 0u; k < (noDirect || !drawn ? 0u : shadowRays); ++k) {
       vec4 u = kroneckerPoint4(k, lightShift);
       vec3 contribution;
       uint light;
@@ -149,11 +157,12 @@ void main() {
     OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
     rays += (noDirect ? 0u : shadowRays) + pc.counts.z;
   }
-  if (!oneLight) {
+  if (!oneLight && !kProbe) {
     vec4 lo = hitBounds[2u * pixel], hi = hitBounds[2u * pixel + 1u];
     hitBounds[2u * pixel] = vec4(min(lo.xyz, pathLo), max(lo.w, escaped ? 1.0 : 0.0));
     hitBounds[2u * pixel + 1u] = vec4(max(hi.xyz, pathHi), hi.w);
   }
-  atomicAdd(status[kStatusSpecularRays], rays);
+  if (kProbe) endProbe(pixel);
+  else atomicAdd(status[kStatusSpecularRays], rays);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

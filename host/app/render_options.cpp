@@ -67,6 +67,12 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
                  "which surfaces share a light's flux in I_a: reached (default: those its light reaches, directly or "
                  "after one bounce) or global (the paper's: the whole scene)")
       ->check(CLI::IsMember({"reached", "global"}));
+  cmd.add_option("--dirty-test", o.dirtyTest,
+                 "which pixels a geometry edit (relight --edits: move, remove, insert) retraces: bounds (those whose "
+                 "rays' bounding boxes and shafts may meet the object's old or new place), probe (of those, the ones "
+                 "one of whose rays does, found by replaying their rays) or auto (default: probe where the scene has "
+                 "glossy surfaces, else bounds)")
+      ->check(CLI::IsMember({"auto", "probe", "bounds"}));
   cmd.add_option("--secondary-reflectors", o.obscurance.secondaryReflectors,
                  "T: important secondary reflectors (the paper's future work): surfaces a light lights at least T "
                  "times its mean direct irradiance are marked, and an obscurance ray that lands on one traces the "
@@ -120,6 +126,9 @@ render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scen
                                                             : render::ShadowSampling::Selection;
   settings.lightSampling = lightSampling(o);
   settings.ambient = o.ambient == "global" ? render::AmbientModel::Global : render::AmbientModel::Reached;
+  settings.dirtyTest = o.dirtyTest == "bounds"  ? render::DirtyTest::Bounds
+                       : o.dirtyTest == "probe" ? render::DirtyTest::Probe
+                                                : render::DirtyTest::Auto;
   return settings;
 }
 

@@ -36,6 +36,7 @@ struct RenderOptions {
   std::string shadowSampling = "selection";
   std::string lightSampling = "spatial";
   std::string ambient = "reached";
+  std::string dirtyTest = "auto";
   std::vector<float> background; // R,G,B radiance of the sky; empty: none
   bool denoise = false;          // render only: the denoised combined image too (render/denoise/)
   DeviceOptions device;

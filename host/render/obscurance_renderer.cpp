@@ -240,7 +240,7 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
 }
 
 void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t s, std::uint32_t primaryFlags,
-                                      std::uint32_t shadeFlags) {
+                                      std::uint32_t shadeFlags, bool tracePrimary) {
   const FrameLayout& layout = frame_.layout();
   const std::uint32_t bands = layout.bandCount();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
@@ -252,27 +252,33 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   if (dirtyOnly != ((primaryFlags & gpu::kPrimaryFlagDirtyOnly) != 0))
     throw std::logic_error("recordSample: the primary and shading passes retrace different pixels");
   const ObscuranceFrame* dirtyOf = dirtyOnly ? &frame_ : nullptr;
-  timestamps_.begin(cmd, "primary");
-  for (std::uint32_t b = 0; b < bands; ++b)
-    primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, primaryFlags, dirtyOf);
-  timestamps_.end(cmd, "primary");
-  gpu::computeBarrier(cmd);
+  // A probe's passes are timed as probe.<pass>.
+  const bool probe = (shadeFlags & gpu::kShadeFlagProbe) != 0;
+  const auto label = [probe](const char* pass) { return probe ? "probe." + std::string(pass) : std::string(pass); };
+  if (tracePrimary) {
+    timestamps_.begin(cmd, label("primary"));
+    for (std::uint32_t b = 0; b < bands; ++b)
+      primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, primaryFlags, dirtyOf);
+    timestamps_.end(cmd, label("primary"));
+    gpu::computeBarrier(cmd);
+  }
   if (settings_.shadowSampling == ShadowSampling::PerLight) {
-    timestamps_.begin(cmd, "shadow");
+    timestamps_.begin(cmd, label("shadow"));
     for (std::uint32_t light = 0; light < lightCount; ++light) recordShadowForLight(cmd, push, light);
-    timestamps_.end(cmd, "shadow");
+    timestamps_.end(cmd, label("shadow"));
   } else if (lights_.anySampled() && settings_.shadowRays > 0) {
-    timestamps_.begin(cmd, "shadow");
+    timestamps_.begin(cmd, label("shadow"));
     for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push, dirtyOf);
-    timestamps_.end(cmd, "shadow");
+    timestamps_.end(cmd, label("shadow"));
   }
   if (settings_.obscuranceRays > 0) {
-    timestamps_.begin(cmd, "obscurance");
+    timestamps_.begin(cmd, label("obscurance"));
     for (std::uint32_t b = 0; b < bands; ++b) obscurance_.record(cmd, b, layout, push, dirtyOf);
-    timestamps_.end(cmd, "obscurance");
+    timestamps_.end(cmd, label("obscurance"));
   }
   if (runSpecular_) {
-    timestamps_.begin(cmd, "specular");
+    if (probe) gpu::computeBarrier(cmd); // the costly specular probe skips what the others found
+    timestamps_.begin(cmd, label("specular"));
     if (settings_.shadowSampling == ShadowSampling::PerLight) {
       // The ambient along the paths once, then every light alone along the same paths: each
       // light's S_s is as independent of the others' powers as its D_s.
@@ -286,7 +292,7 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
     } else {
       for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, push);
     }
-    timestamps_.end(cmd, "specular");
+    timestamps_.end(cmd, label("specular"));
   }
 }
 
@@ -349,21 +355,39 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
   // a changed box grown by 1e-3 of the scene's size and reach covers them.
   const scene::Bounds& bounds = scene_->bounds;
   const float dirtyPad = 1e-3f * (glm::length(bounds.extent()) + glm::length(glm::max(glm::abs(bounds.lo), glm::abs(bounds.hi))));
+  // The sky lights every pixel from every direction: any edit may change any pixel.
+  // So do secondary reflectors: what the edit lights or shades anew is marked anew.
+  const bool all = everyPixel || backgroundLight(lights_) < lights_.size() || reflectorsOn();
+  // Probing replays the rays the frame traced, so not after addEmitter: its new light changed how
+  // lights are chosen, and the replayed rays would not be those traced.
+  const bool probing = settings_.dirtyTest == DirtyTest::Probe || (settings_.dirtyTest == DirtyTest::Auto && runSpecular_);
+  const bool probe = probing && !all && tracedLight == gpu::kInvalidIndex && samples_ > 0;
   for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
-    // The sky lights every pixel from every direction: any edit may change any pixel.
-    // So do secondary reflectors: what the edit lights or shades anew is marked anew.
-    dirty_.prepare(b, layout, camera, changed, dirtyPad, dMax_, lightCount,
-                   everyPixel || backgroundLight(lights_) < lights_.size() || reflectorsOn(), tracedLight);
+    dirty_.prepare(b, layout, camera, changed, dirtyPad, dMax_, lightCount, all, tracedLight, probe);
   const std::uint32_t dirtyBefore = frame_.statusWords()[gpu::kStatusDirtyPixels];
+  const auto clear = [&](const vk::raii::CommandBuffer& cmd) {
+    gpu::computeBarrier(cmd);
+    for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.recordClear(cmd, b, layout, lightCount, runSpecular_);
+  };
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
     timestamps_.begin(cmd, "dirty");
     for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.record(cmd, b, layout);
-    gpu::computeBarrier(cmd);
-    for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.recordClear(cmd, b, layout, lightCount, runSpecular_);
+    if (!probe) clear(cmd);
     timestamps_.end(cmd, "dirty");
   });
   timestamps_.collect();
+  if (probe) {
+    probeCandidates();
+    stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+      timestamps_.reset(cmd);
+      timestamps_.begin(cmd, "dirty");
+      for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.recordList(cmd, b, layout);
+      clear(cmd);
+      timestamps_.end(cmd, "dirty");
+    });
+    timestamps_.collect();
+  }
   const std::uint64_t retraced = frame_.statusWords()[gpu::kStatusDirtyPixels] - dirtyBefore;
   const std::uint32_t primaryFlags = gpu::kPrimaryFlagDirtyOnly | (settings_.primaryAovs ? 0u : gpu::kPrimaryFlagNoAovs);
   for (std::uint32_t first = 0; retraced > 0 && first < samples_; first += kSamplesPerSubmission) {
@@ -380,8 +404,32 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
   }
   // The retraced pixels' G-buffer now holds the last sample; the others' still hold theirs.
   if (retraced > 0 && gbufferSample_ + 1 != samples_) gbufferSample_ = kNoSample;
-  markResolveStale(0, true);
+  // Only the listed pixels changed: where the rest is resolved, the next light mix resolves them
+  // alone (the lists stay until the next edit, so a second edit before it resolves everything).
+  if (resolveFrom_ >= lightCount && !resolveAmbient_ && !resolveDirty_) resolveDirty_ = retraced > 0;
+  else markResolveStale(0, true);
   return retraced;
+}
+
+void ObscuranceRenderer::probeCandidates() {
+  // Every sample in order over the candidates: the G-buffer holds sample 0 already only where the
+  // frame has one sample; else each sample's primary hits are traced again (G-buffer only: the
+  // candidates' camera rays miss the changed boxes, so they find what the frame's did).
+  const std::uint32_t primaryFlags = gpu::kPrimaryFlagDirtyOnly | gpu::kPrimaryFlagGBufferOnly;
+  const std::uint32_t shadeFlags = gpu::kShadeFlagDirtyOnly | gpu::kShadeFlagProbe;
+  for (std::uint32_t first = 0; first < samples_; first += kSamplesPerSubmission) {
+    const std::uint32_t last = std::min(samples_, first + kSamplesPerSubmission);
+    stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
+      timestamps_.reset(cmd);
+      for (std::uint32_t s = first; s < last; ++s) {
+        gpu::computeBarrier(cmd);
+        recordSample(cmd, s, primaryFlags, shadeFlags, !(s == 0 && gbufferSample_ == 0));
+      }
+    });
+    timestamps_.collect();
+  }
+  // The candidates' G-buffer now holds the last sample; the others' still hold theirs.
+  if (gbufferSample_ + 1 != samples_) gbufferSample_ = kNoSample;
 }
 
 void ObscuranceRenderer::render(const ProgressFn& progress) {
@@ -431,13 +479,15 @@ void ObscuranceRenderer::composeDisplay(float exposureStops) {
   const glm::vec3 ia = ambientIntensity();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
   const bool resolve = resolveFrom_ < lightCount || resolveAmbient_;
+  const bool resolveDirty = !resolve && resolveDirty_;
   const std::uint32_t slots = frame_.lightCapacity();
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
-    if (resolve) {
+    if (resolve || resolveDirty) {
       timestamps_.begin(cmd, "resolve");
       for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
-        resolve_.record(cmd, b, layout, lightCount, slots, runSpecular_, resolveFrom_, resolveAmbient_);
+        resolve_.record(cmd, b, layout, lightCount, slots, runSpecular_, resolveDirty ? 0u : resolveFrom_,
+                        resolveDirty || resolveAmbient_, resolveDirty);
       timestamps_.end(cmd, "resolve");
       gpu::computeBarrier(cmd);
     }
@@ -448,6 +498,7 @@ void ObscuranceRenderer::composeDisplay(float exposureStops) {
   timestamps_.collect();
   resolveFrom_ = lightCount;
   resolveAmbient_ = false;
+  resolveDirty_ = false;
   wallSeconds_ += secondsSince(start);
 }
 
@@ -722,6 +773,7 @@ RenderStats ObscuranceRenderer::stats() const {
   pass("resolve", 0);
   pass("lightmix", 0);
   pass("dirty", 0);
+  for (const char* probed : {"probe.primary", "probe.shadow", "probe.obscurance", "probe.specular"}) pass(probed, 0);
   st.deviceBytes = deviceBytes();
   st.wallSeconds = wallSeconds_;
   return st;

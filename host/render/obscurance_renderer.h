@@ -56,6 +56,9 @@ enum class ShadowSampling {
              // still gets transport, so switching it on later is a clean relight
 };
 
+// The dirty test of a geometry edit (ObscuranceSettings::dirtyTest).
+enum class DirtyTest { Auto, Bounds, Probe };
+
 struct ObscuranceSettings {
   std::uint32_t width = 512, height = 512;
   std::uint32_t spp = 8;             // primary samples (iterations) per pixel
@@ -86,6 +89,15 @@ struct ObscuranceSettings {
   // irradiance is marked). Needs ShadowSampling::Selection. With them on, adding or removing a
   // light and a geometry edit mark anew and retrace every pixel.
   float secondaryReflectors = 0.0f;
+  // How a geometry edit finds the pixels to retrace (dirty.comp): Bounds retraces every pixel
+  // whose rays' bounds (hit box, shafts to the lights, dMax, specular paths' boxes) may meet a
+  // changed box; Probe replays those pixels' rays first and retraces only those one of whose rays
+  // does (lib/probe.glsl). Both retrace every pixel that can change. Auto probes where the frame
+  // has specular paths: a path that left the scene bounds nothing, so the bounds keep most glossy
+  // pixels, while without them the pixels a probe clears are those with the cheapest rays, and
+  // on lavapipe the replay (light selection above all) costs what their retrace would
+  // (docs/BENCHMARKS.md, "Geometry edits: probing").
+  DirtyTest dirtyTest = DirtyTest::Auto;
 };
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.
@@ -251,14 +263,22 @@ private:
   DirtyPass dirty_;
   gpu::Buffer lightBounds_; // for dirty.comp
   float sceneScale_ = 1.0f; // the ray-origin offset's scale, kept across geometry edits
+  // Sample `sample`'s passes. With kShadeFlagProbe in `shadeFlags` they probe the dirty list's
+  // candidates (lib/probe.glsl), timed as "probe.<pass>"; `tracePrimary` false: the G-buffer holds the
+  // sample already.
   void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, std::uint32_t primaryFlags,
-                    std::uint32_t shadeFlags);
+                    std::uint32_t shadeFlags, bool tracePrimary = true);
+  // The probing half of a geometry edit's dirty test: every sample so far replayed over the
+  // candidates dirty.comp listed, each ray tested against the changed boxes (lib/probe.glsl).
+  void probeCandidates();
   // The shadow pass for `light` alone (kShadeFlagPerLight), over every band.
   void recordShadowForLight(const vk::raii::CommandBuffer& cmd, gpu::ShadePush push, std::uint32_t light) const;
   // The resolved transport is current for lights before resolveFrom_ (and the ambient unless
   // resolveAmbient_); a new sample makes all of it stale, an added light only itself.
   std::uint32_t resolveFrom_ = 0;
   bool resolveAmbient_ = true;
+  // A geometry edit's retrace left only the pixels of the dirty lists stale (the rest is current).
+  bool resolveDirty_ = false;
   void markResolveStale(std::uint32_t fromLight, bool ambient);
 
   gpu::CommandStream stream_;

@@ -24,12 +24,22 @@ vec4 kahanStep(vec4 sum, inout vec4 compensation, vec4 value) {
   return t;
 }
 
+// A probing pass (probe.glsl) sums nothing. `value` is then not evaluated: a call with side effects
+// (rays, random numbers) goes before the macro.
+#ifdef OBSCURA_PROBE_GLSL
+#define OBS_SUMS_OFF kProbe
+#else
+#define OBS_SUMS_OFF false
+#endif
+
 #define OBS_ACCUMULATE(array, index, value)                          \
   {                                                                   \
-    uint k_ = 2u * (index);                                           \
-    vec4 c_ = array[k_ + 1u];                                         \
-    array[k_] = kahanStep(array[k_], c_, (value));                    \
-    array[k_ + 1u] = c_;                                              \
+    if (!OBS_SUMS_OFF) {                                              \
+      uint k_ = 2u * (index);                                         \
+      vec4 c_ = array[k_ + 1u];                                       \
+      array[k_] = kahanStep(array[k_], c_, (value));                  \
+      array[k_ + 1u] = c_;                                            \
+    }                                                                 \
   }
 
 // Starts an accumulator at `value` (the first sample: no clear needed).

@@ -16,6 +16,8 @@
 
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
+#include "probe.glsl"
+
 struct RayHit {
   float t;
   float u;          // barycentric of v1
@@ -344,7 +346,14 @@ StepBudget newStepBudget() {
   return StepBudget(false, 0u);
 }
 
-RayHit traceWithBudget(inout StepBudget budget, vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit) {
+// A probing pass's ray (probe.glsl): tested against the changed boxes, not traced; "nothing hit".
+RayHit probedRay(vec3 origin, vec3 direction, float tmin, float tmax) {
+  probeSegment(origin, direction, tmin, tmax);
+  return RayHit(tmax, 0.0, 0.0, kInvalidIndex, 0u, 0u);
+}
+
+// A ray traced through the BVH, its passes counted against the subgroup's budget.
+RayHit traceBudgeted(inout StepBudget budget, vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit) {
   uint used = subgroupPasses[gl_SubgroupID];
   uint left = used < kMaxTraversalSteps ? kMaxTraversalSteps - used : 0u;
   RayHit h = traverseBvh(origin, direction, tmin, tmax, anyHit, left);
@@ -353,6 +362,24 @@ RayHit traceWithBudget(inout StepBudget budget, vec3 origin, vec3 direction, flo
   subgroupMemoryBarrierShared();
   if (h.primitive == kTruncatedHit) budget.truncated = true;
   budget.traced++;
+  return h;
+}
+
+// Every ray of the shading passes: traced, or in a probing kernel (kProbe, a specialisation
+// constant, so the other branch is compiled out) only tested against the changed boxes.
+RayHit traceWithBudget(inout StepBudget budget, vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit) {
+  if (kProbe) return probedRay(origin, direction, tmin, tmax);
+  return traceBudgeted(budget, origin, direction, tmin, tmax, anyHit);
+}
+
+// A ray whose hit a path needs to go on (a specular lobe sample): traced even when probing, and
+// then its segment up to the hit tested (to infinity on a miss; a truncated one counts as met).
+RayHit traceFollowed(inout StepBudget budget, vec3 origin, vec3 direction, float tmin, float tmax) {
+  RayHit h = traceBudgeted(budget, origin, direction, tmin, tmax, false);
+  if (kProbe) {
+    if (h.primitive == kTruncatedHit) gProbeMet = true;
+    probeSegment(origin, direction, tmin, rayHitValid(h) && h.primitive != kInvalidIndex ? h.t : tmax);
+  }
   return h;
 }
 

@@ -103,7 +103,9 @@ vec3 directLightFromOne(ShadingPoint sp, uint light, vec4 lightShift, inout Step
   const uint type = lights[light].info.x;
   const uint first = type == kLightArea || type == kLightBackground ? kPerLightRays : 1u;
   for (uint k = 0u; k < kPerLightMaxRays; ++k) {
-    if (k == first && (seen == 0u || seen == first)) break;
+    // A probe (lib/probe.glsl) sees every ray reach the light: it tests all the rays a penumbra
+    // may have taken.
+    if (k == first && (seen == 0u || seen == first) && !kProbe) break;
     vec4 u = kroneckerPoint4(k, lightShift);
     vec3 contribution;
     bool visible;
@@ -137,6 +139,7 @@ void directLightFrom(ShadingPoint sp, LightSample ls, float lightSamples, inout 
     direction = d / tmax;
   }
   RayHit h = traceWithBudget(budget, origin, direction, 0.0, tmax, true);
+  if (kProbe) return; // a probe only tests the ray
   if (h.primitive != kInvalidIndex) return; // occluded (or truncated, reported by the caller)
   visible = true;
   // The BSDF sees the light mirrored above the shading normal when it lies below it.

@@ -4,6 +4,8 @@
 #define OBSCURA_SHADING_BINDINGS_GLSL
 
 #include "band.glsl"
+#include "probe.glsl"
+#include "shaft.glsl"
 
 layout(std430, set = 0, binding = kBindingGBuffer) readonly buffer GBuffer { GBufferTexel gbuffer[]; };
 layout(std430, set = 0, binding = kBindingLights) readonly buffer LightBuffer { GpuLight lights[]; };
@@ -19,15 +21,19 @@ layout(std430, set = 0, binding = kBindingSpecularAmbient) buffer SpecularAmbien
 // queue[0..3] = indirect dispatch groups (x, y, z) and the entry count; pixel indices follow.
 layout(std430, set = 0, binding = kBindingSpecularQueue) buffer SpecularQueue { uint queue[]; };
 layout(std430, set = 0, binding = kBindingLightScales) readonly buffer LightScales { vec4 lightScales[]; };
-layout(std430, set = 0, binding = kBindingDirty) readonly buffer DirtyMask { uint dirty[]; };
+layout(std430, set = 0, binding = kBindingDirty) buffer DirtyMask { uint dirty[]; }; // probes mark it
 // Per pixel, the box of its hits and specular path vertices (primary.comp starts it; specular.comp
 // grows it), for the dirty pixels of a geometry edit.
 layout(std430, set = 0, binding = kBindingHitBounds) buffer HitBounds { vec4 hitBounds[]; };
 
 layout(push_constant) uniform Push { ShadePush pc; };
 
-// Whether this pass skips `pixel`: a retrace after a geometry edit runs the dirty pixels only.
-bool skipClean(uint pixel) { return (pc.band.z & kShadeFlagDirtyOnly) != 0u && dirty[pixel] == 0u; }
+// Whether this pass skips `pixel`: a retrace after a geometry edit runs the dirty pixels only, and
+// a probing pass the candidates that no probe has found dirty yet (mask 1, dirty.comp).
+bool skipClean(uint pixel) {
+  if ((pc.band.z & kShadeFlagProbe) != 0u) return dirty[pixel] != 1u;
+  return (pc.band.z & kShadeFlagDirtyOnly) != 0u && dirty[pixel] == 0u;
+}
 
 // The pixel of this invocation: over the band in 2D, or (a retrace, kShadeFlagDirtyOnly) over the
 // band's dirty list, dispatched indirectly.
@@ -35,6 +41,45 @@ BandPixel shadedPixel() {
   if ((pc.band.z & kShadeFlagDirtyOnly) == 0u) return bandPixel(gl_GlobalInvocationID.xy, pc.frame.xy, pc.band.xy);
   const uint base = dirtyListBase(pc.frame.x * pc.band.y), entry = listEntry(), count = dirty[base + kQueueCount];
   return listedPixel(entry, count, entry < count ? dirty[base + kQueueHeader + entry] : 0u, pc.frame.xy, pc.band.xy);
+}
+
+// Starts a probing kernel (kProbe, dispatched with kShadeFlagProbe) if this is one: the changed
+// boxes from the dirty buffer's tail (DirtyPass::record). Returns whether it is.
+bool beginProbe() {
+  if (!kProbe) return false;
+  const uint base = dirtyBoxesBase(pc.frame.x * pc.band.y);
+  for (uint b = 0u; b < kMaxChangedBoxes; ++b) {
+    uint at = base + 8u * b;
+    gProbeUsed[b] = uintBitsToFloat(dirty[at + 3u]) != 0.0;
+    gProbeLo[b] = uintBitsToFloat(uvec3(dirty[at], dirty[at + 1u], dirty[at + 2u]));
+    gProbeHi[b] = uintBitsToFloat(uvec3(dirty[at + 4u], dirty[at + 5u], dirty[at + 6u]));
+  }
+  return true;
+}
+
+// Whether a shadow ray from p to any of the first `lightCount` lights may meet a changed box: the
+// shafts from p to the lights' bounds (lib/shaft.glsl, as dirty.comp tests a hit box). Where none
+// does, a probe need not draw p's light samples: none of its shadow rays can meet a box.
+bool probeShadowRaysMayMeet(vec3 p, uint lightCount) {
+  const uint lightsAt = dirtyLightsBase(pc.frame.x * pc.band.y);
+  for (uint b = 0u; b < kMaxChangedBoxes; ++b) {
+    if (!gProbeUsed[b]) continue;
+    vec3 bc = 0.5 * (gProbeLo[b] + gProbeHi[b]), bh = 0.5 * (gProbeHi[b] - gProbeLo[b]);
+    for (uint s = 0u; s < lightCount; ++s) {
+      uint at = lightsAt + 8u * s;
+      vec4 light = uintBitsToFloat(uvec4(dirty[at], dirty[at + 1u], dirty[at + 2u], dirty[at + 3u]));
+      vec3 extent = uintBitsToFloat(uvec3(dirty[at + 4u], dirty[at + 5u], dirty[at + 6u]));
+      bool meets = light.w != 0.0 ? meetsInfiniteShaft(bc, bh, p, vec3(0.0), extent)
+                                  : meetsShaft(bc, bh, p, vec3(0.0), light.xyz, extent);
+      if (meets) return true;
+    }
+  }
+  return false;
+}
+
+// Ends a probed pixel: marked dirty for certain when one of its rays met a changed box.
+void endProbe(uint pixel) {
+  if (kProbe && gProbeMet) dirty[pixel] = kDirtyCertain;
 }
 
 #endif

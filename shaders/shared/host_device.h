@@ -264,6 +264,15 @@ OBS_CONST uint kShadeFlagPerLight = 2u;
 // sampling every light then follows the same paths in a dispatch of its own (kShadeFlagPerLight),
 // so each light's specular transport is independent of the others' powers too.
 OBS_CONST uint kShadeFlagNoDirect = 4u;
+// The pass probes instead of shading (a geometry edit's dirty test, dirty.comp): it draws the rays
+// of the listed pixels from the same seeds as when they were rendered, but tests each against the
+// changed boxes (the dirty buffer's tail, dirtyBoxesBase) instead of tracing it, and marks the
+// pixel 2 in the dirty mask when one meets a box. Only a specular lobe ray is traced, in the edited
+// scene, so that the path goes on, and tested up to its hit. Nothing is accumulated.
+OBS_CONST uint kShadeFlagProbe = 8u;
+// The specialisation constant (a bool) that makes a shading kernel its probing variant (kProbe,
+// lib/probe.glsl); kShadeFlagProbe dispatches go to that kernel.
+OBS_CONST uint kSpecConstantProbe = 0u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 
@@ -369,7 +378,9 @@ struct ResolvePush {
   uvec4 frame;     // 0:  width, rows (of the band), unused (samples are counted per pixel), light count
   uvec4 flags;     // 16: x = 1 when the specular buffers hold data, y = first light to resolve (the
                    //     ones before are current), z = 1 to resolve the ambient too
-  uvec4 capacity;  // 32: x = light slots of the frame (A_t lives after them)
+  uvec4 capacity;  // 32: x = light slots of the frame (A_t lives after them), y = 1 to resolve only
+                   //     the pixels of the band's dirty list (after a geometry edit), dispatched
+                   //     indirectly; the others are current
 };                 // 48 bytes
 OBS_CONST uint kBindingResolveBasis = 0;           // vec4 pairs [light][pixel]: D_s
 OBS_CONST uint kBindingResolveEmissionBasis = 1;   // vec4 pairs [light][pixel]: M_s
@@ -378,7 +389,8 @@ OBS_CONST uint kBindingResolveAmbient = 3;         // vec4 pairs [pixel]: A
 OBS_CONST uint kBindingResolveSpecularAmbient = 4; // vec4 pairs [pixel]: A^spec
 OBS_CONST uint kBindingResolveOutput = 5;          // uint [(slots + 1) * resolvedStride(pixels)], RGB9E5
 OBS_CONST uint kBindingResolveSampleCounts = 6;    // uint[pixel] (primary.comp)
-OBS_CONST uint kResolveBindingCount = 7;
+OBS_CONST uint kBindingResolveDirty = 7;           // uint[]: the dirty mask and list (capacity.y)
+OBS_CONST uint kResolveBindingCount = 8;
 
 struct LightMixPush {
   uvec4 frame;     // 0:  width, rows (of the band), light count, light slots (A_t lives after them)
@@ -403,14 +415,33 @@ OBS_CONST uint kLightMixBindingCount = 3;
 // lane waits on a clean neighbour.
 OBS_FN uint dirtyListBase(uint pixels) { return pixels; }
 OBS_CONST uint kMaxChangedBoxes = 4;
+// After the list, DirtyPass::record leaves the changed boxes for the probing passes (kShadeFlagProbe):
+// per box, lo xyz and w = 1 (used) or 0, then hi xyz (as floatBits).
+OBS_FN uint dirtyBoxesBase(uint pixels) { return 2u * pixels + kQueueHeader; }
+OBS_CONST uint kDirtyBoxWords = 8u * kMaxChangedBoxes;
+// After the boxes, the light bounds of dirty.comp (kBindingDirtyLights' layout, 8 words a light),
+// with which a probe skips the light samples of a point none of whose shafts meets a box.
+OBS_FN uint dirtyLightsBase(uint pixels) { return dirtyBoxesBase(pixels) + kDirtyBoxWords; }
 struct DirtyPush {
   uvec4 frame;        // 0:   width, rows (of the band), first row, light count
   vec4 boxLo[4];      // 16:  changed boxes, padded: lo xyz, w = 1 (used) or 0 (unused)
   vec4 boxHi[4];      // 80:  hi xyz
   uvec4 rects[4];     // 144: their screen rectangles in frame pixels: x0, y0, x1, y1 (inclusive)
   vec4 params;        // 208: dMax, all dirty (1) or not, a light whose shadow rays are traced
-                      //      anew at every pixel anyway (uint bits; kInvalidIndex: none), unused
+                      //      anew at every pixel anyway (uint bits; kInvalidIndex: none), 1 when
+                      //      the probing passes decide the candidates (kShadeFlagProbe)
 };                    // 224 bytes (> 128: passed in a uniform-like storage buffer, not push constants)
+// Probing in two steps, one dirty.comp dispatch each (its push constant, stage.x):
+// kDirtyStageMark: mask 2 where certain (a changed box covers the pixel on screen), 1 where only a
+// bound says a ray may meet a box (a candidate: listed for the probing passes), 0 elsewhere;
+// kDirtyStageList, after the probes: mask 1 where it was 2, 0 elsewhere, and the list of those.
+// Without probing, kDirtyStageMark marks and lists every candidate as dirty (mask 1).
+OBS_CONST uint kDirtyStageMark = 0u;
+OBS_CONST uint kDirtyStageList = 1u;
+OBS_CONST uint kDirtyCertain = 2u;
+struct DirtyStagePush {
+  uvec4 stage;        // 0: kDirtyStage*, unused x3
+};                    // 16 bytes
 // Light bounds for dirty.comp, two vec4 per light: (centre xyz, w = 1 for a directional light,
 // whose segments run to infinity along -direction, else 0) and (the box's half extent xyz, or the
 // directional light's direction).

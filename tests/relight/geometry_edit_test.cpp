@@ -2,11 +2,16 @@
 // with the frame a full render of the edited scene gives — bit for bit in the per-pixel sums,
 // since every pixel is traced with the same seeds either way. A dirty set that is too small fails
 // here: the moved occluder's shadow falls far from its screen footprint, a small object changes
-// the floor's obscurance only within dMax, and an object is seen in a mirror floor.
+// the floor's obscurance only within dMax, and an object is seen in a mirror floor. By default
+// (DirtyTest::Auto) the glossy rooms' candidates are probed (their rays replayed, lib/probe.glsl)
+// and the matte rooms' retraced on their bounds; the tests below run each case the other way too,
+// and what only a probe could miss (a shadow ray at a specular path's vertex, the extra shadow
+// rays of a per-light penumbra).
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -21,8 +26,9 @@ namespace obscura::test {
 namespace {
 
 // A room lit by a ceiling lamp (or unlit: obscurance alone), with a small floating "object" (a
-// horizontal double quad) at `object`.
-scene::Scene roomWithObject(glm::vec3 object, float size, bool lamp = true, bool glossyFloor = false) {
+// horizontal double quad) at `object`; with `blind`, a fixed double quad under half of the lamp
+// (penumbrae everywhere below).
+scene::Scene roomWithObject(glm::vec3 object, float size, bool lamp = true, bool glossyFloor = false, bool blind = false) {
   SceneBuilder b;
   auto white = b.lambertian(glm::vec3(0.7f));
   auto floor = glossyFloor ? b.glossy(glm::vec3(0.8f), 1.0f, 0.05f) : white;
@@ -31,6 +37,10 @@ scene::Scene roomWithObject(glm::vec3 object, float size, bool lamp = true, bool
   b.quad({-2, 0, -2}, {0, 0, 4}, {4, 0, 0}, floor);  // floor, faces +y
   b.quad({-2, 0, -2}, {4, 0, 0}, {0, 3, 0}, white);  // back wall, faces +z
   if (lamp) b.quad({-0.3f, 2.99f, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f}, emitter, "lamp");
+  if (blind) {
+    b.quad({-0.4f, 2.8f, -0.4f}, {0, 0, 0.8f}, {0.4f, 0, 0}, green);
+    b.quad({-0.4f, 2.8f, -0.4f}, {0.4f, 0, 0}, {0, 0, 0.8f}, green);
+  }
   const glm::vec3 c = object - glm::vec3(size / 2, 0, size / 2);
   b.quad(c, {0, 0, size}, {size, 0, 0}, green);      // the object: faces up...
   b.quad(c, {size, 0, 0}, {0, 0, size}, green);      // ...and down
@@ -62,15 +72,19 @@ class GeometryEdit : public GpuTest {
 protected:
   // Renders with the object at `from`, moves it to `to` incrementally, and compares with a full
   // render of the moved scene. Returns the pixels retraced.
+  // `tweak` changes the settings of both renders.
   std::uint64_t moveAndCompare(glm::vec3 from, glm::vec3 to, float size, bool lamp = true,
-                               bool glossyFloor = false, float secondaryReflectors = 0.0f) {
-    const scene::Scene before = roomWithObject(from, size, lamp, glossyFloor);
+                               bool glossyFloor = false, float secondaryReflectors = 0.0f,
+                               const std::function<void(render::ObscuranceSettings&)>& tweak = {}) {
+    render::ObscuranceSettings settings = editSettings(secondaryReflectors);
+    if (tweak) tweak(settings);
+    const scene::Scene before = roomWithObject(from, size, lamp, glossyFloor, blind_);
     const bvh::Bvh beforeBvh = bvh::build(render::triangleSoup(before));
-    edited_ = roomWithObject(to, size, lamp, glossyFloor);
+    edited_ = roomWithObject(to, size, lamp, glossyFloor, blind_);
     // As `relight --edits` does for a move: the BVH refitted, not rebuilt.
     editedBvh_ = beforeBvh;
     bvh::refit(editedBvh_, render::triangleSoup(edited_));
-    render::ObscuranceRenderer r(context(), before, beforeBvh, editSettings(secondaryReflectors));
+    render::ObscuranceRenderer r(context(), before, beforeBvh, settings);
     r.render();
     const io::Image old = r.image();
     const std::uint64_t retraced = r.updateGeometry(edited_, editedBvh_, {objectBox(from, size), objectBox(to, size)});
@@ -81,8 +95,7 @@ protected:
     const auto counts = r.sampleCounts();
     EXPECT_EQ(std::count(counts.begin(), counts.end(), r.samples()), static_cast<std::ptrdiff_t>(counts.size()));
     const io::Image fresh =
-        renderObscurances(context(), edited_, bvh::build(render::triangleSoup(edited_)), editSettings(secondaryReflectors))
-            .image;
+        renderObscurances(context(), edited_, bvh::build(render::triangleSoup(edited_)), settings).image;
     EXPECT_EQ(r.stats().truncatedTraversals, 0u);
     // The sums are the full render's bit for bit; composed values may differ in the last bits
     // because I_a's areas are summed from the moved vertices.
@@ -112,6 +125,7 @@ protected:
   }
   scene::Scene edited_;
   bvh::Bvh editedBvh_;
+  bool blind_ = false; // roomWithObject's blind
 };
 
 TEST_F(GeometryEdit, MovedOccluderMatchesAFullRenderAndItsShadowIsRetraced) {
@@ -139,6 +153,83 @@ TEST_F(GeometryEdit, WithSecondaryReflectorsEveryPixelIsRetracedAndMatchesAFullR
   // with the marks of the edited scene, and the sums are the full render's bit for bit.
   const std::uint64_t retraced = moveAndCompare({-0.8f, 2.5f, 0.0f}, {0.8f, 2.5f, 0.0f}, 0.5f, true, false, 1.0f);
   EXPECT_EQ(retraced, 48u * 36u);
+}
+
+void boundsOnly(render::ObscuranceSettings& s) { s.dirtyTest = render::DirtyTest::Bounds; }
+void probed(render::ObscuranceSettings& s) { s.dirtyTest = render::DirtyTest::Probe; }
+
+TEST_F(GeometryEdit, ProbedMovedOccluderMatchesAFullRender) {
+  const std::uint64_t probedPixels = moveAndCompare({-0.8f, 2.5f, 0.0f}, {0.8f, 2.5f, 0.0f}, 0.5f, true, false, 0.0f, probed);
+  const std::uint64_t bounded = moveAndCompare({-0.8f, 2.5f, 0.0f}, {0.8f, 2.5f, 0.0f}, 0.5f);
+  EXPECT_LE(probedPixels, bounded);
+}
+
+TEST_F(GeometryEdit, ProbedLowTableTopMatchesAFullRender) {
+  // Only obscurance rays change: the probe must replay them (a probe that skipped them fails here).
+  moveAndCompare({-1.0f, 0.25f, 0.0f}, {1.0f, 0.25f, 0.0f}, 0.6f, false, false, 0.0f, probed);
+}
+
+TEST_F(GeometryEdit, BoundsOnlyDirtyTestAlsoMatchesAFullRender) {
+  const std::uint64_t retraced = moveAndCompare({-0.8f, 1.2f, -1.0f}, {0.8f, 1.2f, -1.0f}, 0.5f, true, true, 0.0f, boundsOnly);
+  EXPECT_LT(retraced, 48u * 36u);
+}
+
+TEST_F(GeometryEdit, ProbingRetracesFewerGlossyPixelsThanBounds) {
+  // The mirror floor's specular paths that leave the room are dirty for the bounds (they may pass
+  // anywhere); replayed, most of them miss the object's old and new places.
+  const glm::vec3 from{-0.8f, 1.2f, -1.0f}, to{0.8f, 1.2f, -1.0f};
+  const std::uint64_t probed = moveAndCompare(from, to, 0.5f, true, true);
+  const std::uint64_t bounded = moveAndCompare(from, to, 0.5f, true, true, 0.0f, boundsOnly);
+  EXPECT_LT(probed, bounded);
+}
+
+TEST_F(GeometryEdit, ShadowAtASpecularPathsVertexIsRetraced) {
+  // The object hangs in front of the back wall under the lamp: its shadow on the wall is seen in
+  // the mirror floor, where the only rays that change are shadow rays from the paths' vertices on
+  // the wall (a probe that tested only the lobe rays would leave those floor pixels stale).
+  moveAndCompare({-0.6f, 2.2f, -1.6f}, {0.6f, 2.2f, -1.6f}, 0.4f, true, true);
+}
+
+TEST_F(GeometryEdit, PerLightPenumbraRaysBeyondTheFirstFourAreProbed) {
+  // Per-light sampling takes 4 shadow rays to the lamp and up to 64 where they disagree, as they do
+  // in the blind's penumbra. A small object just under the lamp's other half meets only a few of
+  // those rays; a probe sees every ray reach the lamp, so it must test all 64 the render may have
+  // taken, not stop after 4.
+  blind_ = true;
+  moveAndCompare({0.15f, 2.9f, 0.1f}, {0.2f, 2.9f, -0.1f}, 0.08f, true, false, 0.0f,
+                 [](render::ObscuranceSettings& s) {
+                   s.shadowSampling = render::ShadowSampling::PerLight;
+                   s.dirtyTest = render::DirtyTest::Probe; // a matte room: Auto would not probe
+                 });
+}
+
+TEST_F(GeometryEdit, LightMixAfterAMoveResolvesTheRetracedPixelsAlone) {
+  // The light mix after a move resolves only the dirty list's pixels again; it must show what the
+  // full compose shows, to 2 display levels (RGB9E5 keeps 2^-9 of a pixel's largest channel,
+  // sRGB at 8 bits steps by about 2^-8 near white), the moved shadow included.
+  const glm::vec3 from{-0.8f, 2.5f, 0.0f}, to{0.8f, 2.5f, 0.0f};
+  const scene::Scene before = roomWithObject(from, 0.5f);
+  const bvh::Bvh beforeBvh = bvh::build(render::triangleSoup(before));
+  edited_ = roomWithObject(to, 0.5f);
+  editedBvh_ = beforeBvh;
+  bvh::refit(editedBvh_, render::triangleSoup(edited_));
+  render::ObscuranceRenderer r(context(), before, beforeBvh, editSettings());
+  r.render();
+  r.composeDisplay();
+  const auto resolvedBefore = r.stats().passes.at("resolve").gpuMs;
+  r.updateGeometry(edited_, editedBvh_, {objectBox(from, 0.5f), objectBox(to, 0.5f)});
+  r.composeDisplay();
+  const auto fast = r.display();
+  EXPECT_GT(r.stats().passes.at("resolve").gpuMs, resolvedBefore) << "the retraced pixels are resolved again";
+  r.compose();
+  const auto full = r.display();
+  ASSERT_EQ(full.size(), fast.size());
+  int worst = 0;
+  for (std::size_t i = 0; i < full.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      worst = std::max(worst, std::abs(static_cast<int>((full[i] >> (8 * c)) & 255u) -
+                                       static_cast<int>((fast[i] >> (8 * c)) & 255u)));
+  EXPECT_LE(worst, 2);
 }
 
 } // namespace

@@ -33,7 +33,7 @@ std::vector<FrameBufferKind> ObscuranceFrame::bufferKinds(const FrameContents& c
       {"resolved", 4, true},
       {"resolved_ambient", 4, false},
       {"hit_bounds", 2 * kVec4, false},
-      {"dirty", 8, false}, // mask and list
+      {"dirty", 8, false}, // mask and list (and the changed boxes: a few words a band)
       {"sample_counts", 4, false},
   };
   if (contents.primaryAovs) kinds.push_back({"aovs", gpu::kAovSlots * kAccumulator, false});
@@ -98,7 +98,7 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.resolved = gpu::TexelBuffer(context, resolvedWords * 4, vk::Format::eR32G32B32A32Uint, kStorage,
                                   "frame.resolved" + tag);
     b.hitBounds = gpu::Buffer(context, px * 2 * kVec4, kStorage, "frame.hit_bounds" + tag);
-    b.dirty = gpu::Buffer(context, (2 * px + gpu::kQueueHeader) * 4, kStorage | Usage::eIndirectBuffer,
+    b.dirty = gpu::Buffer(context, (2 * px + gpu::kQueueHeader + gpu::kDirtyBoxWords + 8 * slots) * 4, kStorage | Usage::eIndirectBuffer,
                           "frame.dirty" + tag);
     b.sampleCounts = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.sample_counts" + tag);
     bands_.push_back(std::move(b));

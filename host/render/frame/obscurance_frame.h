@@ -51,7 +51,8 @@ public:
                                // lightmix.comp reads four pixels at a time as RGBA32UI texels
     gpu::Buffer hitBounds; // per pixel, the box of its primary hits over samples (geometry edits)
     gpu::Buffer dirty;     // per pixel, 1 = retrace after a geometry edit, then the list of those
-                           // pixels with its indirect dispatch (dirty.comp; host_device.h)
+                           // pixels with its indirect dispatch (dirty.comp; host_device.h), then
+                           // the changed boxes for the probing passes (dirtyBoxesBase)
     gpu::Buffer sampleCounts; // per pixel, the samples its sums hold (primary.comp); compose divides by it
   };
 

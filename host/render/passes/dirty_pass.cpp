@@ -65,10 +65,11 @@ std::vector<glm::vec4> lightBounds(const LightSet& lights) {
 
 DirtyPass::DirtyPass(const gpu::Context& context, std::uint32_t bands)
     : context_(&context),
-      mark_(context, gpu::storageKernelDesc("dirty", kSpirv_dirty, gpu::kDirtyBindingCount, 0, bands)),
+      mark_(context, gpu::storageKernelDesc("dirty", kSpirv_dirty, gpu::kDirtyBindingCount, sizeof(gpu::DirtyStagePush), bands)),
       clear_(context, gpu::storageKernelDesc("clear", kSpirv_clear, gpu::kClearBindingCount, sizeof(gpu::ClearPush), bands)) {
   for (std::uint32_t b = 0; b < bands; ++b)
     params_.emplace_back(context, sizeof(gpu::DirtyPush), vk::BufferUsageFlagBits::eStorageBuffer, "dirty.params");
+  boxes_.resize(bands);
 }
 
 void DirtyPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& bounds) {
@@ -78,6 +79,7 @@ void DirtyPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu
   mark_.bind(gpu::kBindingDirtyLights, bounds, band);
   mark_.bind(gpu::kBindingDirtyMask, b.dirty, band);
   frame_ = &frame;
+  lightBounds_ = &bounds;
   mark_.bind(gpu::kBindingDirtyStatus, frame.status(), band);
   clear_.bind(gpu::kBindingClearDirty, b.dirty, band);
   clear_.bind(gpu::kBindingClearBasis, b.basis, band);
@@ -88,7 +90,7 @@ void DirtyPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu
 
 void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu::GpuCamera& camera,
                         const std::vector<scene::Bounds>& changed, float pad, float dMax, std::uint32_t lights,
-                        bool all, std::uint32_t tracedLight) {
+                        bool all, std::uint32_t tracedLight, bool probe) {
   gpu::DirtyPush push{};
   push.frame = glm::uvec4(layout.width, layout.bands[band].rows, layout.bands[band].firstRow, lights);
   const bool tooMany = changed.size() > gpu::kMaxChangedBoxes;
@@ -104,16 +106,37 @@ void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu
       push.rects[i] = glm::uvec4(1u, 1u, 0u, 0u);
     }
   }
-  push.params = glm::vec4(dMax, all || tooMany ? 1.0f : 0.0f, std::bit_cast<float>(tracedLight), 0.0f);
+  push.params = glm::vec4(dMax, all || tooMany ? 1.0f : 0.0f, std::bit_cast<float>(tracedLight), probe ? 1.0f : 0.0f);
   params_[band].upload(*context_, &push, sizeof(push));
+  for (std::uint32_t i = 0; i < gpu::kMaxChangedBoxes; ++i) {
+    boxes_[band][2 * i] = push.boxLo[i];
+    boxes_[band][2 * i + 1] = push.boxHi[i];
+  }
 }
 
-void DirtyPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout) const {
+void DirtyPass::resetList(const vk::raii::CommandBuffer& cmd, std::uint32_t band) const {
   // The list starts empty: dispatching it indirectly runs (0, 1, 1) groups until dirty.comp appends.
   static constexpr std::array<std::uint32_t, gpu::kQueueHeader> kEmptyList = {0u, 1u, 1u, 0u};
   cmd.updateBuffer<std::uint32_t>(frame_->band(band).dirty.handle(), frame_->dirtyListOffset(band), kEmptyList);
+}
+
+void DirtyPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout) const {
+  resetList(cmd, band);
+  const auto boxesAt = vk::DeviceSize(gpu::dirtyBoxesBase(static_cast<std::uint32_t>(layout.bandPixels(band)))) * 4;
+  cmd.updateBuffer<glm::vec4>(frame_->band(band).dirty.handle(), boxesAt, boxes_[band]);
+  const auto lightsAt = vk::DeviceSize(gpu::dirtyLightsBase(static_cast<std::uint32_t>(layout.bandPixels(band)))) * 4;
+  const vk::DeviceSize lightBytes = std::min<vk::DeviceSize>(lightBounds_->size(), vk::DeviceSize(frame_->lightCapacity()) * 32);
+  if (lightBytes > 0) cmd.copyBuffer(lightBounds_->handle(), frame_->band(band).dirty.handle(), vk::BufferCopy{0, lightsAt, lightBytes});
   gpu::computeBarrier(cmd);
-  mark_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, nullptr, band);
+  const gpu::DirtyStagePush push{.stage = glm::uvec4(gpu::kDirtyStageMark, 0u, 0u, 0u)};
+  mark_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+}
+
+void DirtyPass::recordList(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout) const {
+  resetList(cmd, band);
+  gpu::computeBarrier(cmd);
+  const gpu::DirtyStagePush push{.stage = glm::uvec4(gpu::kDirtyStageList, 0u, 0u, 0u)};
+  mark_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
 }
 
 void DirtyPass::recordClear(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,

@@ -16,14 +16,20 @@ void ResolvePass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
   kernel_.bind(gpu::kBindingResolveSpecularAmbient, b.specularAmbient, band);
   kernel_.bind(gpu::kBindingResolveOutput, b.resolved.buffer(), band);
   kernel_.bind(gpu::kBindingResolveSampleCounts, b.sampleCounts, band);
+  kernel_.bind(gpu::kBindingResolveDirty, b.dirty, band);
+  frame_ = &frame;
 }
 
 void ResolvePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
                          std::uint32_t lights, std::uint32_t slots, bool specular,
-                         std::uint32_t firstLight, bool ambient) const {
+                         std::uint32_t firstLight, bool ambient, bool dirtyOnly) const {
   gpu::ResolvePush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, 0u, lights),
                         .flags = glm::uvec4(specular ? 1u : 0u, firstLight, ambient ? 1u : 0u, 0u),
-                        .capacity = glm::uvec4(slots, 0u, 0u, 0u)};
+                        .capacity = glm::uvec4(slots, dirtyOnly ? 1u : 0u, 0u, 0u)};
+  if (dirtyOnly) {
+    kernel_.dispatchIndirect(cmd, frame_->band(band).dirty, frame_->dirtyListOffset(band), &push, band);
+    return;
+  }
   kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
 }
 

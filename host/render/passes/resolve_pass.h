@@ -11,12 +11,14 @@ class ResolvePass {
 public:
   ResolvePass(const gpu::Context& context, std::uint32_t bands);
   void bind(std::uint32_t band, const ObscuranceFrame& frame);
+  // Every pixel of the band; with `dirtyOnly`, those of the frame's dirty list (dispatched indirectly).
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
               std::uint32_t lights, std::uint32_t slots, bool specular,
-              std::uint32_t firstLight, bool ambient) const;
+              std::uint32_t firstLight, bool ambient, bool dirtyOnly = false) const;
 
 private:
   gpu::Kernel kernel_;
+  const ObscuranceFrame* frame_ = nullptr; // whose dirty lists a dirty-only resolve reads (bind)
 };
 
 } // namespace obscura::render

@@ -18,6 +18,7 @@ public:
 private:
   gpu::Kernel queue_;
   gpu::Kernel paths_;
+  gpu::Kernel probe_; // paths_'s probing variant (kShadeFlagProbe)
 };
 
 } // namespace obscura::render
