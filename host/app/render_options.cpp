@@ -119,7 +119,7 @@ render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scen
   settings.seed = o.seed;
   settings.camera = camera;
   settings.dMax = o.dMax;
-  settings.rho = o.rho == "exp" ? render::RhoKind::Exp : o.rho == "ao" ? render::RhoKind::Ao : render::RhoKind::Sqrt;
+  settings.rho = render::rhoKindNamed(o.rho);
   settings.systematic = o.sampling == "systematic";
   settings.colourBleeding = !o.noBleed;
   settings.shadowSampling = o.shadowSampling == "per-light" ? render::ShadowSampling::PerLight

@@ -46,6 +46,9 @@
 namespace obscura::render {
 
 enum class RhoKind : std::uint32_t { Sqrt = 0, Exp = 1, Ao = 2 };
+// The names --rho and the window's panel use: "sqrt", "exp", "ao" (anything else: Sqrt).
+RhoKind rhoKindNamed(const std::string& name);
+const char* rhoKindName(RhoKind kind);
 
 // How the shadow pass spends its rays [SPEC §1.3, IVR §3.1].
 enum class ShadowSampling {

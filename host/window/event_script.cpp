@@ -142,7 +142,6 @@ EventScript::EventScript(const std::string& path) {
     const json& e = file[i];
     if (!e.is_object()) at.fail("an event is an object");
     ScriptEvent ev;
-    ev.entry = i;
     ev.frame = count(e, "frame", at, 1u << 24);
     int kinds = 0;
     if (e.contains("key")) {
@@ -236,12 +235,6 @@ std::vector<const ScriptEvent*> EventScript::eventsAt(std::size_t frame) const {
                              e.kind == ScriptEvent::Kind::Screenshot))
       out.push_back(&e);
   return out;
-}
-
-std::size_t EventScript::lastFrame() const {
-  std::size_t last = 0;
-  for (const auto& e : events_) last = std::max(last, e.frame + static_cast<std::size_t>(e.kind == ScriptEvent::Kind::Key ? e.hold : 1));
-  return last;
 }
 
 } // namespace obscura::window

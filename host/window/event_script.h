@@ -31,7 +31,6 @@ struct ScriptEvent {
   enum class Kind { Key, Drag, Click, Scroll, Panel, Window, Screenshot };
   Kind kind = Kind::Key;
   std::size_t frame = 0;
-  std::size_t entry = 0;
   int key = 0, hold = 1;               // Key (GLFW key code)
   int button = 0;                      // Drag: 0 left, 1 right, 2 middle
   std::array<double, 2> xy{0.0, 0.0};  // Drag: motion; Click: position; Window resize: size
@@ -49,8 +48,6 @@ public:
   void feed(std::size_t frame, InputState& input) const;
   // The events of `frame` of the other kinds (panel, window, screenshot), in file order.
   std::vector<const ScriptEvent*> eventsAt(std::size_t frame) const;
-  // The last frame any event acts on (0 for an empty script).
-  std::size_t lastFrame() const;
   bool empty() const { return events_.empty(); }
 
 private:

@@ -59,14 +59,6 @@ FramePresenter::FramePresenter(const gpu::Context& context, Swapchain& swapchain
 
 FramePresenter::~FramePresenter() { context_->device().waitIdle(); }
 
-void FramePresenter::setRenderSize(std::uint32_t width, std::uint32_t height) {
-  if (width == width_ && height == height_) return;
-  context_->device().waitIdle();
-  width_ = width;
-  height_ = height;
-  makeImage();
-}
-
 void FramePresenter::makeImage() {
   const auto& device = context_->device();
   staging_ = gpu::Buffer(*context_, vk::DeviceSize(width_) * height_ * 4, vk::BufferUsageFlagBits::eTransferSrc,

@@ -32,9 +32,6 @@ public:
   FramePresenter(const gpu::Context& context, Swapchain& swapchain, std::uint32_t width, std::uint32_t height);
   ~FramePresenter();
 
-  // The render's size changed (a new renderer): the staging buffer and image follow.
-  void setRenderSize(std::uint32_t width, std::uint32_t height);
-
   // Shows `rgba` (width x height of the render) on a drawable of `drawable` pixels, with `overlay`
   // on top when given. Returns false when nothing was shown (minimised, or the swapchain was out of
   // date and has been made again: show the next frame). With `capture`, the image as presented

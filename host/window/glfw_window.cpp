@@ -99,7 +99,6 @@ std::array<int, 2> GlfwWindow::framebufferSize() const {
 void GlfwWindow::resize(int width, int height) { glfwSetWindowSize(window_, width, height); }
 void GlfwWindow::iconify() { glfwIconifyWindow(window_); }
 void GlfwWindow::restore() { glfwRestoreWindow(window_); }
-void GlfwWindow::setTitle(const std::string& title) { glfwSetWindowTitle(window_, title.c_str()); }
 
 void GlfwWindow::onKey(GLFWwindow* window, int key, int, int action, int mods) {
   InputState& in = owner(window)->input_;

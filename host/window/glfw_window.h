@@ -53,7 +53,6 @@ public:
   void resize(int width, int height);
   void iconify();
   void restore();
-  void setTitle(const std::string& title);
 
   InputState& input() { return input_; }
   GLFWwindow* handle() const { return window_; }

@@ -48,20 +48,6 @@ double totalGpuMs(const render::RenderStats& stats) {
   return ms;
 }
 
-render::RhoKind rhoKind(const std::string& name) {
-  if (name == "exp") return render::RhoKind::Exp;
-  if (name == "ao") return render::RhoKind::Ao;
-  return render::RhoKind::Sqrt;
-}
-
-std::string rhoName(render::RhoKind kind) {
-  switch (kind) {
-  case render::RhoKind::Exp: return "exp";
-  case render::RhoKind::Ao: return "ao";
-  default: return "sqrt";
-  }
-}
-
 } // namespace
 
 struct Viewer::FrameRecord {
@@ -176,6 +162,13 @@ void Viewer::moveObject(std::size_t object, glm::vec3 translate, FrameRecord& re
 }
 
 void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
+  // A change that restarts the accumulation (`cameraOnly`: the view alone, so the denoiser's
+  // history is reprojected rather than forgotten).
+  auto restartFor = [&](const char* action, bool cameraOnly) {
+    restart(false, cameraOnly);
+    record.restarted = true;
+    record.actions.push_back(action);
+  };
   switch (a.kind) {
   case Kind::LightScale:
     lights_[lightIndex(a.name)].scale = a.value;
@@ -252,37 +245,27 @@ void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
     record.actions.push_back("method");
     break;
   case Kind::Rho:
-    config_.obscurance.rho = rhoKind(a.name);
-    restart(false);
-    record.restarted = true;
-    record.actions.push_back("rho");
+    config_.obscurance.rho = render::rhoKindNamed(a.name);
+    restartFor("rho", false);
     break;
   case Kind::DMax:
     config_.obscurance.dMax = a.value;
-    restart(false);
-    record.restarted = true;
-    record.actions.push_back("dmax");
+    restartFor("dmax", false);
     break;
   case Kind::ShadowRays:
     config_.obscurance.shadowRays = static_cast<std::uint32_t>(a.count);
-    restart(false);
-    record.restarted = true;
-    record.actions.push_back("shadow_rays");
+    restartFor("shadow_rays", false);
     break;
   case Kind::ObscuranceRays:
     config_.obscurance.obscuranceRays = static_cast<std::uint32_t>(a.count);
-    restart(false);
-    record.restarted = true;
-    record.actions.push_back("obscurance_rays");
+    restartFor("obscurance_rays", false);
     break;
   case Kind::Camera: {
     const auto& cameras = scenes_.back().cameras;
     if (a.count >= cameras.size())
       throw InputError(fmt::format("camera {}: the scene has {} camera(s)", a.count, cameras.size()));
     camera_.setCamera(cameras[a.count]);
-    restart(false, true);
-    record.restarted = true;
-    record.actions.push_back("camera");
+    restartFor("camera", true);
     break;
   }
   case Kind::Denoise:
@@ -297,10 +280,8 @@ void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
     break;
   case Kind::LoadView:
     camera_.setCamera(loadView(a.name));
-    restart(false, true);
-    record.restarted = true;
+    restartFor("load_view", true);
     status_ = fmt::format("view loaded from {}", a.name);
-    record.actions.push_back("load_view");
     break;
   }
 }
@@ -401,7 +382,7 @@ PanelState Viewer::panelState() const {
   s.aovs = {"combined"};
   for (const auto& name : render::obscuranceAovNames())
     if (name != "combined") s.aovs.push_back(name);
-  s.rho = rhoName(config_.obscurance.rho);
+  s.rho = render::rhoKindName(config_.obscurance.rho);
   s.exposure = config_.exposure;
   s.dMax = renderer_->dMax();
   s.shadowRays = config_.obscurance.shadowRays;
@@ -488,7 +469,10 @@ void Viewer::run() {
     InputState& input = window_.input();
     input.beginFrame();
     const auto drawable = window_.framebufferSize();
-    window_.pollEvents(drawable[0] == 0 && config_.script.empty() ? 0.05 : 0.0);
+    // A person's window waits for input while there is nothing to do (minimised, or every sample
+    // done and nothing changed last frame) instead of spinning; a script never waits.
+    const bool idle = drawable[0] == 0 || idleLastFrame_;
+    window_.pollEvents(idle && config_.script.empty() ? 0.05 : 0.0);
     if (window_.shouldClose()) break;
     config_.script.feed(frame_, input);
     std::vector<ViewerAction> actions;
@@ -572,6 +556,7 @@ void Viewer::run() {
     record.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     lastFrameMs_ = record.frameMs;
     writeLog(record);
+    idleLastFrame_ = record.rays == 0 && record.actions.empty() && !record.restarted && !needsCompose_;
   }
   context_.device().waitIdle();
 }

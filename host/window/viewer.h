@@ -119,6 +119,7 @@ private:
   int selected_ = -1;
   bool previewShown_ = false;
   bool needsCompose_ = true;
+  bool idleLastFrame_ = false; // nothing traced or changed: the next poll may wait for input
   std::vector<std::uint32_t> shown_;
   std::size_t frame_ = 0;
   std::string status_; // the last edit's outcome, shown on the panel
