@@ -118,24 +118,47 @@ bool useSpatialSelection(uint count) {
   return gLightSampling == kLightSamplingSpatial && count <= kMaxSpatialLights;
 }
 
+// The spatial selection's weights at one shading point: every bounded light's importance, their
+// sum and the number of unbounded lights with power. A hit draws several light samples (N_s shadow
+// rays, the specular pass's vertex samples, MIS densities of lobe rays that reach a light) from the
+// same p and n, so the weights are computed once per point and kept here: the per-sample cost is a
+// walk over stored numbers, not count importance evaluations (each a dozen transcendental-free but
+// divergent loads and square roots), and lavapipe's loop limiter is charged once per point. The
+// numbers are the ones every sample would compute, in the same order, so images are unchanged.
+float gImportance[kMaxSpatialLights];
+float gImportanceTotal = 0.0;
+uint gImportanceDirectional = 0u;
+bool gImportanceValid = false;
+vec3 gImportanceP = vec3(0.0);
+vec3 gImportanceN = vec3(0.0);
+uint gImportanceCount = 0u;
+
+void prepareLightImportances(vec3 p, vec3 n, uint count) {
+  if (gImportanceValid && p == gImportanceP && n == gImportanceN && count == gImportanceCount) return;
+  gImportanceValid = true;
+  gImportanceP = p;
+  gImportanceN = n;
+  gImportanceCount = count;
+  gImportanceTotal = 0.0;
+  gImportanceDirectional = 0u;
+  for (uint i = 0u; i < count; ++i) {
+    float w = 0.0;
+    if (isUnbounded(lights[i].info.x)) gImportanceDirectional += lights[i].params.y > 0.0 ? 1u : 0u;
+    else w = lightImportance(i, p, n);
+    gImportance[i] = w;
+    gImportanceTotal += w;
+  }
+}
+
 // The probability that the estimator picks light `chosen` at p with normal n.
 float lightSelectionPdf(uint chosen, vec3 p, vec3 n, uint count) {
   if (!useSpatialSelection(count)) return lights[chosen].params.y;
-  float total = 0.0, mine = 0.0;
-  uint directional = 0u;
-  for (uint i = 0u; i < count; ++i) {
-    if (isUnbounded(lights[i].info.x)) {
-      directional += lights[i].params.y > 0.0 ? 1u : 0u;
-      continue;
-    }
-    float w = lightImportance(i, p, n);
-    total += w;
-    if (i == chosen) mine = w;
-  }
-  float shares = float(directional) + (total > 0.0 ? 1.0 : 0.0);
+  prepareLightImportances(p, n, count);
+  float total = gImportanceTotal;
+  float shares = float(gImportanceDirectional) + (total > 0.0 ? 1.0 : 0.0);
   if (shares == 0.0) return 0.0;
   if (isUnbounded(lights[chosen].info.x)) return lights[chosen].params.y > 0.0 ? 1.0 / shares : 0.0;
-  return total > 0.0 ? mine / total / shares : 0.0;
+  return total > 0.0 ? gImportance[chosen] / total / shares : 0.0;
 }
 
 // Picks a light for p with normal n; selection = its probability (0: no light can light p).
@@ -145,12 +168,9 @@ uint selectLight(float u, vec3 p, vec3 n, uint count, out float selection) {
     selection = lights[chosen].params.y;
     return chosen;
   }
-  float total = 0.0;
-  uint directional = 0u;
-  for (uint i = 0u; i < count; ++i) {
-    if (isUnbounded(lights[i].info.x)) directional += lights[i].params.y > 0.0 ? 1u : 0u;
-    else total += lightImportance(i, p, n);
-  }
+  prepareLightImportances(p, n, count);
+  float total = gImportanceTotal;
+  uint directional = gImportanceDirectional;
   float shares = float(directional) + (total > 0.0 ? 1.0 : 0.0);
   selection = 0.0;
   if (shares == 0.0) return 0u;
@@ -173,8 +193,7 @@ uint selectLight(float u, vec3 p, vec3 n, uint count, out float selection) {
   uint last = 0u;
   float lastWeight = 0.0;
   for (uint i = 0u; i < count; ++i) {
-    if (isUnbounded(lights[i].info.x)) continue;
-    float w = lightImportance(i, p, n);
+    float w = gImportance[i]; // 0 for the unbounded lights
     if (w <= 0.0) continue;
     running += w;
     last = i;
