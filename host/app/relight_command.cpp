@@ -273,7 +273,12 @@ void relightScene(RelightOptions& o) {
     const double totalMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     nlohmann::json line = {{"edit", n}, {"kind", e.kindName()}, {"name", e.name}, {"pixels_retraced", retraced}};
     line.update(passFigures(before, renderer.stats()));
-    if (!bvhUpdate.is_null()) line["bvh"] = std::exchange(bvhUpdate, nlohmann::json());
+    if (!bvhUpdate.is_null()) {
+      line["bvh"] = std::exchange(bvhUpdate, nlohmann::json());
+      // What the lights reach (CPU rays of the Reached ambient model), measured again for the edit.
+      const auto reach = renderer.lastReachUpdate();
+      line["reach"] = {{"rays", reach.rays}, {"ms", reach.ms}};
+    }
     line["total_ms"] = totalMs;
     log << line.dump() << "\n";
     writeFrame(n + 1);

@@ -77,8 +77,9 @@ struct Hit {
 
 // Closest hit in (tmin, tmax]; ties in t go to the lower original primitive index.
 Hit closestHit(const Bvh& bvh, const Ray& ray);
-// True when anything is hit in (tmin, tmax).
-bool anyHit(const Bvh& bvh, const Ray& ray);
+// True when anything is hit in (tmin, tmax); `hitT`, if given, gets the distance of the hit found
+// (not necessarily the closest): the ray is blocked within that much of its origin.
+bool anyHit(const Bvh& bvh, const Ray& ray, float* hitT = nullptr);
 // Brute force over every triangle, same rules: the oracle for closestHit and for the GPU.
 Hit closestHitBruteForce(const TriangleSoup& soup, const Ray& ray);
 

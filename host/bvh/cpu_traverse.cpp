@@ -95,7 +95,7 @@ Hit closestHit(const Bvh& bvh, const Ray& ray) {
   return best;
 }
 
-bool anyHit(const Bvh& bvh, const Ray& ray) {
+bool anyHit(const Bvh& bvh, const Ray& ray, float* hitT) {
   const WatertightRay wr = prepareWatertightRay(ray.origin, ray.direction);
   bool found = false;
   traverse(
@@ -109,6 +109,7 @@ bool anyHit(const Bvh& bvh, const Ray& ray) {
                                 ray.tmin, ray.tmax, t, u, v) &&
               t < ray.tmax) {
             found = true;
+            if (hitT) *hitT = t;
             return true;
           }
         }

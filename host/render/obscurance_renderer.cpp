@@ -87,17 +87,34 @@ gpu::GpuCamera ObscuranceRenderer::primaryCamera() const {
                    sky < lights_.size() ? static_cast<std::uint32_t>(sky) : gpu::kInvalidIndex);
 }
 
-void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh& bvh) {
-  std::vector<glm::vec3> meanAlbedo; // of `scene`'s materials (an insert brings its own)
-  for (const auto& m : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(m));
-  reached_ = std::make_unique<ReachedSurfaces>(scene, bvh, triangleReflectances(scene, meanAlbedo));
+void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh& bvh,
+                                      const std::vector<scene::Bounds>* changed) {
+  const auto start = Clock::now();
+  // Every triangle's mean reflectance: a move or a removal keeps them (averaging modern-hall's
+  // textures takes ~0.25 s); an insert brings its own.
+  if (!changed || reachReflectance_.size() != scene.triangles.size()) {
+    std::vector<glm::vec3> meanAlbedo;
+    for (const auto& m : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(m));
+    reachReflectance_ = triangleReflectances(scene, meanAlbedo);
+  }
+  auto before = std::move(reached_);
+  reached_ = std::make_unique<ReachedSurfaces>(scene, bvh, reachReflectance_);
   ambient_.depth = settings_.maxDepth;
-  // Lights spread over the cores (measure is const and seeds its own generator): the CPU rays of
-  // modern-hall's 13 lights take ~0.3 s on one core.
+  std::vector<scene::Bounds> padded;
+  const bool incremental = changed && before && ambient_.reach.size() == lights_.size();
+  if (incremental) {
+    const float pad = changedBoxPadding();
+    for (scene::Bounds b : *changed) padded.push_back({b.lo - pad, b.hi + pad});
+  }
+  std::vector<LightReach> previous = std::move(ambient_.reach);
+  // Lights spread over the cores (measure is const and draws its own numbers): the CPU rays of
+  // modern-hall's 13 lights take ~0.3 s on one core when measured whole.
   ambient_.reach.assign(lights_.size(), LightReach{});
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
-    for (std::size_t s = next++; s < lights_.size(); s = next++) ambient_.reach[s] = reached_->measure(lights_, s);
+    for (std::size_t s = next++; s < lights_.size(); s = next++)
+      ambient_.reach[s] = incremental ? reached_->remeasure(*before, previous[s], lights_, s, padded)
+                                      : reached_->measure(lights_, s);
   };
   std::vector<std::future<void>> workers;
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
@@ -105,6 +122,13 @@ void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh&
   worker();
   for (auto& w : workers) w.get();
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
+  lastReach_ = {0, 1e3 * secondsSince(start)};
+  for (const LightReach& r : ambient_.reach) lastReach_.rays += r.rays.traced;
+}
+
+float ObscuranceRenderer::changedBoxPadding() const {
+  const scene::Bounds& bounds = scene_->bounds;
+  return 1e-3f * (glm::length(bounds.extent()) + glm::length(glm::max(glm::abs(bounds.lo), glm::abs(bounds.hi))));
 }
 
 void ObscuranceRenderer::markReflectors() {
@@ -319,13 +343,14 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
                                                  const std::vector<scene::Bounds>& changed) {
   const auto start = Clock::now();
   const double wallBefore = wallSeconds_;
-  const bool emittersMoved = replaceScene(edited, bvh);
+  const bool emittersMoved = replaceScene(edited, bvh, &changed);
   const std::uint64_t retraced = retraceDirty(changed, emittersMoved);
   wallSeconds_ = wallBefore + secondsSince(start);
   return retraced;
 }
 
-bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh& bvh) {
+bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh& bvh,
+                                      const std::vector<scene::Bounds>* changed) {
   // Same lights: only an emitter that moved changes them, and then every pixel may change.
   LightSet moved = buildLightSet(edited);
   bool emittersMoved = moved.emitters.size() != lights_.emitters.size();
@@ -348,8 +373,9 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
   const bool sameSurfaces = edited.materials.size() == scene_->materials.size() &&
                             edited.textures.size() == scene_->textures.size();
   scene_ = &edited;
-  // Moved occluders change what every light reaches.
-  if (reached_) measureReach(edited, bvh);
+  // Moved occluders change what every light reaches: where the emitters and surfaces stayed, only
+  // the rays that meet the changed boxes are traced again.
+  if (reached_) measureReach(edited, bvh, emittersMoved || !sameSurfaces ? nullptr : changed);
   bool rebind = true;
   if (sameSurfaces) rebind = sceneBuffers_.updateGeometry(edited, bvh);
   else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
@@ -365,8 +391,7 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
   // Ray origins leave their surfaces by a few hundred ulps of their coordinates (lib/ray.glsl):
   // a changed box grown by 1e-3 of the scene's size and reach covers them.
-  const scene::Bounds& bounds = scene_->bounds;
-  const float dirtyPad = 1e-3f * (glm::length(bounds.extent()) + glm::length(glm::max(glm::abs(bounds.lo), glm::abs(bounds.hi))));
+  const float dirtyPad = changedBoxPadding();
   // The sky lights every pixel from every direction: any edit may change any pixel.
   // So do secondary reflectors: what the edit lights or shades anew is marked anew.
   const bool all = everyPixel || backgroundLight(lights_) < lights_.size() || reflectorsOn();
@@ -732,7 +757,7 @@ std::uint64_t ObscuranceRenderer::addEmitter(const scene::Scene& edited, const b
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   // The quad is geometry too: replaceScene uploads it, measures what every light reaches anew,
   // and the pixels it can change are retraced for every light (the new one included).
-  const bool everyPixel = replaceScene(edited, bvh);
+  const bool everyPixel = replaceScene(edited, bvh, nullptr);
   std::uint64_t retraced = 0;
   if (reflectorsOn()) {
     retraceAll();

@@ -194,6 +194,13 @@ public:
   bool specular() const { return runSpecular_; }
   // Per-pass GPU ms and rays since the last reset, wall time, memory, truncations, notes.
   RenderStats stats() const;
+  // The last measurement of what the lights reach (the Reached ambient model, CPU rays): rays
+  // traced and wall ms; after a move, only the rays it could change.
+  struct ReachUpdate {
+    std::uint64_t rays = 0;
+    double ms = 0.0;
+  };
+  ReachUpdate lastReachUpdate() const { return lastReach_; }
   // Triangles marked as important secondary reflectors (0 when they are off).
   std::uint32_t secondaryReflectors() const { return reflectorsMarked_; }
   // Bytes of device memory held: scene, lights and frame (the real allocations).
@@ -201,8 +208,13 @@ public:
 
 private:
   void uploadLights();
-  // The Reached ambient model: what every light reaches in `scene` (after a geometry edit too).
-  void measureReach(const scene::Scene& scene, const bvh::Bvh& bvh);
+  // The Reached ambient model: what every light reaches in `scene`. After a geometry edit that
+  // kept the lights, `changed` (the edited objects' old and new boxes) lets each light re-trace
+  // only the rays the edit can change (ReachedSurfaces::remeasure: the same numbers).
+  void measureReach(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<scene::Bounds>* changed = nullptr);
+  // How far beyond a changed box the rays' offset origins may start: 1e-3 of the scene's size and
+  // reach (lib/ray.glsl offsets by a few hundred ulps of the coordinates).
+  float changedBoxPadding() const;
   // Marks the secondary reflectors from the measured reach (settings_.secondaryReflectors > 0).
   void markReflectors();
   bool reflectorsOn() const { return settings_.secondaryReflectors > 0.0f; }
@@ -214,7 +226,8 @@ private:
   void traceAddedLight(std::uint32_t light);
   // The geometry half of an edit: `edited` replaces the scene (buffers, reach, lights whose
   // emitters moved). Returns whether emitters moved (then every pixel may change).
-  bool replaceScene(const scene::Scene& edited, const bvh::Bvh& bvh);
+  // `changed`: the boxes of a move or removal (null: anything may have changed, e.g. an insert).
+  bool replaceScene(const scene::Scene& edited, const bvh::Bvh& bvh, const std::vector<scene::Bounds>* changed);
   // Clears and retraces, for every sample so far, the pixels `changed` can change (all of them
   // with `everyPixel`). `tracedLight`, a new light traced at every pixel, is left out of the
   // shadow-segment test. Returns how many.
@@ -238,6 +251,8 @@ private:
   SceneBuffers sceneBuffers_;
   LightSet lights_;
   AmbientTerm ambient_;
+  ReachUpdate lastReach_;
+  std::vector<glm::vec3> reachReflectance_; // mean reflectance per triangle of the measured scene
   std::unique_ptr<ReachedSurfaces> reached_; // the light rays of the Reached model and the reflectors (CPU)
   std::uint32_t reflectorsMarked_ = 0;       // triangles marked as secondary reflectors
   float unmarkedFirstBounce_ = 1.0f;         // r of secondary_reflectors.h

@@ -4,13 +4,41 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <limits>
 #include <random>
+#include <string>
 
 
 namespace obscura::render {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// The streams of a light's measurement: one per ray (or per surface sample, whose tries share it).
+enum class Stream : std::uint32_t { LightRay = 1, Bounce = 2, Sample = 3 };
+
+// A counter-based generator (splitmix64, Steele, Lea & Flood 2014) for one stream: cheap to start
+// at any (light, stream, index), so that every ray has numbers of its own.
+class StreamRng {
+public:
+  StreamRng(std::uint32_t lightSeed, Stream stream, std::uint32_t index)
+      : state_((std::uint64_t{lightSeed} << 32) ^ (std::uint64_t{static_cast<std::uint32_t>(stream)} << 28) ^ index) {
+    next64(); // decorrelate neighbouring seeds
+  }
+  float next() { return static_cast<float>(next64() >> 40) * 0x1p-24f; } // uniform in [0, 1)
+  std::uint32_t below(std::uint32_t n) { return static_cast<std::uint32_t>((next64() >> 32) * n >> 32); }
+
+private:
+  std::uint64_t next64() {
+    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  std::uint64_t state_;
+};
 
 struct Frame {
   glm::vec3 t, b, n;
@@ -42,8 +70,8 @@ struct LightPoint {
   glm::vec3 direction{0.0f}; // directional: the way the light travels
 };
 
-LightPoint samplePoint(const LightSet& lights, std::size_t s, std::mt19937& rng, const scene::Bounds& bounds) {
-  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+LightPoint samplePoint(const LightSet& lights, std::size_t s, StreamRng& rng, const scene::Bounds& bounds) {
+  auto uni = [](StreamRng& r) { return r.next(); };
   const gpu::GpuLight& l = lights.lights[s];
   LightPoint p;
   if (l.info.x == gpu::kLightArea) {
@@ -83,8 +111,8 @@ LightPoint samplePoint(const LightSet& lights, std::size_t s, std::mt19937& rng,
 
 // A direction the light at `p` emits into (cosine for area lights, uniform or within the cone for
 // punctual ones); false when a spot gave none.
-bool emitDirection(const LightSet& lights, std::size_t s, const LightPoint& p, std::mt19937& rng, glm::vec3& d) {
-  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+bool emitDirection(const LightSet& lights, std::size_t s, const LightPoint& p, StreamRng& rng, glm::vec3& d) {
+  auto uni = [](StreamRng& r) { return r.next(); };
   const gpu::GpuLight& l = lights.lights[s];
   if (p.directional) {
     d = p.direction;
@@ -114,10 +142,36 @@ float offsetAt(glm::vec3 p, float offset) {
   return std::max(offset, 4e-6f * std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z))));
 }
 
+// Whether the segment origin + t direction, t in [0, tmax] (tmax may be infinite), meets the box:
+// the slab test, an axis the direction runs parallel to tested on the origin alone.
+bool segmentMeetsBox(glm::vec3 origin, glm::vec3 direction, float tmax, const scene::Bounds& box) {
+  float t0 = 0.0f, t1 = tmax;
+  for (int axis = 0; axis < 3; ++axis) {
+    const float o = origin[axis], d = direction[axis];
+    if (d == 0.0f) {
+      if (o < box.lo[axis] || o > box.hi[axis]) return false;
+      continue;
+    }
+    const float a = (box.lo[axis] - o) / d, b = (box.hi[axis] - o) / d;
+    t0 = std::max(t0, std::min(a, b));
+    t1 = std::min(t1, std::max(a, b));
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+std::uint32_t lightSeed(const std::string& name) {
+  // Seeded by the light's name, not its index: the same light gets the same estimate in a scene
+  // with other lights added or removed.
+  std::uint32_t seed = 2166136261u; // FNV-1a
+  for (unsigned char c : name) seed = (seed ^ c) * 16777619u;
+  return seed;
+}
+
 } // namespace
 
 ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<glm::vec3>& reflectance)
-    : scene_(&scene), bvh_(bvh), offset_(1e-5f * largestExtent(scene.bounds)) {
+    : scene_(&scene), bvh_(bvh), bounds_(scene.bounds), offset_(1e-5f * largestExtent(scene.bounds)) {
   std::vector<double> cdf;
   cdf.reserve(scene.triangles.size());
   for (const auto& t : scene.triangles) {
@@ -141,90 +195,175 @@ ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh,
   }
 }
 
+// What remeasure reuses: the measurement before the edit and the boxes the edit changed.
+struct ReachedSurfaces::Replay {
+  const ReachedSurfaces& before;
+  const ReachRays& rays;
+  const std::vector<scene::Bounds>& changed;
+  bool samplesComparable; // the same number of surface samples: sample j before is sample j now
+
+  bool meets(glm::vec3 origin, glm::vec3 direction, float tmax) const {
+    for (const scene::Bounds& b : changed)
+      if (segmentMeetsBox(origin, direction, tmax, b)) return true;
+    return false;
+  }
+};
+
 LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) const {
+  return trace(lights, light, nullptr);
+}
+
+LightReach ReachedSurfaces::remeasure(const ReachedSurfaces& before, const LightReach& previous, const LightSet& lights,
+                                      std::size_t light, const std::vector<scene::Bounds>& changed) const {
+  if (previous.rays.landingT.size() != kLightRays) return measure(lights, light); // never measured
+  // The sky's and the sun's points are placed by the scene's bounds: a move that changed them
+  // moved every one of those light points.
+  const std::uint32_t type = lights.lights[light].info.x;
+  const bool placedByBounds = type == gpu::kLightBackground || type == gpu::kLightDirectional;
+  if (placedByBounds && (before.bounds_.lo != bounds_.lo || before.bounds_.hi != bounds_.hi)) return measure(lights, light);
+  const Replay replay{before, previous.rays, changed, before.samples_.size() == samples_.size()};
+  return trace(lights, light, &replay);
+}
+
+LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, const Replay* replay) const {
   LightReach reach;
   if (samples_.empty() || !(lights.power[light] > 0.0)) return reach;
-  // Seeded by the light's name, not its index: the same light gets the same estimate in a scene
-  // with other lights added or removed.
-  std::uint32_t seed = 2166136261u; // FNV-1a
-  for (unsigned char c : lights.names[light]) seed = (seed ^ c) * 16777619u;
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  const std::uint32_t seed = lightSeed(lights.names[light]);
   const scene::Scene& scene = *scene_;
+  ReachRays& rays = reach.rays;
   auto offsetToward = [&](glm::vec3 p, glm::vec3 n, glm::vec3 towards) {
     const float o = offsetAt(p, offset_);
     return p + (glm::dot(n, towards - p) >= 0.0f ? o : -o) * n;
   };
 
-  // 1. Where the light lands: first hits of rays leaving it (the position and the lit side's normal).
+  // 1. Where the light lands: first hits of rays leaving it (the position and the lit side's
+  // normal). A light ray is traced again when its segment up to its old hit meets a changed box:
+  // every other ray has the same first hit in the edited scene.
   struct Landing {
     glm::vec3 position, normal;
+    bool moved = false; // re-traced: what was seen of it before says nothing now
   };
-  std::vector<Landing> landings;
+  std::vector<Landing> landingOf(kLightRays); // by light ray; valid where landingT is finite
+  rays.landingT.assign(kLightRays, std::numeric_limits<float>::quiet_NaN());
+  rays.landingPrimitive.assign(kLightRays, gpu::kInvalidIndex);
   std::map<std::uint32_t, std::uint32_t> landedOn; // triangle -> rays
-  std::uint32_t emitted = 0;
+  std::uint32_t emitted = 0, landed = 0;
   for (std::uint32_t i = 0; i < kLightRays; ++i) {
+    StreamRng rng(seed, Stream::LightRay, i);
     LightPoint p = samplePoint(lights, light, rng, scene.bounds);
     glm::vec3 d;
     if (!emitDirection(lights, light, p, rng, d)) continue;
     bvh::Ray ray{.origin = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, p.position + d),
                  .direction = d};
-    bvh::Hit hit = bvh::closestHit(bvh_, ray);
     ++emitted;
-    if (!hit.hit()) continue;
-    const glm::uvec3 tri = scene.triangles[hit.primitive];
+    float t = replay ? replay->rays.landingT[i] : 0.0f;
+    std::uint32_t primitive = replay ? replay->rays.landingPrimitive[i] : gpu::kInvalidIndex;
+    const bool retrace = !replay || std::isnan(t) || replay->meets(ray.origin, d, t);
+    if (retrace) {
+      bvh::Hit hit = bvh::closestHit(bvh_, ray);
+      ++rays.traced;
+      t = hit.hit() ? hit.t : std::numeric_limits<float>::infinity();
+      primitive = hit.hit() ? hit.primitive : gpu::kInvalidIndex;
+    }
+    rays.landingT[i] = t;
+    rays.landingPrimitive[i] = primitive;
+    if (!std::isfinite(t)) continue;
+    const glm::uvec3 tri = scene.triangles[primitive];
     glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
     glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
     if (glm::dot(n, d) > 0.0f) n = -n; // the side the light arrives on
-    landings.push_back({ray.origin + hit.t * d, n});
-    ++landedOn[hit.primitive];
+    landingOf[i] = {ray.origin + t * d, n, retrace && replay};
+    ++landed;
+    ++landedOn[primitive];
   }
   reach.landedTriangles.assign(landedOn.begin(), landedOn.end());
-  reach.landings = static_cast<std::uint32_t>(landings.size());
+  reach.landings = landed;
 
   // What leaves the scene: directly (not for a directional light, whose flux counts only what
   // crosses the scene's box already), and after one diffuse reflection where the light lands.
   const bool directional = lights.lights[light].info.x == gpu::kLightDirectional;
-  reach.escapeDirect = directional || emitted == 0 ? 0.0 : 1.0 - static_cast<double>(landings.size()) / emitted;
+  reach.escapeDirect = directional || emitted == 0 ? 0.0 : 1.0 - static_cast<double>(landed) / emitted;
   std::size_t escapedBounce = 0;
-  for (const Landing& h : landings) {
-    glm::vec3 d = cosineDirection(h.normal, uni(rng), uni(rng));
+  rays.bounceBlockedAt.assign(kLightRays, kInfinity);
+  for (std::uint32_t i = 0; i < kLightRays; ++i) {
+    if (!std::isfinite(rays.landingT[i])) continue;
+    const Landing& h = landingOf[i];
+    StreamRng rng(seed, Stream::Bounce, i);
+    glm::vec3 d = cosineDirection(h.normal, rng.next(), rng.next());
     bvh::Ray ray{.origin = h.position + offsetAt(h.position, offset_) * h.normal, .direction = d};
-    if (!bvh::anyHit(bvh_, ray)) ++escapedBounce;
+    // Blocked at t before: still blocked unless the segment up to there meets a changed box; left
+    // the scene: still does unless the whole ray meets one.
+    float blockedAt = replay ? replay->rays.bounceBlockedAt[i] : kInfinity;
+    if (!replay || h.moved || replay->meets(ray.origin, d, blockedAt)) {
+      blockedAt = kInfinity;
+      bvh::anyHit(bvh_, ray, &blockedAt);
+      ++rays.traced;
+    }
+    rays.bounceBlockedAt[i] = blockedAt;
+    escapedBounce += std::isinf(blockedAt) ? 1 : 0;
   }
-  reach.escapeBounce = landings.empty() ? 0.0 : static_cast<double>(escapedBounce) / static_cast<double>(landings.size());
+  reach.escapeBounce = landed == 0 ? 0.0 : static_cast<double>(escapedBounce) / static_cast<double>(landed);
 
-  // 2. Surface samples that see the light or a landing point.
-  auto visible = [&](glm::vec3 from, glm::vec3 to) {
-    bvh::Ray ray{.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f};
-    return !bvh::anyHit(bvh_, ray);
-  };
+  // 2. Surface samples that see the light or a landing point: up to kVisibilityTries points of the
+  // light, then as many landing points (a light ray picked at random; none when it did not land),
+  // stopping at the first seen. Before an edit, try k of sample j was unseen for k < its first seen
+  // try, seen at it, and not traced after it.
+  const gpu::GpuLight& l = lights.lights[light];
   std::size_t reached = 0;
   glm::dvec3 reflectance(0.0);
-  for (const SurfacePoint& s : samples_) {
+  rays.firstSeenTry.assign(samples_.size(), kNotSeen);
+  rays.tryBlockedAt.assign(samples_.size() * kTries, kNaN);
+  for (std::size_t j = 0; j < samples_.size(); ++j) {
+    const SurfacePoint& s = samples_[j];
+    const bool sameSample = replay && replay->samplesComparable && replay->before.samples_[j] == s;
+    const std::uint8_t firstBefore = sameSample ? replay->rays.firstSeenTry[j] : kNotSeen;
+    // Try k, the segment from -> to: seen before and its whole segment clear of the changed boxes,
+    // or blocked at t before and its segment up to t clear of them, it finds the same now.
+    auto seenFrom = [&](std::uint32_t k, glm::vec3 from, glm::vec3 to, bool targetMoved) {
+      float& blockedAt = rays.tryBlockedAt[j * kTries + k];
+      if (sameSample && !targetMoved) {
+        const float before = replay->rays.tryBlockedAt[j * kTries + k];
+        if (k == firstBefore && !replay->meets(from, to - from, 1.0f)) return true;
+        if (!std::isnan(before) && !replay->meets(from, to - from, before)) {
+          blockedAt = before;
+          return false;
+        }
+      }
+      bvh::Ray ray{.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f};
+      ++rays.traced;
+      float t = kNaN;
+      if (!bvh::anyHit(bvh_, ray, &t)) return true;
+      blockedAt = t;
+      return false;
+    };
+    StreamRng rng(seed, Stream::Sample, static_cast<std::uint32_t>(j));
     bool seen = false;
-    for (std::uint32_t k = 0; k < kVisibilityTries && !seen; ++k) {
+    std::uint32_t k = 0;
+    for (; k < kVisibilityTries && !seen; ++k) {
       LightPoint p = samplePoint(lights, light, rng, scene.bounds);
       if (p.directional) {
         glm::vec3 to = s.position - 4.0f * largestExtent(scene.bounds) * p.direction;
-        seen = visible(offsetToward(s.position, s.normal, to), to);
+        seen = seenFrom(k, offsetToward(s.position, s.normal, to), to, false);
         continue;
       }
       if (p.normal != glm::vec3(0.0f) && !p.twoSided && glm::dot(p.normal, s.position - p.position) <= 0.0f) continue;
-      const gpu::GpuLight& l = lights.lights[light];
-      if (l.info.x == gpu::kLightSpot &&
-          glm::dot(glm::normalize(s.position - p.position), glm::vec3(l.direction)) < l.params.w)
+      if (l.info.x == gpu::kLightSpot && glm::dot(glm::normalize(s.position - p.position), glm::vec3(l.direction)) < l.params.w)
         continue;
       glm::vec3 target = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, s.position);
-      seen = visible(offsetToward(s.position, s.normal, target), target);
+      seen = seenFrom(k, offsetToward(s.position, s.normal, target), target, false);
     }
-    for (std::uint32_t k = 0; k < kVisibilityTries && !seen && !landings.empty(); ++k) {
-      const Landing& h = landings[std::uniform_int_distribution<std::size_t>(0, landings.size() - 1)(rng)];
+    for (std::uint32_t tries = 0; tries < kVisibilityTries && !seen && landed > 0; ++tries) {
+      const std::uint32_t k2 = kVisibilityTries + tries;
+      const std::uint32_t i = rng.below(kLightRays);
+      if (!std::isfinite(rays.landingT[i])) continue; // that light ray left the scene
+      const Landing& h = landingOf[i];
       if (glm::dot(h.normal, s.position - h.position) <= 0.0f) continue; // behind the lit side
       glm::vec3 target = h.position + offsetAt(h.position, offset_) * h.normal;
-      seen = visible(offsetToward(s.position, s.normal, target), target);
+      seen = seenFrom(k2, offsetToward(s.position, s.normal, target), target, h.moved);
+      if (seen) k = k2 + 1;
     }
     if (seen) {
+      rays.firstSeenTry[j] = static_cast<std::uint8_t>(k - 1);
       ++reached;
       reflectance += glm::dvec3(s.reflectance);
     }
@@ -237,3 +376,4 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
 }
 
 } // namespace obscura::render
+

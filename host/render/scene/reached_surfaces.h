@@ -19,6 +19,12 @@
 // emission. The rays run on the CPU (bvh::closestHit / anyHit): a few
 // thousand per light, deterministic for a given scene (fixed seeds), so an incremental edit and a
 // fresh render agree.
+//
+// Every ray draws its random numbers from a stream of its own (the light's name, the kind of ray
+// and its index), so no ray's outcome shifts another's numbers. That is what lets a geometry edit
+// re-measure a light exactly by re-tracing only the rays the edit can change (remeasure): a ray
+// whose segment meets none of the changed boxes, from a sample point and to a target that did not
+// move, finds in the edited scene what it found before.
 #pragma once
 #include <cstdint>
 #include <utility>
@@ -32,6 +38,23 @@
 
 namespace obscura::render {
 
+// What each ray of a light's measurement found, kept so that an edit can re-trace only the rays
+// it may change (ReachedSurfaces::remeasure).
+struct ReachRays {
+  std::vector<float> landingT;                   // per light ray: distance to its first hit; inf: none,
+                                                 // NaN: nothing emitted (a spot gave no direction)
+  std::vector<std::uint32_t> landingPrimitive;   // per light ray: the triangle it landed on
+  std::vector<float> bounceBlockedAt;            // per light ray that landed: where its reflected ray
+                                                 // was found blocked (inf: it left the scene)
+  std::vector<std::uint8_t> firstSeenTry;        // per surface sample: the try that saw the light or
+                                                 // a landing (kNotSeen: none did)
+  std::vector<float> tryBlockedAt;               // per surface sample and try (kTries each): where
+                                                 // along its segment (0..1) it was found blocked; NaN:
+                                                 // not traced (skipped, or after the seen one)
+  std::uint64_t traced = 0;                      // rays this measurement traced (re-traced ones only
+                                                 // for remeasure)
+};
+
 struct LightReach {
   double area = 0.0;              // A_s: area the light reaches (directly or after one bounce)
   glm::vec3 reflectance{0.0f};    // R_s: mean reflectance of that area
@@ -42,6 +65,7 @@ struct LightReach {
   // `landings` rays that hit something (secondary_reflectors.h marks the strongly lit ones).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> landedTriangles;
   std::uint32_t landings = 0;
+  ReachRays rays;
 };
 
 class ReachedSurfaces {
@@ -54,6 +78,14 @@ public:
   // enclosed): the caller falls back to the whole scene.
   LightReach measure(const LightSet& lights, std::size_t light) const;
 
+  // The same measurement in this (edited) scene, from `previous`, what `before` (the scene before
+  // the edit, with the same lights and emitters) measured for this light: only the rays that can
+  // have changed are traced again, those whose segment meets one of `changed` (the edited
+  // objects' old and new boxes, padded by the caller for ray offsets) or whose end points moved.
+  // The result equals measure() on this scene bit for bit (ReachedSurfaces.Remeasure* test it).
+  LightReach remeasure(const ReachedSurfaces& before, const LightReach& previous, const LightSet& lights,
+                       std::size_t light, const std::vector<scene::Bounds>& changed) const;
+
   double totalArea() const { return totalArea_; }
 
   // Light rays per light and surface samples over the scene (OURS: a few thousand keep the
@@ -61,15 +93,21 @@ public:
   static constexpr std::uint32_t kLightRays = 1024;
   static constexpr std::uint32_t kSurfaceSamples = 4096;
   static constexpr std::uint32_t kVisibilityTries = 4; // shadow rays per sample and kind of target
+  static constexpr std::uint8_t kNotSeen = 0xff;
+  static constexpr std::uint32_t kTries = 2 * kVisibilityTries; // light points, then landing points
 
 private:
   struct SurfacePoint {
     glm::vec3 position, normal, reflectance;
+    bool operator==(const SurfacePoint&) const = default;
   };
+  struct Replay; // what remeasure reuses
+  LightReach trace(const LightSet& lights, std::size_t light, const Replay* replay) const;
   const scene::Scene* scene_;
   bvh::Bvh bvh_;
   std::vector<SurfacePoint> samples_;
   double totalArea_ = 0.0;
+  scene::Bounds bounds_; // the scene's: where the sky's and the sun's light points lie
   float offset_ = 1e-5f; // ray-origin offset along the normal: 1e-5 of the scene's largest extent
 };
 
