@@ -183,6 +183,16 @@ TEST_F(GeometryEdit, ProbingRetracesFewerGlossyPixelsThanBounds) {
   EXPECT_LT(probed, bounded);
 }
 
+TEST_F(GeometryEdit, ObjectMovedInFromOutsideTheRoomMatchesAFullRender) {
+  // The object starts outside the room, so the move shrinks the scene's bounds, and with them the
+  // offset every ray of the lights' reach measurement leaves its surface by: that measurement must
+  // then be made whole again (replaying the old rays gave another I_a: 282 glossy pixels differed).
+  // It ends high over the back of the mirror floor, where the floor's escaped paths pass.
+  const std::uint64_t retraced =
+      moveAndCompare({6.0f, 2.8f, -1.2f}, {1.0f, 2.8f, -1.2f}, 1.0f, true, true, 0.0f, boundsOnly);
+  EXPECT_LT(retraced, 48u * 36u);
+}
+
 TEST_F(GeometryEdit, ShadowAtASpecularPathsVertexIsRetraced) {
   // The object hangs in front of the back wall under the lamp: its shadow on the wall is seen in
   // the mirror floor, where the only rays that change are shadow rays from the paths' vertices on

@@ -216,6 +216,9 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
 LightReach ReachedSurfaces::remeasure(const ReachedSurfaces& before, const LightReach& previous, const LightSet& lights,
                                       std::size_t light, const std::vector<scene::Bounds>& changed) const {
   if (previous.rays.landingT.size() != kLightRays) return measure(lights, light); // never measured
+  // Ray origins leave their surfaces by a share of the scene's size: a move that changed it moved
+  // every ray.
+  if (before.offset_ != offset_) return measure(lights, light);
   // The sky's and the sun's points are placed by the scene's bounds: a move that changed them
   // moved every one of those light points.
   const std::uint32_t type = lights.lights[light].info.x;
