@@ -1,6 +1,7 @@
 // `obscura recover` as a user runs it: a run on two of the Cycles photographs writes the
 // reflectance (with its confidence layer), the report, a relighting state whose albedo is the
-// recovered one and, with --debug/--png, the per-photo images; bad input (photos of different sizes, a lamp inside geometry, another camera, an
+// recovered one and, with --debug/--png, the per-photo images, and `obscura remodel` relights and
+// remodels that folder; bad input (photos of different sizes, a lamp inside geometry, another camera, an
 // unreadable image, a missing field) is a clear error naming the file, exit 2, nothing written.
 #include <cmath>
 #include <filesystem>
@@ -108,22 +109,13 @@ TEST_F(CliRecover, WritesReflectanceWithConfidenceAndThePerPhotoImages) {
     }
   EXPECT_GT(filled, 3000); // what the short box covered
   EXPECT_GT(lit, 30000);   // the new lamp lights the room
-}
 
-TEST_F(CliRecover, RemodelRefusesBadEditsAndFoldersNamingThem) {
-  fs::create_directories(path("notrecovered"));
-  const auto notRecovered = runObscura("remodel " + path("notrecovered") + " --edits " + path("e.json") + " -o " + path("x.exr"));
-  EXPECT_EQ(notRecovered.exitCode, 2) << notRecovered.output;
-  EXPECT_CONTAINS(notRecovered.output, "recover.json: missing");
-  // A folder that recover wrote (two photos, the cheapest settings), then bad edits.
-  const std::string file = write(lights(2));
-  ASSERT_EQ(runObscura("recover " + scene() + " --photos " + file + " -o " + path("out") +
-                       " --spp 1 --gather-rays 4 --iterations 1").exitCode, 0);
-  auto refused = [&](const json& edits, const std::string& mention) {
-    std::ofstream(path("e.json")) << edits.dump();
-    const auto r = runObscura("remodel " + path("out") + " --edits " + path("e.json") + " -o " + path("x.exr"));
-    EXPECT_EQ(r.exitCode, 2) << r.output;
-    EXPECT_CONTAINS(r.output, mention);
+  // Bad remodel input, on the same folder: a clear error naming it, exit 2, nothing written.
+  auto refused = [&](const json& bad, const std::string& mention) {
+    std::ofstream(path("e.json")) << bad.dump();
+    const auto result = runObscura("remodel " + path("out") + " --edits " + path("e.json") + " -o " + path("x.exr"));
+    EXPECT_EQ(result.exitCode, 2) << result.output;
+    EXPECT_CONTAINS(result.output, mention);
     EXPECT_FALSE(fs::exists(path("x.exr")));
   };
   refused(json::array({{{"move", "cube_1"}, {"translate", {0, 0, 0.1}}}}), "moving a photographed object");
@@ -132,6 +124,10 @@ TEST_F(CliRecover, RemodelRefusesBadEditsAndFoldersNamingThem) {
   refused(json::array({{{"add_light", {{"type", "point"}, {"name", "lamp"}, {"position", {0.33, 0.3, 0.37}},
                                        {"color", {1, 1, 1}}, {"intensity", 1}}}}}),
           "inside geometry");
+  fs::create_directories(path("notrecovered"));
+  const auto notRecovered = runObscura("remodel " + path("notrecovered") + " --edits " + path("e.json") + " -o " + path("x.exr"));
+  EXPECT_EQ(notRecovered.exitCode, 2) << notRecovered.output;
+  EXPECT_CONTAINS(notRecovered.output, "recover.json: missing");
 }
 
 TEST_F(CliRecover, PhotosOfDifferentSizesAreRefusedNamingTheImage) {
