@@ -73,7 +73,12 @@ RemodelledFrame renderRemodelled(const gpu::Context& context, const RecoveredRoo
     if (o < 0) continue;
     if (o >= original) out.reflectance[p] = objectReflectance[static_cast<std::size_t>(o)];
     else if (o == room.object[p]) out.reflectance[p] = room.reflectance[p];
-    else uncovered[p] = 1;
+    else {
+      // Synthesized below; a pixel whose surface has nothing photographed to copy from (a mixed
+      // normal at an edge between two planes) keeps its object's mean.
+      uncovered[p] = 1;
+      out.reflectance[p] = objectReflectance[static_cast<std::size_t>(o)];
+    }
   }
   TextureFillInput fill;
   fill.width = room.width;
