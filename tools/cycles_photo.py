@@ -5,6 +5,7 @@
 # 30 W, invisible to the camera), box pixel filter of 1 pixel, black world, 6 bounces with no
 # Russian roulette before them, no clamping, no denoising, no adaptive sampling, CPU.
 #
+# Needs Blender 3.4 (Debian 12: apt-get install blender; not in tools/setup.sh, nothing else uses it):
 #   blender -b -P tools/cycles_photo.py -- SCENE.gltf --lamp X Y Z -o photo.exr \
 #       [--spp 1024] [--size 256] [--seed 0] [--power 30] [--radius 0.04] [--threads 2] [--albedo albedo.exr]
 #
@@ -20,11 +21,8 @@ import bpy
 import numpy
 
 # Debian 12's numpy 1.24 dropped the alias that Blender 3.4's glTF importer still uses.
-if not hasattr(numpy, "bool") or numpy.bool is not bool:
-    try:
-        numpy.bool  # noqa: B018
-    except AttributeError:
-        numpy.bool = bool
+if not hasattr(numpy, "bool"):
+    numpy.bool = bool
 
 
 def parse_args():
