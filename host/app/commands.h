@@ -22,5 +22,6 @@ void addRelightCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
 void addRecoverCommand(CLI::App& app);
+void addRemodelCommand(CLI::App& app);
 
 } // namespace obscura::app

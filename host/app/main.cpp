@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   obscura::app::addCompareCommand(app);
   obscura::app::addViewCommand(app);
   obscura::app::addRecoverCommand(app);
+  obscura::app::addRemodelCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

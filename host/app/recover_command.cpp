@@ -1,7 +1,8 @@
 // obscura recover — reflectance from photographs of one view, one lamp per shot [IVR §4]:
 //   obscura recover SCENE --photos lights.json -o DIR [--camera N] [--debug] [--png]
-// writes DIR/reflectance.exr (R, G, B, confidence.K = sum of the filtered K_i, filled.id),
-// DIR/recover.json (how the estimate converged, what was filled, times), DIR/state (a relighting
+// writes DIR/reflectance.exr (R, G, B, confidence.K = sum of the filtered K_i, filled.id, object.id),
+// DIR/recover.json (the scene, camera and lamps, how the estimate converged, what was filled,
+// times; with reflectance.exr what `obscura remodel DIR` reads), DIR/state (a relighting
 // state of the photographed room with the recovered albedo, for `obscura relight`), with --debug one
 // DIR/shot-NNN.exr per photo (its estimate R_i, V_i, filtered K_i, direct and indirect light per
 // unit reflectance) and with --png reflectance.png and confidence.png.
@@ -86,11 +87,12 @@ nlohmann::json accuracyJson(const recover::Recovery& r, const std::vector<glm::v
 void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const recover::PhotoSet& photos,
                   const nlohmann::json& accuracy) {
   const fs::path dir(o.output);
-  io::Image out = rgbImage(r.width, r.height, {"R", "G", "B", "confidence.K", "filled.id"});
+  io::Image out = rgbImage(r.width, r.height, {"R", "G", "B", "confidence.K", "filled.id", "object.id"});
   for (std::size_t p = 0; p < r.reflectance.size(); ++p) {
     put(out, p, 0, r.reflectance[p]);
     put(out, p, 3, r.confidence[p]);
     put(out, p, 4, float(r.filled[p]));
+    put(out, p, 5, float(r.object[p]));
   }
   io::writeExr((dir / "reflectance.exr").string(), out);
   if (o.png) {
@@ -122,9 +124,21 @@ void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const rec
     iterations.push_back({{"iteration", it.iteration}, {"seconds", it.seconds}, {"rms_change", it.rmsChange},
                           {"object_reflectance", objects}});
   }
+  // What `obscura remodel DIR` needs besides reflectance.exr: the scene, camera and lamps.
+  nlohmann::json lamps = nlohmann::json::array();
+  for (std::size_t i = 0; i < photos.shots.size(); ++i) {
+    const recover::Shot& shot = photos.shots[i];
+    lamps.push_back({{"name", fmt::format("shot{}", i)},
+                     {"position", {shot.position.x, shot.position.y, shot.position.z}},
+                     {"intensity", shot.intensity},
+                     {"color", {shot.color.x, shot.color.y, shot.color.z}}});
+  }
   std::size_t surface = 0;
   for (auto o2 : r.object) surface += o2 >= 0 ? 1 : 0;
-  nlohmann::json report = {{"photos", photos.shots.size()},
+  nlohmann::json report = {{"scene", fs::absolute(o.scene).string()},
+                           {"gltf_camera", photos.gltfCamera},
+                           {"lamps", lamps},
+                           {"photos", photos.shots.size()},
                                  {"width", r.width},
                                  {"height", r.height},
                                  {"indirect", o.indirect},

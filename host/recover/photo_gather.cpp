@@ -120,19 +120,32 @@ PhotoGather::PhotoGather(const scene::Scene& room, const bvh::Bvh& bvh, const sc
 std::vector<std::vector<glm::vec3>> PhotoGather::indirect(const std::vector<Shot>& shots,
                                                           const std::vector<glm::vec3>& objectReflectance,
                                                           const std::vector<glm::vec3>& hiddenAmbient) const {
-  std::vector<std::vector<glm::vec3>> out(shots_, std::vector<glm::vec3>(pixels_, glm::vec3(0.0f)));
-  const float perRay = 1.0f / float(raysPerPixel_);
+  std::vector<std::vector<glm::vec3>> out;
   for (std::size_t i = 0; i < shots_; ++i) {
-    const Shot& shot = shots[i];
-    for (std::size_t p = 0; p < pixels_; ++p) {
-      glm::vec3 sum(0.0f);
-      for (std::uint32_t k = seenStart_[p]; k < seenStart_[p + 1]; ++k) sum += shot.radiance[seen_[k]];
-      for (std::uint32_t k = hiddenStart_[p]; k < hiddenStart_[p + 1]; ++k)
-        sum += objectReflectance[hiddenObject_[k]] * (hiddenDirect_[std::size_t(k) * shots_ + i] * shot.color + hiddenAmbient[i]);
-      out[i][p] = sum * perRay;
-    }
-    if (smoothRadius_ > 0) out[i] = smoothOnSurfaces(out[i], *geometry_, smoothRadius_);
+    std::vector<glm::vec3> lampColour(shots_, glm::vec3(0.0f));
+    lampColour[i] = shots[i].color;
+    out.push_back(gather(shots[i].radiance, lampColour, objectReflectance, hiddenAmbient[i]));
   }
+  return out;
+}
+
+std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radiance,
+                                           const std::vector<glm::vec3>& lampColour,
+                                           const std::vector<glm::vec3>& objectReflectance,
+                                           const glm::vec3& hiddenAmbient) const {
+  std::vector<glm::vec3> out(pixels_, glm::vec3(0.0f));
+  const float perRay = 1.0f / float(raysPerPixel_);
+  for (std::size_t p = 0; p < pixels_; ++p) {
+    glm::vec3 sum(0.0f);
+    for (std::uint32_t k = seenStart_[p]; k < seenStart_[p + 1]; ++k) sum += radiance[seen_[k]];
+    for (std::uint32_t k = hiddenStart_[p]; k < hiddenStart_[p + 1]; ++k) {
+      glm::vec3 light = hiddenAmbient;
+      for (std::size_t i = 0; i < shots_; ++i) light += hiddenDirect_[std::size_t(k) * shots_ + i] * lampColour[i];
+      sum += objectReflectance[hiddenObject_[k]] * light;
+    }
+    out[p] = sum * perRay;
+  }
+  if (smoothRadius_ > 0) out = smoothOnSurfaces(out, *geometry_, smoothRadius_);
   return out;
 }
 

@@ -47,6 +47,12 @@ public:
   std::vector<std::vector<glm::vec3>> indirect(const std::vector<Shot>& shots,
                                                const std::vector<glm::vec3>& objectReflectance,
                                                const std::vector<glm::vec3>& hiddenAmbient) const;
+  // One gather of an arbitrary lighting (relighting the recovered room, remodel.h): B(P) with
+  // `radiance` the current radiance of the pixels the camera sees, and at hidden hits
+  // objectReflectance x (sum_i lampColour[i] x the shot-i lamp's direct light + hiddenAmbient).
+  // indirect() is this with photo i's radiance and only lamp i.
+  std::vector<glm::vec3> gather(const std::vector<glm::vec3>& radiance, const std::vector<glm::vec3>& lampColour,
+                                const std::vector<glm::vec3>& objectReflectance, const glm::vec3& hiddenAmbient) const;
   // Fractions of the rays whose hit the camera sees, that are hidden, and that leave the scene.
   double seenFraction() const { return double(seen_.size()) / double(rays_); }
   double hiddenFraction() const { return double(hiddenObject_.size()) / double(rays_); }

@@ -1,6 +1,7 @@
 // `obscura recover` as a user runs it: a run on two of the Cycles photographs writes the
 // reflectance (with its confidence layer), the report, a relighting state whose albedo is the
-// recovered one and, with --debug/--png, the per-photo images; bad input (photos of different sizes, a lamp inside geometry, another camera, an
+// recovered one and, with --debug/--png, the per-photo images, and `obscura remodel` relights and
+// remodels that folder; bad input (photos of different sizes, a lamp inside geometry, another camera, an
 // unreadable image, a missing field) is a clear error naming the file, exit 2, nothing written.
 #include <cmath>
 #include <filesystem>
@@ -85,6 +86,48 @@ TEST_F(CliRecover, WritesReflectanceWithConfidenceAndThePerPhotoImages) {
     }
   EXPECT_GT(checked, 500);
   EXPECT_GE(agree, checked * 95 / 100) << agree << " of " << checked;
+
+  // `remodel` on the folder: both photographed lamps off, a new one on, the short box removed.
+  const json edits = json::array({{{"light", "shot0"}, {"scale", 0}},
+                                  {{"remove_light", "shot1"}},
+                                  {{"add_light", {{"type", "point"}, {"name", "lamp"}, {"position", {0.45, 1.55, -0.1}},
+                                                  {"color", {1, 1, 1}}, {"intensity", 2.387}}}},
+                                  {{"remove", "cube_1"}}});
+  std::ofstream(path("edits.json")) << edits.dump();
+  const auto remodel = runObscura("remodel " + path("out") + " --edits " + path("edits.json") + " -o " +
+                                  path("remodel.exr") + " --spp 1 --gather-rays 8 --bounces 2");
+  ASSERT_EQ(remodel.exitCode, 0) << remodel.output;
+  const io::Image frame = io::readImage(path("remodel.exr"));
+  const int synthesized = frame.channelIndex("synthesized.id");
+  ASSERT_GE(synthesized, 0);
+  for (const char* c : {"R", "reflectance.R", "direct.R", "indirect.R"}) EXPECT_GE(frame.channelIndex(c), 0) << c;
+  int filled = 0, lit = 0;
+  for (int y = 0; y < 256; ++y)
+    for (int x = 0; x < 256; ++x) {
+      filled += frame.at(x, y, synthesized) > 0.5f ? 1 : 0;
+      lit += frame.at(x, y, 0) > 0.01f ? 1 : 0;
+    }
+  EXPECT_GT(filled, 3000); // what the short box covered
+  EXPECT_GT(lit, 30000);   // the new lamp lights the room
+
+  // Bad remodel input, on the same folder: a clear error naming it, exit 2, nothing written.
+  auto refused = [&](const json& bad, const std::string& mention) {
+    std::ofstream(path("e.json")) << bad.dump();
+    const auto result = runObscura("remodel " + path("out") + " --edits " + path("e.json") + " -o " + path("x.exr"));
+    EXPECT_EQ(result.exitCode, 2) << result.output;
+    EXPECT_CONTAINS(result.output, mention);
+    EXPECT_FALSE(fs::exists(path("x.exr")));
+  };
+  refused(json::array({{{"move", "cube_1"}, {"translate", {0, 0, 0.1}}}}), "moving a photographed object");
+  refused(json::array({{{"remove", "sofa"}}}), "sofa");
+  refused(json::array({{{"light", "shot0"}, {"scale", 0}}, {{"light", "shot1"}, {"scale", 0}}}), "no lamp is left on");
+  refused(json::array({{{"add_light", {{"type", "point"}, {"name", "lamp"}, {"position", {0.33, 0.3, 0.37}},
+                                       {"color", {1, 1, 1}}, {"intensity", 1}}}}}),
+          "inside geometry");
+  fs::create_directories(path("notrecovered"));
+  const auto notRecovered = runObscura("remodel " + path("notrecovered") + " --edits " + path("e.json") + " -o " + path("x.exr"));
+  EXPECT_EQ(notRecovered.exitCode, 2) << notRecovered.output;
+  EXPECT_CONTAINS(notRecovered.output, "recover.json: missing");
 }
 
 TEST_F(CliRecover, PhotosOfDifferentSizesAreRefusedNamingTheImage) {

@@ -10,47 +10,14 @@
 // what we measure, 10 times the spread over seeds 1-4 (lit 0.0167 .. 0.0170, all 0.0241 .. 0.0250).
 #include <gtest/gtest.h>
 
-#include "app/scene_setup.h"
-#include "gpu_test.h"
-#include "recover/photo_set.h"
-#include "recover/recovery_accuracy.h"
-#include "recover/reflectance_recovery.h"
+#include "recover_cornell_fixture.h"
 
 namespace obscura::test {
 namespace {
 using namespace obscura::recover;
 
-class RecoverCornell : public GpuTest {
-protected:
-  static void SetUpTestSuite() {
-    room_ = new app::LoadedScene(app::loadScene(sharedScene("cornell-box/cornell-box.gltf")));
-    photos_ = new PhotoSet(readPhotoSet(sharedScene("../photos/cornell-box/lights.json")));
-    int w = 0, h = 0;
-    truth_ = new std::vector<glm::vec3>(readRadiance(sharedScene("../photos/cornell-box/albedo.exr"), 1.0f, w, h));
-  }
-  static void TearDownTestSuite() {
-    delete room_;
-    delete photos_;
-    delete truth_;
-  }
-  static RecoveryOptions options() {
-    RecoveryOptions o;
-    o.spp = 4;
-    return o;
-  }
-  Recovery recover(const RecoveryOptions& o, const PhotoSet& photos) {
-    return recoverReflectance(context(), room_->scene, room_->bvh, room_->scene.cameras.at(0), photos, o);
-  }
-  static RecoveryAccuracy accuracy(const Recovery& r) {
-    return recoveryAccuracy(r.reflectance, *truth_, lightRegions(r.visibility, r.object));
-  }
-  static inline app::LoadedScene* room_ = nullptr;
-  static inline PhotoSet* photos_ = nullptr;
-  static inline std::vector<glm::vec3>* truth_ = nullptr;
-};
-
 TEST_F(RecoverCornell, GatheredIndirectLightMeetsTheGoalsAndConverges) {
-  const Recovery r = recover(options(), *photos_);
+  const Recovery& r = standardRecovery();
   const RecoveryAccuracy a = accuracy(r);
   EXPECT_LE(a.lit.rmse, 0.02) << "lit pixels";
   EXPECT_LE(a.all.rmse, 0.04) << "all pixels";
@@ -74,7 +41,7 @@ TEST_F(RecoverCornell, GatheredIndirectLightBeatsThePapersConstantAmbient) {
   RecoveryOptions constant = options();
   constant.indirect = IndirectModel::Constant;
   const RecoveryAccuracy c = accuracy(recover(constant, *photos_));
-  const RecoveryAccuracy g = accuracy(recover(options(), *photos_));
+  const RecoveryAccuracy g = accuracy(standardRecovery());
   EXPECT_LT(g.lit.rmse, 0.5 * c.lit.rmse);
   EXPECT_LT(g.all.rmse, 0.5 * c.all.rmse);
 }
@@ -85,7 +52,7 @@ TEST_F(RecoverCornell, MinFilterKeepsShadowedEstimatesOutOfTheMerge) {
   RecoveryOptions noMin = options();
   noMin.filters.minFilter = false;
   const RecoveryAccuracy without = accuracy(recover(noMin, *photos_));
-  const RecoveryAccuracy with = accuracy(recover(options(), *photos_));
+  const RecoveryAccuracy with = accuracy(standardRecovery());
   EXPECT_LT(with.all.rmse, 0.8 * without.all.rmse);
 }
 
