@@ -26,6 +26,7 @@
 #include "bench/embree_frame.h"
 #endif
 #include "bench/cpu_time.h"
+#include "bench/lane_order.h"
 #include "bench/pass_bench.h"
 #include "bench/ray_tracer.h"
 #include "render/passes/primary_pass.h"
@@ -47,6 +48,7 @@ struct BenchOptions {
   bool refit = false; // ...and refit the BVH instead of rebuilding it
   std::string passes;              // WxH: the paper's budget rendered, per pass
   std::vector<std::string> frames; // WxH each: the obscurance-only frame, Obscura against Embree
+  std::string lanes;               // WxH: lane utilisation of that frame's rays in several orders
   render::ObscuranceFrameWork frameWork; // its spp, rays per hit, dmax, seed
   DeviceOptions device;
 };
@@ -290,6 +292,8 @@ void runBench(const BenchOptions& o) {
     throw InputError("--frame compares Obscura with Embree on the same frame: add --baseline embree");
   std::optional<glm::uvec2> passesSize;
   if (!o.passes.empty()) passesSize = parseSize(o.passes, "--passes");
+  std::optional<glm::uvec2> lanesSize;
+  if (!o.lanes.empty()) lanesSize = parseSize(o.lanes, "--lanes");
   std::vector<glm::uvec2> frameSizes;
   for (const auto& f : o.frames) frameSizes.push_back(parseSize(f, "--frame"));
   if (!(std::isfinite(o.frameWork.dMax) && o.frameWork.dMax > 0.0f))
@@ -317,6 +321,15 @@ void runBench(const BenchOptions& o) {
                                                               passesSize->y, o.repeats)};
   std::vector<FrameRun> frames;
   for (glm::uvec2 size : frameSizes) frames.push_back(runFrame(o, context, loaded, camera, size));
+  std::vector<render::LaneOrderFigures> lanes;
+  if (lanesSize) {
+    render::ObscuranceFrameWork work = o.frameWork;
+    work.width = lanesSize->x;
+    work.height = lanesSize->y;
+    work.camera = render::gpuCamera(camera, work.width, work.height);
+    work.sceneScale = render::sceneScale(loaded.scene.bounds);
+    lanes = render::measureLaneOrders(tracer, loaded.scene, work, o.repeats);
+  }
   std::uint32_t truncated = buffers.truncatedTraversals();
   if (truncated > 0) throw DeviceError(fmt::format("{} traversals ran out of steps", truncated));
   if (closest.bestMs <= 0.0) throw DeviceError("the device has no timestamps; cannot time the traversal");
@@ -366,6 +379,9 @@ void runBench(const BenchOptions& o) {
     }
     if (passes) j["passes"] = passesJson(*passes, closestMrays, shadowMrays);
     for (const FrameRun& f : frames) j["frames"].push_back(frameJson(o, f));
+    for (const auto& l : lanes)
+      j["lanes"].push_back({{"order", l.name}, {"rays", l.rays}, {"mean_steps", l.meanSteps},
+                            {"group_steps", l.groupSteps}, {"utilisation", l.utilisation()}, {"gpu_ms", l.gpuMs}});
     fmt::print("{}\n", j.dump());
   } else {
     fmt::print("closest hit (a): {:8.2f} Mrays/s (best of {}, median {:.2f}), hit fraction {:.3f}, {:.1f} steps/ray "
@@ -392,6 +408,14 @@ void runBench(const BenchOptions& o) {
     }
     if (passes) printPasses(*passes, closestMrays, shadowMrays);
     for (const FrameRun& f : frames) printFrame(o, f);
+    if (lanesSize)
+      fmt::print("lanes: sample 0 of the obscurance-only frame at {}x{}, traced by trace.comp in each order\n",
+                 lanesSize->x, lanesSize->y);
+    for (const auto& l : lanes)
+      fmt::print("  {:<52} {:>9} rays {:6.2f} steps/ray {:6.2f} per group  utilisation {:5.1f} %  {:8.1f} ms "
+                 "({:.2f} Mrays/s)\n",
+                 l.name, l.rays, l.meanSteps, l.groupSteps, 100.0 * l.utilisation(), l.gpuMs,
+                 static_cast<double>(l.rays) / (l.gpuMs * 1e3));
   }
   if (baselineDisagrees) throw DeviceError("the baseline's hit fractions differ from ours by more than 0.1%");
   if (closest.mismatches + shadow.mismatches > 0) throw DeviceError("GPU traversal disagrees with the CPU reference");
@@ -419,6 +443,9 @@ void addBenchRaysCommand(CLI::App& app) {
   cmd->add_option("--frame", o->frames,
                   "WxH (repeatable): also trace the obscurance-only frame at this size with Obscura and with Embree "
                   "(needs --baseline embree) and print the ratio");
+  cmd->add_option("--lanes", o->lanes,
+                  "WxH: lane utilisation (loop passes per ray over those per 8-lane group) of the obscurance-only "
+                  "frame's rays at this size, in the passes' order and coherent ones");
   cmd->add_option("--frame-spp", o->frameWork.spp, "--frame: samples per pixel")->check(CLI::Range(1u, 1024u));
   cmd->add_option("--frame-rays", o->frameWork.obscuranceRays, "--frame: obscurance rays per hit")
       ->check(CLI::Range(1u, 256u));
