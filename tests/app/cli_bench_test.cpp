@@ -24,7 +24,7 @@ nlohmann::json lastJsonLine(const std::string& output) {
 TEST_F(CliBench, PassesAndFrameFiguresArePositiveAndConsistent) {
   const auto r = runObscura("bench-rays " + cornellBox() +
                             " --rays 4096 --repeats 1 --verify 512 --json --passes 24x24 --frame 20x16 --frame-dmax 0.5"
-                            " --frame-spp 4 --baseline embree");
+                            " --frame-spp 4 --lanes 32x24 --baseline embree");
 #ifndef OBSCURA_HAVE_EMBREE
   EXPECT_NE(r.exitCode, 0);
   EXPECT_CONTAINS(r.output, "without Embree");
@@ -88,6 +88,20 @@ TEST_F(CliBench, PassesAndFrameFiguresArePositiveAndConsistent) {
   EXPECT_GT(wOurs, 0.05);
   EXPECT_LT(wOurs, 0.95);
   EXPECT_NEAR(wOurs, f.at("embree_mean_obscurance").get<double>(), 0.005);
+
+  // --lanes: the same rays in every order (camera: 32 x 24; obscurance: equal across orders), a
+  // group's longest ray at least its mean, so utilisation in (0, 1].
+  const nlohmann::json& lanes = j.at("lanes");
+  ASSERT_EQ(lanes.size(), 6u);
+  EXPECT_EQ(lanes.at(0).at("rays").get<std::uint64_t>(), 768u);
+  EXPECT_EQ(lanes.at(1).at("rays").get<std::uint64_t>(), 768u);
+  for (std::size_t k = 2; k < lanes.size(); ++k)
+    EXPECT_EQ(lanes.at(k).at("rays"), lanes.at(2).at("rays")) << lanes.at(k).at("order");
+  for (const auto& l : lanes) {
+    EXPECT_GT(l.at("mean_steps").get<double>(), 0.0) << l.at("order");
+    EXPECT_GT(l.at("utilisation").get<double>(), 0.0) << l.at("order");
+    EXPECT_LE(l.at("utilisation").get<double>(), 1.0) << l.at("order");
+  }
 #endif
 }
 
