@@ -2,10 +2,13 @@
 // the GPU path with reproducible rays (see bench/bench_rays.h), so other ray tracers can shoot the
 // same ones. --baseline embree traces the same rays with Embree 3 in the same process (when built
 // with it) and reports the ratio, which machine load affects on both sides alike.
+// --passes WxH adds a real render of the paper's budget: each pass's rays per second (the
+// renderer's counters and GPU timestamps) beside the rate of its kind of ray above, and the
+// frame's wall and GPU time. --frame WxH (repeatable) adds the obscurance-only frame traced by
+// Obscura and by Embree in the same process (bench/pass_bench.h, bench/embree_frame.h).
 #include <cstdio>
 #include <cmath>
 #include <optional>
-#include <sys/resource.h>
 #include <algorithm>
 #include <vector>
 
@@ -20,9 +23,14 @@
 #include "bench/bench_rays.h"
 #ifdef OBSCURA_HAVE_EMBREE
 #include "bench/embree_baseline.h"
+#include "bench/embree_frame.h"
 #endif
+#include "bench/cpu_time.h"
+#include "bench/lane_order.h"
+#include "bench/pass_bench.h"
 #include "bench/ray_tracer.h"
-#include "render/scene/scene_buffers.h"
+#include "render/passes/primary_pass.h"
+#include "app/render_options.h"
 
 namespace obscura::app {
 namespace {
@@ -38,8 +46,21 @@ struct BenchOptions {
   std::string baseline;
   std::string move;   // OBJECT=dx,dy,dz: move an object first (what a remodelling edit does)
   bool refit = false; // ...and refit the BVH instead of rebuilding it
+  std::string passes;              // WxH: the paper's budget rendered, per pass
+  std::vector<std::string> frames; // WxH each: the obscurance-only frame, Obscura against Embree
+  std::string lanes;               // WxH: lane utilisation of that frame's rays in several orders
+  render::ObscuranceFrameWork frameWork; // its spp, rays per hit, dmax, seed
   DeviceOptions device;
 };
+
+// "800x600" -> {800, 600}; InputError naming the option otherwise.
+glm::uvec2 parseSize(const std::string& text, const char* option) {
+  unsigned w = 0, h = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%ux%u%c", &w, &h, &tail) != 2 || w == 0 || h == 0 || w > 16384 || h > 16384)
+    throw InputError(fmt::format("{} {}: expected WIDTHxHEIGHT, e.g. 800x600 (1 to 16384 each)", option, text));
+  return {w, h};
+}
 
 // Applies --move to the loaded scene and updates its BVH by refit or rebuild (traversal cost
 // after an edit: a refit keeps the old topology, docs/BENCHMARKS.md).
@@ -52,15 +73,6 @@ void applyMove(const BenchOptions& o, LoadedScene& loaded) {
   scene::moveObject(loaded.scene, object, d, glm::vec3(0.0f));
   if (o.refit) bvh::refit(loaded.bvh, render::triangleSoup(loaded.scene));
   else loaded.bvh = bvh::build(render::triangleSoup(loaded.scene));
-}
-
-// CPU time of the whole process (all threads), in ms. On lavapipe the "GPU" is this process's
-// threads, so the CPU time of a trace is a measure that other load on the machine hardly affects.
-double processCpuMs() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  auto ms = [](const timeval& t) { return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_usec) * 1e-3; };
-  return ms(u.ru_utime) + ms(u.ru_stime);
 }
 
 struct SetResult {
@@ -97,9 +109,9 @@ SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std
   r.meanGroupMaxSteps = rays.empty() ? 0.0 : groupMax / static_cast<double>((rays.size() + kLanes - 1) / kLanes);
   std::vector<double> times, cpuMs;
   for (int k = 0; k < o.repeats; ++k) {
-    double c0 = processCpuMs();
+    double c0 = render::processCpuMs();
     times.push_back(tracer.trace(rays, mode).gpuMs);
-    cpuMs.push_back(processCpuMs() - c0);
+    cpuMs.push_back(render::processCpuMs() - c0);
   }
   r.bestCpuMs = *std::min_element(cpuMs.begin(), cpuMs.end());
   std::sort(times.begin(), times.end());
@@ -152,6 +164,123 @@ std::optional<Baseline> runBaseline(const BenchOptions& o, const LoadedScene& lo
 #endif
 }
 
+// --passes: the paper's budget rendered at one size, each pass beside the bench-rays rate of the
+// kind of ray it traces (primary, obscurance and specular rays: closest hit; shadow rays: any hit).
+struct PassesRun {
+  glm::uvec2 size{0};
+  render::RenderStats stats;
+};
+
+const char* benchKindOf(const std::string& pass) { return pass == "shadow" ? "shadow" : "closest"; }
+
+// --frame: one size of the obscurance-only frame, by Obscura and by Embree.
+struct FrameRun {
+  glm::uvec2 size{0};
+  render::ObscuraFrameResult ours;
+  render::EmbreeFrameResult embree;
+};
+
+double meanOf(const std::vector<float>& values) {
+  double sum = 0.0;
+  for (float v : values) sum += v;
+  return values.empty() ? 0.0 : sum / static_cast<double>(values.size());
+}
+
+FrameRun runFrame(const BenchOptions& o, const gpu::Context& context, const LoadedScene& loaded,
+                  const scene::Camera& camera, glm::uvec2 size) {
+  FrameRun run;
+  run.size = size;
+  render::ObscuranceFrameWork work = o.frameWork;
+  work.width = size.x;
+  work.height = size.y;
+  work.camera = render::gpuCamera(camera, size.x, size.y);
+  work.sceneScale = render::sceneScale(loaded.scene.bounds);
+  run.ours = render::runObscuraFrame(context, loaded.scene, loaded.bvh, camera, work, o.repeats);
+#ifdef OBSCURA_HAVE_EMBREE
+  run.embree = render::runEmbreeFrame(loaded.scene, work, o.repeats);
+#endif
+  // The same work on both sides: every camera ray, and N_obs rays per hit (the hits may differ at
+  // a few silhouette pixels: Embree's triangle test is not watertight, ours is).
+  if (run.ours.primaryRays != run.embree.primaryRays)
+    throw DeviceError(fmt::format("--frame {}x{}: {} camera rays traced by Obscura, {} by Embree", size.x, size.y,
+                                  run.ours.primaryRays, run.embree.primaryRays));
+  const double a = static_cast<double>(run.ours.obscuranceRays), b = static_cast<double>(run.embree.obscuranceRays);
+  if (std::abs(a - b) > 1e-2 * std::max(a, b))
+    throw DeviceError(fmt::format("--frame {}x{}: {} obscurance rays by Obscura, {} by Embree (more than 1% apart)",
+                                  size.x, size.y, run.ours.obscuranceRays, run.embree.obscuranceRays));
+  return run;
+}
+
+nlohmann::json passesJson(const PassesRun& p, double closestMrays, double shadowMrays) {
+  nlohmann::json passes = nlohmann::json::object();
+  for (const auto& [name, pass] : p.stats.passes) {
+    nlohmann::json j = {{"gpu_ms", pass.gpuMs}, {"rays", pass.rays}};
+    if (pass.rays > 0 && pass.gpuMs > 0.0) {
+      const double mrays = static_cast<double>(pass.rays) / (pass.gpuMs * 1e3);
+      const char* kind = benchKindOf(name);
+      j["mrays_per_s"] = mrays;
+      j["bench_rays_kind"] = kind;
+      j["ratio_vs_bench_rays"] = mrays / (std::string(kind) == "shadow" ? shadowMrays : closestMrays);
+    }
+    passes[name] = j;
+  }
+  return {{"width", p.size.x}, {"height", p.size.y}, {"wall_s", p.stats.wallSeconds},
+          {"gpu_ms", render::totalGpuMs(p.stats)}, {"per_pass", passes}};
+}
+
+nlohmann::json frameJson(const BenchOptions& o, const FrameRun& f) {
+  return {{"width", f.size.x}, {"height", f.size.y}, {"spp", o.frameWork.spp},
+          {"obscurance_rays_per_hit", o.frameWork.obscuranceRays}, {"dmax", o.frameWork.dMax},
+          {"obscura_gpu_ms", f.ours.bestMs}, {"obscura_median_gpu_ms", f.ours.medianMs},
+          {"obscura_primary_ms", f.ours.bestPrimaryMs}, {"obscura_obscurance_ms", f.ours.bestObscuranceMs},
+          {"obscura_cpu_ms", f.ours.bestCpuMs},
+          {"obscura_primary_rays", f.ours.primaryRays}, {"obscura_obscurance_rays", f.ours.obscuranceRays},
+          {"obscura_mean_obscurance", meanOf(f.ours.obscurance)},
+          {"embree_threads", f.embree.threads}, {"embree_ms", f.embree.bestMs},
+          {"embree_median_ms", f.embree.medianMs}, {"embree_cpu_ms", f.embree.bestCpuMs},
+          {"embree_primary_rays", f.embree.primaryRays}, {"embree_obscurance_rays", f.embree.obscuranceRays},
+          {"embree_obscurance_rays_traced", f.embree.obscuranceRaysTraced},
+          {"embree_mean_obscurance", meanOf(f.embree.obscurance)},
+          {"ratio_vs_embree", f.embree.bestMs / f.ours.bestMs},
+          {"cpu_ratio_vs_embree", f.embree.bestCpuMs / f.ours.bestCpuMs}};
+}
+
+void printPasses(const PassesRun& p, double closestMrays, double shadowMrays) {
+  const render::ObscuranceSettings budget; // the paper's budget is the defaults
+  fmt::print("passes: the paper's budget at {}x{} ({} spp, {} shadow + {} obscurance rays per hit), best repeat by GPU "
+             "time: wall {:.2f} s, GPU {:.0f} ms\n",
+             p.size.x, p.size.y, budget.spp, budget.shadowRays, budget.obscuranceRays, p.stats.wallSeconds,
+             render::totalGpuMs(p.stats));
+  fmt::print("  {:<12} {:>10} {:>12} {:>9}   {}\n", "pass", "GPU ms", "rays", "Mrays/s",
+             "/ bench-rays rate of its kind (goal >= 0.77, i.e. within 1.3x)");
+  for (const auto& [name, pass] : p.stats.passes) {
+    if (pass.rays == 0 || pass.gpuMs <= 0.0) {
+      fmt::print("  {:<12} {:>10.1f}\n", name, pass.gpuMs);
+      continue;
+    }
+    const double mrays = static_cast<double>(pass.rays) / (pass.gpuMs * 1e3);
+    const std::string kind = benchKindOf(name);
+    fmt::print("  {:<12} {:>10.1f} {:>12} {:>9.2f}   {:.2f} of {} ({:.2f} Mrays/s)\n", name, pass.gpuMs, pass.rays,
+               mrays, mrays / (kind == "shadow" ? shadowMrays : closestMrays), kind,
+               kind == "shadow" ? shadowMrays : closestMrays);
+  }
+}
+
+void printFrame(const BenchOptions& o, const FrameRun& f) {
+  fmt::print("frame {}x{}: obscurance only, {} spp x {} rays, dmax {} (best of {})\n", f.size.x, f.size.y,
+             o.frameWork.spp, o.frameWork.obscuranceRays, o.frameWork.dMax, o.repeats);
+  fmt::print("  obscura: primary {:.1f} ms + obscurance {:.1f} ms = {:.1f} ms GPU (process CPU {:.0f} ms); {} camera + "
+             "{} obscurance rays, mean W {:.4f}\n",
+             f.ours.bestPrimaryMs, f.ours.bestObscuranceMs, f.ours.bestMs, f.ours.bestCpuMs, f.ours.primaryRays,
+             f.ours.obscuranceRays, meanOf(f.ours.obscurance));
+  fmt::print("  embree {} threads: {:.1f} ms (process CPU {:.0f} ms); {} camera + {} obscurance rays ({} traced), "
+             "mean W {:.4f}\n",
+             f.embree.threads, f.embree.bestMs, f.embree.bestCpuMs, f.embree.primaryRays, f.embree.obscuranceRays,
+             f.embree.obscuranceRaysTraced, meanOf(f.embree.obscurance));
+  fmt::print("  ours / embree = {:.3f} (by CPU time {:.3f})\n", f.embree.bestMs / f.ours.bestMs,
+             f.embree.bestCpuMs / f.ours.bestCpuMs);
+}
+
 void runBench(const BenchOptions& o) {
   if (o.rays == 0) throw InputError("--rays must be at least 1");
 #ifndef OBSCURA_HAVE_EMBREE
@@ -159,6 +288,16 @@ void runBench(const BenchOptions& o) {
     throw InputError("--baseline embree: this obscura was built without Embree 3 "
                      "(install libembree-dev, e.g. tools/setup.sh, and re-run CMake)");
 #endif
+  if (!o.frames.empty() && o.baseline != "embree")
+    throw InputError("--frame compares Obscura with Embree on the same frame: add --baseline embree");
+  std::optional<glm::uvec2> passesSize;
+  if (!o.passes.empty()) passesSize = parseSize(o.passes, "--passes");
+  std::optional<glm::uvec2> lanesSize;
+  if (!o.lanes.empty()) lanesSize = parseSize(o.lanes, "--lanes");
+  std::vector<glm::uvec2> frameSizes;
+  for (const auto& f : o.frames) frameSizes.push_back(parseSize(f, "--frame"));
+  if (!(std::isfinite(o.frameWork.dMax) && o.frameWork.dMax > 0.0f))
+    throw InputError(fmt::format("--frame-dmax {}: must be a finite positive distance in scene units", o.frameWork.dMax));
   LoadedScene loaded = loadScene(o.scenePath);
   if (!o.move.empty()) applyMove(o, loaded);
   gpu::Context context(o.device.contextOptions());
@@ -175,6 +314,22 @@ void runBench(const BenchOptions& o) {
   SetResult closest = runSet(tracer, loaded, closestRays, render::TraceMode::Closest, o);
   SetResult shadow = runSet(tracer, loaded, shadowRays, render::TraceMode::Any, o);
   std::optional<Baseline> base = runBaseline(o, loaded, closestRays, shadowRays);
+  const scene::Camera camera = chooseCamera(loaded.scene, -1);
+  std::optional<PassesRun> passes;
+  if (passesSize)
+    passes = PassesRun{*passesSize, render::renderPaperBudget(context, loaded.scene, loaded.bvh, camera, passesSize->x,
+                                                              passesSize->y, o.repeats)};
+  std::vector<FrameRun> frames;
+  for (glm::uvec2 size : frameSizes) frames.push_back(runFrame(o, context, loaded, camera, size));
+  std::vector<render::LaneOrderFigures> lanes;
+  if (lanesSize) {
+    render::ObscuranceFrameWork work = o.frameWork;
+    work.width = lanesSize->x;
+    work.height = lanesSize->y;
+    work.camera = render::gpuCamera(camera, work.width, work.height);
+    work.sceneScale = render::sceneScale(loaded.scene.bounds);
+    lanes = render::measureLaneOrders(tracer, loaded.scene, work, o.repeats);
+  }
   std::uint32_t truncated = buffers.truncatedTraversals();
   if (truncated > 0) throw DeviceError(fmt::format("{} traversals ran out of steps", truncated));
   if (closest.bestMs <= 0.0) throw DeviceError("the device has no timestamps; cannot time the traversal");
@@ -222,6 +377,11 @@ void runBench(const BenchOptions& o) {
       j["closest_cpu_ratio_vs_embree"] = base->closestCpuMs / closest.bestCpuMs;
       j["shadow_cpu_ratio_vs_embree"] = base->shadowCpuMs / shadow.bestCpuMs;
     }
+    if (passes) j["passes"] = passesJson(*passes, closestMrays, shadowMrays);
+    for (const FrameRun& f : frames) j["frames"].push_back(frameJson(o, f));
+    for (const auto& l : lanes)
+      j["lanes"].push_back({{"order", l.name}, {"rays", l.rays}, {"mean_steps", l.meanSteps},
+                            {"group_steps", l.groupSteps}, {"utilisation", l.utilisation()}, {"gpu_ms", l.gpuMs}});
     fmt::print("{}\n", j.dump());
   } else {
     fmt::print("closest hit (a): {:8.2f} Mrays/s (best of {}, median {:.2f}), hit fraction {:.3f}, {:.1f} steps/ray "
@@ -246,6 +406,16 @@ void runBench(const BenchOptions& o) {
                  base->shadowMrays, base->shadowOccludedFraction, shadowMrays / base->shadowMrays,
                  base->shadowCpuMs / shadow.bestCpuMs);
     }
+    if (passes) printPasses(*passes, closestMrays, shadowMrays);
+    for (const FrameRun& f : frames) printFrame(o, f);
+    if (lanesSize)
+      fmt::print("lanes: sample 0 of the obscurance-only frame at {}x{}, traced by trace.comp in each order\n",
+                 lanesSize->x, lanesSize->y);
+    for (const auto& l : lanes)
+      fmt::print("  {:<52} {:>9} rays {:6.2f} steps/ray {:6.2f} per group  utilisation {:5.1f} %  {:8.1f} ms "
+                 "({:.2f} Mrays/s)\n",
+                 l.name, l.rays, l.meanSteps, l.groupSteps, 100.0 * l.utilisation(), l.gpuMs,
+                 static_cast<double>(l.rays) / (l.gpuMs * 1e3));
   }
   if (baselineDisagrees) throw DeviceError("the baseline's hit fractions differ from ours by more than 0.1%");
   if (closest.mismatches + shadow.mismatches > 0) throw DeviceError("GPU traversal disagrees with the CPU reference");
@@ -267,6 +437,19 @@ void addBenchRaysCommand(CLI::App& app) {
   cmd->add_flag("--json", o->json, "print one JSON line");
   cmd->add_option("--move", o->move, "OBJECT=dx,dy,dz: move an object first, then rebuild the BVH (or --refit)");
   cmd->add_flag("--refit", o->refit, "with --move: refit the BVH (the topology of before the move) instead of a rebuild");
+  cmd->add_option("--passes", o->passes,
+                  "WxH: also render the paper's budget at this size and print each pass's rays per second beside "
+                  "the rate of its kind of ray");
+  cmd->add_option("--frame", o->frames,
+                  "WxH (repeatable): also trace the obscurance-only frame at this size with Obscura and with Embree "
+                  "(needs --baseline embree) and print the ratio");
+  cmd->add_option("--lanes", o->lanes,
+                  "WxH: lane utilisation (loop passes per ray over those per 8-lane group) of the obscurance-only "
+                  "frame's rays at this size, in the passes' order and coherent ones");
+  cmd->add_option("--frame-spp", o->frameWork.spp, "--frame: samples per pixel")->check(CLI::Range(1u, 1024u));
+  cmd->add_option("--frame-rays", o->frameWork.obscuranceRays, "--frame: obscurance rays per hit")
+      ->check(CLI::Range(1u, 256u));
+  cmd->add_option("--frame-dmax", o->frameWork.dMax, "--frame: dmax in scene units");
   addDeviceOptions(*cmd, o->device);
   cmd->callback([o] { runBench(*o); });
 }

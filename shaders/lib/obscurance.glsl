@@ -5,6 +5,12 @@
 #ifndef OBSCURA_OBSCURANCE_GLSL
 #define OBSCURA_OBSCURANCE_GLSL
 
+// The variant of a kernel that gathers the secondary reflectors' light (kSpecConstantReflectors):
+// without it the reflectors' branch, with a light sample and a second traversal inlined, is not
+// compiled in at all; lavapipe's register allocation over the whole shader made the obscurance
+// rays' traversal loop 1.7x slower with it present but never taken.
+layout(constant_id = kSpecConstantReflectors) const bool kReflectors = false;
+
 // rho(d) for d < dMax; rho = 1 from dMax on (a miss within dMax).
 float rho(float d, float dMax, uint kind, float tau) {
   float x = clamp(d / dMax, 0.0, 1.0);
@@ -55,7 +61,7 @@ vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, 
   const uint n = pc.counts.z;
   const bool systematic = (pc.counts.w & kFlagSystematic) != 0u;
   const bool bleed = (pc.counts.w & kFlagBleed) != 0u;
-  const bool reflectors = reflectorPixel != kInvalidIndex && (pc.counts.w & kFlagSecondaryReflectors) != 0u;
+  const bool reflectors = kReflectors && reflectorPixel != kInvalidIndex && (pc.counts.w & kFlagSecondaryReflectors) != 0u;
   const float dMax = pc.params.x;
   const uint rhoKind = uint(pc.params.z);
   uvec2 grid = systematicGrid(n);

@@ -273,6 +273,11 @@ OBS_CONST uint kShadeFlagProbe = 8u;
 // The specialisation constant (a bool) that makes a shading kernel its probing variant (kProbe,
 // lib/probe.glsl); kShadeFlagProbe dispatches go to that kernel.
 OBS_CONST uint kSpecConstantProbe = 0u;
+// The specialisation constant (a bool) that compiles the secondary reflectors' light samples into
+// gatherObscurance (kReflectors, lib/obscurance.glsl); kFlagSecondaryReflectors dispatches of the
+// obscurance pass go to that variant. Left out, the branch costs the pass 40 % of its time on
+// lavapipe even when no ray takes it (docs/BENCHMARKS.md, issue 10).
+OBS_CONST uint kSpecConstantReflectors = 1u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

@@ -1,7 +1,9 @@
 // pixel_shading_pass.h — a shading pass with one invocation per pixel of a band: the base of the
 // shadow and obscurance passes (which differ only in their shader).
 #pragma once
+#include <memory>
 #include <span>
+#include <stdexcept>
 
 #include "render/passes/shading_inputs.h"
 
@@ -9,13 +11,19 @@ namespace obscura::render {
 
 class PixelShadingPass {
 public:
+  // `reflectorVariant`: the shader gathers the secondary reflectors' light when specialised for
+  // it (kSpecConstantReflectors, lib/obscurance.glsl): a third kernel takes the dispatches with
+  // kFlagSecondaryReflectors, and the other two leave that code out.
   PixelShadingPass(const gpu::Context& context, const char* name, std::span<const std::uint32_t> spirv,
-                   std::uint32_t bands)
-      : kernel_(context, shadingKernelDesc(name, spirv, bands)), probe_(context, probingKernelDesc(name, spirv, bands)) {}
+                   std::uint32_t bands, bool reflectorVariant = false)
+      : kernel_(context, shadingKernelDesc(name, spirv, bands)), probe_(context, probingKernelDesc(name, spirv, bands)),
+        reflectors_(reflectorVariant ? std::make_unique<gpu::Kernel>(context, reflectorKernelDesc(name, spirv, bands))
+                                     : nullptr) {}
 
   void bind(std::uint32_t band, const ShadingInputs& in) {
     bindShadingInputs(kernel_, band, in);
     bindShadingInputs(probe_, band, in);
+    if (reflectors_) bindShadingInputs(*reflectors_, band, in);
   }
 
   // Every pixel of the band; or, with `dirtyOf` (and kShadeFlagDirtyOnly in the push), only the
@@ -24,7 +32,12 @@ public:
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
               const gpu::ShadePush& push, const ObscuranceFrame* dirtyOf = nullptr) const {
     const gpu::ShadePush p = forBand(push, layout, band);
-    const gpu::Kernel& kernel = (push.band.z & gpu::kShadeFlagProbe) != 0 ? probe_ : kernel_;
+    const bool probe = (push.band.z & gpu::kShadeFlagProbe) != 0;
+    const bool reflectors = reflectors_ && (push.counts.w & gpu::kFlagSecondaryReflectors) != 0;
+    // A geometry edit retraces every pixel while the reflectors are on (they are marked anew), so
+    // nothing probes with them; the probing kernel has no reflectors' code.
+    if (probe && reflectors) throw std::logic_error("PixelShadingPass: no probing variant with secondary reflectors");
+    const gpu::Kernel& kernel = probe ? probe_ : reflectors ? *reflectors_ : kernel_;
     if (dirtyOf != nullptr) {
       kernel.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &p, band);
       return;
@@ -36,6 +49,7 @@ public:
 private:
   gpu::Kernel kernel_;
   gpu::Kernel probe_;
+  std::unique_ptr<gpu::Kernel> reflectors_;
 };
 
 } // namespace obscura::render

@@ -16,6 +16,13 @@ gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_
   return desc;
 }
 
+gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
+  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
+  desc.name += ".reflectors";
+  desc.specConstants.push_back({.id = gpu::kSpecConstantReflectors, .value = 1u});
+  return desc;
+}
+
 void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInputs& in) {
   in.scene.bindTo(kernel, band, &in.frame.status());
   const auto& b = in.frame.band(band);

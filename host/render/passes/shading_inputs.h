@@ -26,6 +26,8 @@ struct ShadingInputs {
 gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
 // The same shader's probing variant (kSpecConstantProbe, lib/probe.glsl): "<name>.probe".
 gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+// The variant with the secondary reflectors' code (kSpecConstantReflectors): "<name>.reflectors".
+gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
 
 // Binds descriptor set `band` of a shading kernel.
 void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInputs& in);

@@ -1,0 +1,124 @@
+// `obscura bench-rays --passes / --frame` as a smoke test on the Cornell box at a tiny size: the
+// figures it prints are positive and consistent with each other (it is the speed benchmark of
+// issue 10; speed itself is never asserted by a test, docs/BENCHMARKS.md records it).
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "app/cli_runner.h"
+#include "gpu_test.h"
+
+namespace obscura::test {
+namespace {
+
+using CliBench = CliTest;
+
+// The last line of the output: --json prints one line (warnings may come before it).
+nlohmann::json lastJsonLine(const std::string& output) {
+  const auto end = output.find_last_not_of('\n');
+  const auto start = output.rfind('\n', end);
+  return nlohmann::json::parse(output.substr(start == std::string::npos ? 0 : start + 1, end + 1));
+}
+
+TEST_F(CliBench, PassesAndFrameFiguresArePositiveAndConsistent) {
+  const auto r = runObscura("bench-rays " + cornellBox() +
+                            " --rays 4096 --repeats 1 --verify 512 --json --passes 24x24 --frame 20x16 --frame-dmax 0.5"
+                            " --frame-spp 4 --lanes 32x24 --baseline embree");
+#ifndef OBSCURA_HAVE_EMBREE
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_CONTAINS(r.output, "without Embree");
+#else
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const nlohmann::json j = lastJsonLine(r.output);
+
+  // --passes: the paper's budget (8 spp, 5 shadow and 5 obscurance rays per hit) at 24x24.
+  const nlohmann::json& passes = j.at("passes");
+  EXPECT_GT(passes.at("wall_s").get<double>(), 0.0);
+  const nlohmann::json& perPass = passes.at("per_pass");
+  double sumMs = 0.0;
+  for (const char* pass : {"primary", "shadow", "obscurance"}) {
+    const nlohmann::json& p = perPass.at(pass);
+    EXPECT_GT(p.at("gpu_ms").get<double>(), 0.0) << pass;
+    EXPECT_GT(p.at("mrays_per_s").get<double>(), 0.0) << pass;
+    EXPECT_GT(p.at("ratio_vs_bench_rays").get<double>(), 0.0) << pass;
+    sumMs += p.at("gpu_ms").get<double>();
+  }
+  EXPECT_GE(passes.at("gpu_ms").get<double>(), sumMs * (1.0 - 1e-9));
+  EXPECT_EQ(perPass.at("primary").at("rays").get<std::uint64_t>(), 24u * 24u * 8u);
+  EXPECT_EQ(perPass.at("shadow").at("bench_rays_kind"), "shadow");
+  EXPECT_EQ(perPass.at("obscurance").at("bench_rays_kind"), "closest");
+  // Each camera ray that hits (the box is open to the camera: not all) takes 5 shadow and 5
+  // obscurance rays.
+  const auto obscuranceRays = perPass.at("obscurance").at("rays").get<std::uint64_t>();
+  EXPECT_EQ(perPass.at("shadow").at("rays").get<std::uint64_t>(), obscuranceRays);
+  EXPECT_EQ(obscuranceRays % 5u, 0u);
+  EXPECT_GT(obscuranceRays, 24u * 24u * 8u * 5u / 2u);
+  EXPECT_LE(obscuranceRays, 24u * 24u * 8u * 5u);
+  // The ratio is the pass's rate over bench-rays' rate of its kind, printed in the same run.
+  const nlohmann::json& shadow = perPass.at("shadow");
+  EXPECT_NEAR(shadow.at("ratio_vs_bench_rays").get<double>(),
+              shadow.at("mrays_per_s").get<double>() / j.at("shadow_mrays_per_s").get<double>(), 1e-9);
+
+  // --frame: the obscurance-only frame by Obscura and by Embree, the same rays on both sides.
+  ASSERT_EQ(j.at("frames").size(), 1u);
+  const nlohmann::json& f = j.at("frames").at(0);
+  const std::uint64_t cameraRays = 20u * 16u * 4u;
+  EXPECT_EQ(f.at("obscura_primary_rays").get<std::uint64_t>(), cameraRays);
+  EXPECT_EQ(f.at("embree_primary_rays").get<std::uint64_t>(), cameraRays);
+  // 5 per hit on both sides; the hits are those of the same camera rays (Embree's triangle test is
+  // not watertight, so an edge pixel could differ: 1 % leeway, far below the open front's share).
+  const auto oursRays = f.at("obscura_obscurance_rays").get<std::uint64_t>();
+  EXPECT_GT(oursRays, cameraRays * 5u / 2u);
+  EXPECT_LE(oursRays, cameraRays * 5u);
+  EXPECT_NEAR(static_cast<double>(f.at("embree_obscurance_rays").get<std::uint64_t>()), static_cast<double>(oursRays),
+              0.01 * static_cast<double>(oursRays));
+  for (const char* key : {"obscura_gpu_ms", "obscura_primary_ms", "obscura_obscurance_ms", "embree_ms",
+                          "ratio_vs_embree", "cpu_ratio_vs_embree"})
+    EXPECT_GT(f.at(key).get<double>(), 0.0) << key;
+  EXPECT_NEAR(f.at("obscura_gpu_ms").get<double>(),
+              f.at("obscura_primary_ms").get<double>() + f.at("obscura_obscurance_ms").get<double>(), 1e-6);
+  EXPECT_NEAR(f.at("ratio_vs_embree").get<double>(),
+              f.at("embree_ms").get<double>() / f.at("obscura_gpu_ms").get<double>(), 1e-9);
+  // Both images are W = mean rho(d) over the same rays: the box is flat-shaded, so the shading
+  // normal the GPU samples around is the geometric one Embree gives, and the directions agree up
+  // to float rounding. Only a ray whose hit flips by rounding may differ: 0.005 of W's range
+  // (linear instead of sqrt rho on Embree's side moves the mean by 0.027).
+  const double wOurs = f.at("obscura_mean_obscurance").get<double>();
+  EXPECT_GT(wOurs, 0.05);
+  EXPECT_LT(wOurs, 0.95);
+  EXPECT_NEAR(wOurs, f.at("embree_mean_obscurance").get<double>(), 0.005);
+
+  // --lanes: the same rays in every order (camera: 32 x 24; obscurance: equal across orders), a
+  // group's longest ray at least its mean, so utilisation in (0, 1].
+  const nlohmann::json& lanes = j.at("lanes");
+  ASSERT_EQ(lanes.size(), 6u);
+  EXPECT_EQ(lanes.at(0).at("rays").get<std::uint64_t>(), 768u);
+  EXPECT_EQ(lanes.at(1).at("rays").get<std::uint64_t>(), 768u);
+  for (std::size_t k = 2; k < lanes.size(); ++k)
+    EXPECT_EQ(lanes.at(k).at("rays"), lanes.at(2).at("rays")) << lanes.at(k).at("order");
+  for (const auto& l : lanes) {
+    EXPECT_GT(l.at("mean_steps").get<double>(), 0.0) << l.at("order");
+    EXPECT_GT(l.at("utilisation").get<double>(), 0.0) << l.at("order");
+    EXPECT_LE(l.at("utilisation").get<double>(), 1.0) << l.at("order");
+  }
+#endif
+}
+
+TEST_F(CliBench, BadPassesAndFrameOptionsAreRefusedByName) {
+  auto r = runObscura("bench-rays " + cornellBox() + " --rays 64 --passes 24by24");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_CONTAINS(r.output, "--passes 24by24");
+  r = runObscura("bench-rays " + cornellBox() + " --rays 64 --frame 20x0 --baseline embree");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_CONTAINS(r.output, "--frame 20x0");
+  r = runObscura("bench-rays " + cornellBox() + " --rays 64 --frame 20x16");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_CONTAINS(r.output, "--baseline embree");
+  r = runObscura("bench-rays " + cornellBox() + " --rays 64 --frame 20x16 --frame-dmax -1 --baseline embree");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_CONTAINS(r.output, "--frame-dmax");
+}
+
+} // namespace
+} // namespace obscura::test
