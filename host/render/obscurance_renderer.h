@@ -131,7 +131,8 @@ public:
   // The emission scales E_s compose uses (default: the scene's own). I_a follows them [SPEC §3].
   void setEmissions(const std::vector<glm::vec3>& emissions);
   // Which I_a compose uses (no ray: I_a only weighs the ambient sums). Reached needs a renderer
-  // made with AmbientModel::Reached (its reach was measured); Global is always there.
+  // made with AmbientModel::Reached or Seen (its reach was measured; Seen is fitted on first use);
+  // Global is always there.
   void setAmbientModel(AmbientModel model);
   const std::vector<glm::vec3>& emissions() const { return emissions_; }
   // Composes the AOVs on the GPU with the current emissions, then tonemaps `combined` to the
@@ -203,6 +204,8 @@ private:
   void uploadLights();
   // The Reached ambient model: what every light reaches in `scene` (after a geometry edit too).
   void measureReach(const scene::Scene& scene, const bvh::Bvh& bvh);
+  void measureAllReach(); // every light's reach (and Seen fit) with reached_ as it is, then I_a's weights
+  SeenView seenView() const; // the camera and obscurance settings the Seen fit uses
   // Marks the secondary reflectors from the measured reach (settings_.secondaryReflectors > 0).
   void markReflectors();
   bool reflectorsOn() const { return settings_.secondaryReflectors > 0.0f; }

@@ -116,8 +116,15 @@ float offsetAt(glm::vec3 p, float offset) {
 
 } // namespace
 
+float obscuranceRho(float d, float dMax, std::uint32_t kind, float tau) {
+  const float x = std::clamp(d / dMax, 0.0f, 1.0f);
+  if (kind == gpu::kRhoAo) return x >= 1.0f ? 1.0f : 0.0f;
+  if (kind == gpu::kRhoExp) return (1.0f - std::exp(-tau * x)) / (1.0f - std::exp(-tau));
+  return std::sqrt(x);
+}
+
 ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<glm::vec3>& reflectance)
-    : scene_(&scene), bvh_(bvh), offset_(1e-5f * largestExtent(scene.bounds)) {
+    : scene_(&scene), bvh_(bvh), reflectance_(reflectance), offset_(1e-5f * largestExtent(scene.bounds)) {
   std::vector<double> cdf;
   cdf.reserve(scene.triangles.size());
   for (const auto& t : scene.triangles) {
@@ -158,7 +165,7 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
 
   // 1. Where the light lands: first hits of rays leaving it (the position and the lit side's normal).
   struct Landing {
-    glm::vec3 position, normal;
+    glm::vec3 position, normal, reflectance;
   };
   std::vector<Landing> landings;
   std::map<std::uint32_t, std::uint32_t> landedOn; // triangle -> rays
@@ -176,7 +183,7 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
     glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
     glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
     if (glm::dot(n, d) > 0.0f) n = -n; // the side the light arrives on
-    landings.push_back({ray.origin + hit.t * d, n});
+    landings.push_back({ray.origin + hit.t * d, n, reflectance_[hit.primitive]});
     ++landedOn[hit.primitive];
   }
   reach.landedTriangles.assign(landedOn.begin(), landedOn.end());
@@ -233,7 +240,82 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
   reach.fraction = static_cast<double>(reached) / static_cast<double>(samples_.size());
   reach.area = totalArea_ * reach.fraction;
   reach.reflectance = glm::vec3(reflectance / static_cast<double>(reached));
+
+  // 3. Seen: the one-bounce irradiance at the camera's points, the landings as virtual point
+  // lights: each carries flux (1 - e_0) Phi / landings and reflects R cos / pi per steradian, so
+  //   E_1(P) = sum_i Phi_i R_i cos_i cos_P / (pi max(r^2, r_c^2)) V(i, P),
+  // estimated from kSeenLandingsPerPoint random landings. r_c, the radius of one landing's share of
+  // the reached area, bounds the 1/r^2 of a landing next to P (that light is the direct light's
+  // neighbourhood, which the ambient term never resolves anyway).
+  if (!seen_.empty() && !landings.empty() && glm::length(seenModel_) > 0.0) {
+    const glm::dvec3 photon = glm::dvec3(lights.unitFlux[light]) * (1.0 - reach.escapeDirect) / static_cast<double>(landings.size());
+    const double rc2 = reach.area / (std::numbers::pi * static_cast<double>(landings.size()));
+    glm::dvec3 target(0.0);
+    for (const SurfacePoint& p : seen_) {
+      glm::dvec3 sum(0.0);
+      for (std::uint32_t k = 0; k < kSeenLandingsPerPoint; ++k) {
+        const Landing& h = landings[std::uniform_int_distribution<std::size_t>(0, landings.size() - 1)(rng)];
+        glm::vec3 d = h.position - p.position;
+        const float r2 = glm::dot(d, d);
+        if (!(r2 > 0.0f)) continue;
+        d /= std::sqrt(r2);
+        const float cosP = glm::dot(p.normal, d), cosL = -glm::dot(h.normal, d);
+        if (cosP <= 0.0f || cosL <= 0.0f) continue;
+        glm::vec3 from = p.position + offsetAt(p.position, offset_) * p.normal;
+        glm::vec3 to = h.position + offsetAt(h.position, offset_) * h.normal;
+        if (!visible(from, to)) continue;
+        sum += glm::dvec3(h.reflectance) * static_cast<double>(cosP * cosL) / std::max(static_cast<double>(r2), rc2);
+      }
+      // Landings drawn uniformly: the sum over all of them is landings / K times this one.
+      const glm::dvec3 e1 = photon * sum * (static_cast<double>(landings.size()) / kSeenLandingsPerPoint) / std::numbers::pi;
+      target += glm::dvec3(p.reflectance) * e1 / std::numbers::pi;
+    }
+    for (int c = 0; c < 3; ++c) reach.seenFirstBounce[c] = seenModel_[c] > 0.0 ? static_cast<float>(target[c] / seenModel_[c]) : 0.0f;
+    reach.seenFitted = true;
+  }
   return reach;
+}
+
+void ReachedSurfaces::setSeenView(const SeenView& view) {
+  seen_.clear();
+  seenModel_ = glm::dvec3(0.0);
+  const scene::Scene& scene = *scene_;
+  const float tanHalf = std::tan(0.5f * view.yfov);
+  const glm::vec3 right = glm::normalize(glm::cross(view.forward, view.up));
+  std::mt19937 rng(0x5ee9u);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  for (std::uint32_t y = 0; y < kSeenGrid; ++y)
+    for (std::uint32_t x = 0; x < kSeenGrid; ++x) {
+      // A jittered grid over the image.
+      float sx = (2.0f * (static_cast<float>(x) + uni(rng)) / kSeenGrid - 1.0f) * tanHalf * view.aspect;
+      float sy = (1.0f - 2.0f * (static_cast<float>(y) + uni(rng)) / kSeenGrid) * tanHalf;
+      glm::vec3 d = glm::normalize(view.forward + sx * right + sy * view.up);
+      bvh::Hit hit = bvh::closestHit(bvh_, {.origin = view.position, .direction = d});
+      if (!hit.hit()) continue;
+      const glm::uvec3 tri = scene.triangles[hit.primitive];
+      glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
+      glm::vec3 n = glm::cross(b - a, c - a);
+      if (!(glm::length(n) > 0.0f)) continue;
+      n = glm::normalize(n);
+      if (glm::dot(n, d) > 0.0f) n = -n; // the side the camera sees
+      const SurfacePoint p{view.position + hit.t * d, n, reflectance_[hit.primitive]};
+      // W_c (or W) at P as obscurance.glsl estimates it: cosine rays of length dmax.
+      glm::dvec3 w(0.0);
+      for (std::uint32_t k = 0; k < kSeenObscuranceRays; ++k) {
+        glm::vec3 dir = cosineDirection(n, uni(rng), uni(rng));
+        bvh::Hit q = bvh::closestHit(bvh_, {.origin = p.position + offsetAt(p.position, offset_) * n, .direction = dir,
+                                            .tmin = 0.0f, .tmax = view.dMax});
+        glm::vec3 r = view.colourBleeding ? view.averageReflectance : glm::vec3(1.0f);
+        float rho = 1.0f;
+        if (q.hit()) {
+          rho = obscuranceRho(q.t, view.dMax, view.rho, view.tau);
+          r = view.colourBleeding ? reflectance_[q.primitive] : glm::vec3(1.0f);
+        }
+        w += glm::dvec3(r) * static_cast<double>(rho);
+      }
+      seenModel_ += glm::dvec3(p.reflectance) * w / static_cast<double>(kSeenObscuranceRays);
+      seen_.push_back(p);
+    }
 }
 
 } // namespace obscura::render

@@ -16,7 +16,20 @@
 //      open front lose that light; the paper's I_a assumes a closed scene).
 // I_a's weight for light s then uses A_s, R_s and the escapes in place of A_t and R_ave
 // (ambient.h): flux (1 - e_0) / (pi A_s) / (1 - R_s (1 - e_1)), which keeps I_a linear in every
-// emission. The rays run on the CPU (bvh::closestHit / anyHit): a few
+// emission.
+//
+// The Seen refinement (OURS, AmbientModel::Seen): a light's flux does not spread evenly over what
+// it reaches. A lamp in a basement or a skylight over a stairwell lights its own corner; the rest
+// of the reached area sees that light only after several bounces, or through a gap at a grazing
+// angle. So, for the points the camera sees, the one-bounce irradiance from light s is measured
+// with the landing points of step 1 as virtual point lights (each carrying flux/emitted, reflected
+// by its surface's R, one shadow ray to a few of them per point), and the first-bounce term of
+// I_a is fitted to it: the ambient term's first bounce is R(P) x W_c(P) x F_s, so
+//   F_s = sum_P R(P) E_1,s(P) / pi  /  sum_P R(P) W_c(P)          (per channel)
+// with W_c (or W, grey) measured at the same points with the render's rho and dmax. F_s replaces
+// flux (1 - e_0) / (pi A_s) and I_a's weight is F_s x the same series of later bounces. F_s is
+// still linear in the light's emission (flux per landing), so relighting holds; it is fitted to
+// one camera (like the default dmax). The rays run on the CPU (bvh::closestHit / anyHit): a few
 // thousand per light, deterministic for a given scene (fixed seeds), so an incremental edit and a
 // fresh render agree.
 #pragma once
@@ -42,7 +55,25 @@ struct LightReach {
   // `landings` rays that hit something (secondary_reflectors.h marks the strongly lit ones).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> landedTriangles;
   std::uint32_t landings = 0;
+  // Seen: the fitted first-bounce term F_s (see above); valid when seenFitted.
+  glm::vec3 seenFirstBounce{0.0f};
+  bool seenFitted = false;
 };
+
+// The camera's view for the Seen fit: where its rays land and the obscurance settings there.
+struct SeenView {
+  glm::vec3 position{0.0f}, forward{0.0f, 0.0f, -1.0f}, up{0.0f, 1.0f, 0.0f};
+  float yfov = 0.8f, aspect = 1.0f;
+  float dMax = 1.0f;
+  std::uint32_t rho = 0;  // gpu::kRhoSqrt, kRhoExp or kRhoAo
+  float tau = 3.0f;
+  bool colourBleeding = true;
+  glm::vec3 averageReflectance{0.5f}; // R(Q) of a miss within dmax
+  bool operator==(const SeenView&) const = default;
+};
+
+// rho(d) [RTO §3], the C++ twin of shaders/lib/obscurance.glsl's rho().
+float obscuranceRho(float d, float dMax, std::uint32_t kind, float tau);
 
 class ReachedSurfaces {
 public:
@@ -56,11 +87,21 @@ public:
 
   double totalArea() const { return totalArea_; }
 
+  // Seen points for the Seen fit (measure() then fits F_s); without them measure() leaves
+  // seenFitted false.
+  void setSeenView(const SeenView& view);
+  std::size_t seenPoints() const { return seen_.size(); }
+
   // Light rays per light and surface samples over the scene (OURS: a few thousand keep the
   // estimate within a percent or two of the reached fraction, tested, at ~0.01 s per light).
   static constexpr std::uint32_t kLightRays = 1024;
   static constexpr std::uint32_t kSurfaceSamples = 4096;
   static constexpr std::uint32_t kVisibilityTries = 4; // shadow rays per sample and kind of target
+  // Seen fit: camera points (a grid), obscurance rays at each, landings (virtual point lights)
+  // tested from each (OURS: ~16k shadow rays per light; the fit's spread over seeds is a few %).
+  static constexpr std::uint32_t kSeenGrid = 24;
+  static constexpr std::uint32_t kSeenObscuranceRays = 16;
+  static constexpr std::uint32_t kSeenLandingsPerPoint = 32;
 
 private:
   struct SurfacePoint {
@@ -69,6 +110,9 @@ private:
   const scene::Scene* scene_;
   bvh::Bvh bvh_;
   std::vector<SurfacePoint> samples_;
+  std::vector<glm::vec3> reflectance_; // per triangle
+  std::vector<SurfacePoint> seen_;     // camera points (reflectance = R(P))
+  glm::dvec3 seenModel_{0.0};          // sum_P R(P) W_c(P): the model's first bounce per unit F_s
   double totalArea_ = 0.0;
   float offset_ = 1e-5f; // ray-origin offset along the normal: 1e-5 of the scene's largest extent
 };
