@@ -88,13 +88,16 @@ void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colour
   const bool seen = reached && term.model == AmbientModel::Seen;
   // A series of bounces each keeping q = R (1 - e_1): all of them (1 / (1 - q)), or the d - 1 a path
   // of depth d holds (light -> Q_1 .. Q_j -> P, j < d).
-  auto series = [](glm::vec3 r, double escapeBounce, std::uint32_t depth) {
+  auto seriesOf = [](glm::vec3 q, std::uint32_t depth) {
     glm::vec3 out(0.0f);
     for (int c = 0; c < 3; ++c) {
-      double q = static_cast<double>(r[c]) * (1.0 - escapeBounce);
-      out[c] = static_cast<float>(depth == 0 ? 1.0 / (1.0 - q) : (1.0 - std::pow(q, depth - 1.0)) / (1.0 - q));
+      double qc = std::min(static_cast<double>(q[c]), static_cast<double>(kMaxAverageReflectance));
+      out[c] = static_cast<float>(depth == 0 ? 1.0 / (1.0 - qc) : (1.0 - std::pow(qc, depth - 1.0)) / (1.0 - qc));
     }
     return out;
+  };
+  auto series = [&](glm::vec3 r, double escapeBounce, std::uint32_t depth) {
+    return seriesOf(r * static_cast<float>(1.0 - escapeBounce), depth);
   };
   // The first bounce: flux kept (1 - e_0) over the area (x R for grey obscurance, whose W has no R(Q)).
   auto firstBounce = [&](std::size_t s, glm::vec3 r, double area, double escapeDirect) {
@@ -119,9 +122,12 @@ void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colour
       byPower += lights.power[s] * glm::dvec3(r);
       power += lights.power[s];
     }
-    // Seen: the first bounce fitted at the camera's points (it holds R(Q) and the escapes already).
-    const glm::vec3 first = seen && term.reach[s].seenFitted ? term.reach[s].seenFirstBounce : firstBounce(s, r, area, escapeDirect);
-    term.weight.push_back(first * series(r, escapeBounce, reached ? term.depth : 0));
+    // Seen: the first bounce fitted at the camera's points (it holds R(Q) and the escapes already),
+    // the later ones with the q measured around them.
+    if (seen && term.reach[s].seenFitted)
+      term.weight.push_back(term.reach[s].seenFirstBounce * seriesOf(term.reach[s].seenBounce, term.depth));
+    else
+      term.weight.push_back(firstBounce(s, r, area, escapeDirect) * series(r, escapeBounce, reached ? term.depth : 0));
   }
   term.reachedReflectance = power > 0.0 ? glm::vec3(byPower / power) : term.averageReflectance;
 }

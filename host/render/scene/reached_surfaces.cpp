@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <random>
@@ -166,6 +167,7 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
   // 1. Where the light lands: first hits of rays leaving it (the position and the lit side's normal).
   struct Landing {
     glm::vec3 position, normal, reflectance;
+    glm::vec3 from, direction; // the light ray that landed there
   };
   std::vector<Landing> landings;
   std::map<std::uint32_t, std::uint32_t> landedOn; // triangle -> rays
@@ -183,7 +185,7 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
     glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
     glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
     if (glm::dot(n, d) > 0.0f) n = -n; // the side the light arrives on
-    landings.push_back({ray.origin + hit.t * d, n, reflectance_[hit.primitive]});
+    landings.push_back({ray.origin + hit.t * d, n, reflectance_[hit.primitive], ray.origin, d});
     ++landedOn[hit.primitive];
   }
   reach.landedTriangles.assign(landedOn.begin(), landedOn.end());
@@ -242,19 +244,35 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
   reach.reflectance = glm::vec3(reflectance / static_cast<double>(reached));
 
   // 3. Seen: the one-bounce irradiance at the camera's points, the landings as virtual point
-  // lights: each carries flux (1 - e_0) Phi / landings and reflects R cos / pi per steradian, so
-  //   E_1(P) = sum_i Phi_i R_i cos_i cos_P / (pi max(r^2, r_c^2)) V(i, P),
-  // estimated from kSeenLandingsPerPoint random landings. r_c, the radius of one landing's share of
-  // the reached area, bounds the 1/r^2 of a landing next to P (that light is the direct light's
+  // lights ("photons"): each carries its flux Phi_i and reflects R cos / pi per steradian, so
+  //   E_1(P) = sum_i Phi_i R_i cos_i cos_P / (pi max(r^2, r_c,i^2)) V(i, P),
+  // estimated from kSeenLandingsPerPoint random photons. r_c,i, the radius of photon i's share of
+  // the lit area, bounds the 1/r^2 of a landing next to P (that light is the direct light's
   // neighbourhood, which the ambient term never resolves anyway).
   if (!seen_.empty() && !landings.empty() && glm::length(seenModel_) > 0.0) {
-    const glm::dvec3 photon = glm::dvec3(lights.unitFlux[light]) * (1.0 - reach.escapeDirect) / static_cast<double>(landings.size());
-    const double rc2 = reach.area / (std::numbers::pi * static_cast<double>(landings.size()));
+    std::vector<Photon> photons;
+    const std::uint32_t type = lights.lights[light].info.x;
+    if (type == gpu::kLightDirectional || type == gpu::kLightBackground) {
+      photons = beamPhotons(lights, light, rng);
+      // The first landings keep the beams outside the seen box's shadow (the strata beamPhotons drew apart).
+      const double perRay = type == gpu::kLightDirectional
+                                ? std::numbers::pi * sceneRadius() * sceneRadius() / emitted // irradiance 1 x the disk's share
+                                : static_cast<double>(lights.unitFlux[light].x) / emitted;
+      for (const Landing& h : landings) {
+        if (beamCrossesSeenBox(h.from, h.direction)) continue;
+        photons.push_back({h.position, h.normal, h.reflectance, glm::dvec3(perRay),
+                           std::numbers::pi * sceneRadius() * sceneRadius() / emitted / std::numbers::pi});
+      }
+    } else {
+      const glm::dvec3 flux = glm::dvec3(lights.unitFlux[light]) * (1.0 - reach.escapeDirect) / static_cast<double>(landings.size());
+      const double rc2 = reach.area / (std::numbers::pi * static_cast<double>(landings.size()));
+      for (const Landing& h : landings) photons.push_back({h.position, h.normal, h.reflectance, flux, rc2});
+    }
     glm::dvec3 target(0.0);
     for (const SurfacePoint& p : seen_) {
       glm::dvec3 sum(0.0);
-      for (std::uint32_t k = 0; k < kSeenLandingsPerPoint; ++k) {
-        const Landing& h = landings[std::uniform_int_distribution<std::size_t>(0, landings.size() - 1)(rng)];
+      for (std::uint32_t k = 0; k < kSeenLandingsPerPoint && !photons.empty(); ++k) {
+        const Photon& h = photons[std::uniform_int_distribution<std::size_t>(0, photons.size() - 1)(rng)];
         glm::vec3 d = h.position - p.position;
         const float r2 = glm::dot(d, d);
         if (!(r2 > 0.0f)) continue;
@@ -264,24 +282,98 @@ LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) c
         glm::vec3 from = p.position + offsetAt(p.position, offset_) * p.normal;
         glm::vec3 to = h.position + offsetAt(h.position, offset_) * h.normal;
         if (!visible(from, to)) continue;
-        sum += glm::dvec3(h.reflectance) * static_cast<double>(cosP * cosL) / std::max(static_cast<double>(r2), rc2);
+        sum += h.flux * glm::dvec3(h.reflectance) * static_cast<double>(cosP * cosL) / std::max(static_cast<double>(r2), h.rc2);
       }
-      // Landings drawn uniformly: the sum over all of them is landings / K times this one.
-      const glm::dvec3 e1 = photon * sum * (static_cast<double>(landings.size()) / kSeenLandingsPerPoint) / std::numbers::pi;
+      // Photons drawn uniformly: the sum over all of them is photons / K times this one.
+      const glm::dvec3 e1 = sum * (static_cast<double>(photons.size()) / kSeenLandingsPerPoint) / std::numbers::pi;
       target += glm::dvec3(p.reflectance) * e1 / std::numbers::pi;
     }
     for (int c = 0; c < 3; ++c) reach.seenFirstBounce[c] = seenModel_[c] > 0.0 ? static_cast<float>(target[c] / seenModel_[c]) : 0.0f;
+    reach.seenBounce = seenBounce_;
     reach.seenFitted = true;
   }
   return reach;
 }
 
+float ReachedSurfaces::sceneRadius() const {
+  const scene::Bounds& b = scene_->bounds;
+  return 0.5f * glm::length(b.hi - b.lo) + 1e-3f; // samplePoint's sphere and disk
+}
+
+// The rectangle, in the plane across `direction` through the scene's centre (frame t, b), that
+// the seen box projects to, clipped to the disk of the scene's radius; area 0 when empty.
+ReachedSurfaces::BeamRect ReachedSurfaces::seenBoxAcross(glm::vec3 direction) const {
+  const scene::Bounds& bounds = scene_->bounds;
+  const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
+  BeamRect r;
+  Frame f = frameAround(direction);
+  r.t = f.t;
+  r.b = f.b;
+  r.lo = glm::vec2(std::numeric_limits<float>::max());
+  r.hi = glm::vec2(-std::numeric_limits<float>::max());
+  for (int corner = 0; corner < 8; ++corner) {
+    glm::vec3 c((corner & 1) ? seenHi_.x : seenLo_.x, (corner & 2) ? seenHi_.y : seenLo_.y, (corner & 4) ? seenHi_.z : seenLo_.z);
+    glm::vec2 uv(glm::dot(c - centre, f.t), glm::dot(c - centre, f.b));
+    r.lo = glm::min(r.lo, uv);
+    r.hi = glm::max(r.hi, uv);
+  }
+  const float radius = sceneRadius();
+  r.lo = glm::max(r.lo, glm::vec2(-radius));
+  r.hi = glm::min(r.hi, glm::vec2(radius));
+  return r;
+}
+
+bool ReachedSurfaces::beamCrossesSeenBox(glm::vec3 from, glm::vec3 direction) const {
+  const scene::Bounds& bounds = scene_->bounds;
+  const BeamRect r = seenBoxAcross(direction);
+  const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
+  glm::vec2 uv(glm::dot(from - centre, r.t), glm::dot(from - centre, r.b));
+  return r.area() > 0.0f && uv.x >= r.lo.x && uv.x < r.hi.x && uv.y >= r.lo.y && uv.y < r.hi.y;
+}
+
+// Lights from outside the scene (directional, sky) as parallel beams across a disk of the scene's
+// radius (the sky: a beam for every direction, uniform, radiance 1 times 4 pi; the sun: its one
+// direction, irradiance 1). A room in a large world (classroom's 221 m ground) gets almost none of
+// the first landings, so the beams that cross the seen box (grown by dmax) are drawn apart:
+// kSeenBeamRays uniform over the box's projection, each carrying irradiance x projected area / N;
+// measure() keeps the first landings outside that stratum. Landings only (misses carry nothing).
+std::vector<ReachedSurfaces::Photon> ReachedSurfaces::beamPhotons(const LightSet& lights, std::size_t light, std::mt19937& rng) const {
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  const scene::Bounds& bounds = scene_->bounds;
+  const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
+  const float radius = sceneRadius();
+  const bool sky = lights.lights[light].info.x == gpu::kLightBackground;
+  std::vector<Photon> out;
+  for (std::uint32_t i = 0; i < kSeenBeamRays; ++i) {
+    const glm::vec3 direction = sky ? sphereDirection(uni(rng), uni(rng)) : glm::normalize(glm::vec3(lights.lights[light].direction));
+    const BeamRect r = seenBoxAcross(direction);
+    if (!(r.area() > 0.0f)) continue;
+    glm::vec2 uv(r.lo.x + uni(rng) * (r.hi.x - r.lo.x), r.lo.y + uni(rng) * (r.hi.y - r.lo.y));
+    if (glm::dot(uv, uv) > radius * radius) continue; // outside the disk: no light there
+    bvh::Ray ray{.origin = centre - 2.0f * radius * direction + uv.x * r.t + uv.y * r.b, .direction = direction};
+    bvh::Hit hit = bvh::closestHit(bvh_, ray);
+    if (!hit.hit()) continue;
+    const glm::uvec3 tri = scene_->triangles[hit.primitive];
+    glm::vec3 a = scene_->positions[tri.x], b = scene_->positions[tri.y], c = scene_->positions[tri.z];
+    glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+    if (glm::dot(n, direction) > 0.0f) n = -n;
+    const double share = static_cast<double>(r.area()) / kSeenBeamRays; // cross-section per ray
+    const double flux = (sky ? 4.0 * std::numbers::pi : 1.0) * share;
+    out.push_back({ray.origin + hit.t * direction, n, reflectance_[hit.primitive], glm::dvec3(flux), share / std::numbers::pi});
+  }
+  return out;
+}
+
 void ReachedSurfaces::setSeenView(const SeenView& view) {
   seen_.clear();
   seenModel_ = glm::dvec3(0.0);
+  seenLo_ = glm::vec3(std::numeric_limits<float>::max());
+  seenHi_ = glm::vec3(-std::numeric_limits<float>::max());
   const scene::Scene& scene = *scene_;
   const float tanHalf = std::tan(0.5f * view.yfov);
   const glm::vec3 right = glm::normalize(glm::cross(view.forward, view.up));
+  glm::dvec3 bounce(0.0);
+  std::size_t bounceRays = 0;
   std::mt19937 rng(0x5ee9u);
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
   for (std::uint32_t y = 0; y < kSeenGrid; ++y)
@@ -302,6 +394,11 @@ void ReachedSurfaces::setSeenView(const SeenView& view) {
       // W_c (or W) at P as obscurance.glsl estimates it: cosine rays of length dmax.
       glm::dvec3 w(0.0);
       for (std::uint32_t k = 0; k < kSeenObscuranceRays; ++k) {
+        // What comes back at all (any distance): the later bounces' q.
+        bvh::Hit any = bvh::closestHit(bvh_, {.origin = p.position + offsetAt(p.position, offset_) * n,
+                                              .direction = cosineDirection(n, uni(rng), uni(rng))});
+        if (any.hit()) bounce += glm::dvec3(reflectance_[any.primitive]);
+        ++bounceRays;
         glm::vec3 dir = cosineDirection(n, uni(rng), uni(rng));
         bvh::Hit q = bvh::closestHit(bvh_, {.origin = p.position + offsetAt(p.position, offset_) * n, .direction = dir,
                                             .tmin = 0.0f, .tmax = view.dMax});
@@ -315,7 +412,10 @@ void ReachedSurfaces::setSeenView(const SeenView& view) {
       }
       seenModel_ += glm::dvec3(p.reflectance) * w / static_cast<double>(kSeenObscuranceRays);
       seen_.push_back(p);
+      seenLo_ = glm::min(seenLo_, p.position - glm::vec3(view.dMax));
+      seenHi_ = glm::max(seenHi_, p.position + glm::vec3(view.dMax));
     }
+  seenBounce_ = bounceRays ? glm::vec3(bounce / static_cast<double>(bounceRays)) : glm::vec3(0.0f);
 }
 
 } // namespace obscura::render

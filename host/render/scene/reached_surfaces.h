@@ -34,6 +34,7 @@
 // fresh render agree.
 #pragma once
 #include <cstdint>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -57,6 +58,9 @@ struct LightReach {
   std::uint32_t landings = 0;
   // Seen: the fitted first-bounce term F_s (see above); valid when seenFitted.
   glm::vec3 seenFirstBounce{0.0f};
+  // Seen: q of the later bounces around the seen points, R (1 - e) of unbounded cosine rays from
+  // them (the same for every light: bounces after the first happen where the camera looks).
+  glm::vec3 seenBounce{0.0f};
   bool seenFitted = false;
 };
 
@@ -102,17 +106,34 @@ public:
   static constexpr std::uint32_t kSeenGrid = 24;
   static constexpr std::uint32_t kSeenObscuranceRays = 16;
   static constexpr std::uint32_t kSeenLandingsPerPoint = 32;
+  static constexpr std::uint32_t kSeenBeamRays = 1024; // sun and sky: beams across the seen box
 
 private:
   struct SurfacePoint {
     glm::vec3 position, normal, reflectance;
   };
+  struct Photon { // a landing point as a virtual point light of the Seen fit
+    glm::vec3 position, normal, reflectance;
+    glm::dvec3 flux;
+    double rc2; // r_c^2: its share of the lit area / pi
+  };
+  struct BeamRect {
+    glm::vec3 t{0.0f}, b{0.0f};
+    glm::vec2 lo{0.0f}, hi{0.0f};
+    float area() const { return hi.x > lo.x && hi.y > lo.y ? (hi.x - lo.x) * (hi.y - lo.y) : 0.0f; }
+  };
+  float sceneRadius() const;
+  BeamRect seenBoxAcross(glm::vec3 direction) const;
+  bool beamCrossesSeenBox(glm::vec3 from, glm::vec3 direction) const;
+  std::vector<Photon> beamPhotons(const LightSet& lights, std::size_t light, std::mt19937& rng) const;
   const scene::Scene* scene_;
   bvh::Bvh bvh_;
   std::vector<SurfacePoint> samples_;
   std::vector<glm::vec3> reflectance_; // per triangle
   std::vector<SurfacePoint> seen_;     // camera points (reflectance = R(P))
-  glm::dvec3 seenModel_{0.0};          // sum_P R(P) W_c(P): the model's first bounce per unit F_s
+  glm::dvec3 seenModel_{0.0};
+  glm::vec3 seenLo_{0.0f}, seenHi_{0.0f}; // the seen points' box grown by dmax
+  glm::vec3 seenBounce_{0.0f};            // q around the seen points (LightReach::seenBounce)          // sum_P R(P) W_c(P): the model's first bounce per unit F_s
   double totalArea_ = 0.0;
   float offset_ = 1e-5f; // ray-origin offset along the normal: 1e-5 of the scene's largest extent
 };
