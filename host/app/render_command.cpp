@@ -219,7 +219,9 @@ void runRender(RenderOptions& o) {
                      "I_a ({:.4g}, {:.4g}, {:.4g}) from {} (the paper's whole-scene formula: ({:.4g}, {:.4g}, {:.4g})); "
                      "{} lights; frame in {} band(s)\n",
              renderer.dMax(), o.rho, o.sampling, o.noBleed ? "grey" : "colour bleeding", rAve.x, rAve.y, rAve.z,
-             ia.x, ia.y, ia.z, o.ambient == "global" ? "the whole scene" : "the surfaces the lights reach",
+             ia.x, ia.y, ia.z, o.ambient == "global" ? "the whole scene"
+             : o.ambient == "seen" ? "the surfaces the lights reach, first bounce fitted to the camera's view"
+                                   : "the surfaces the lights reach",
              iaGlobal.x, iaGlobal.y, iaGlobal.z, renderer.lights().size(), renderer.layout().bandCount());
   if (settings.secondaryReflectors > 0.0f)
     fmt::print(stderr, "secondary reflectors: {} of {} triangles marked (threshold {:g} x each light's mean direct "

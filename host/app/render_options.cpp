@@ -65,8 +65,9 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
       ->check(CLI::IsMember({"spatial", "area"}));
   cmd.add_option("--ambient", o.ambient,
                  "which surfaces share a light's flux in I_a: reached (default: those its light reaches, directly or "
-                 "after one bounce) or global (the paper's: the whole scene)")
-      ->check(CLI::IsMember({"reached", "global"}));
+                 "after one bounce), seen (reached, with the first bounce fitted to what the light's landing points send to "
+                 "the surfaces the camera sees) or global (the paper's: the whole scene)")
+      ->check(CLI::IsMember({"reached", "seen", "global"}));
   cmd.add_option("--dirty-test", o.dirtyTest,
                  "which pixels a geometry edit (relight --edits: move, remove, insert) retraces: bounds (those whose "
                  "rays' bounding boxes and shafts may meet the object's old or new place), probe (of those, the ones "
@@ -125,7 +126,9 @@ render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scen
   settings.shadowSampling = o.shadowSampling == "per-light" ? render::ShadowSampling::PerLight
                                                             : render::ShadowSampling::Selection;
   settings.lightSampling = lightSampling(o);
-  settings.ambient = o.ambient == "global" ? render::AmbientModel::Global : render::AmbientModel::Reached;
+  settings.ambient = o.ambient == "global" ? render::AmbientModel::Global
+                     : o.ambient == "seen"  ? render::AmbientModel::Seen
+                                            : render::AmbientModel::Reached;
   settings.dirtyTest = o.dirtyTest == "bounds"  ? render::DirtyTest::Bounds
                        : o.dirtyTest == "probe" ? render::DirtyTest::Probe
                                                 : render::DirtyTest::Auto;

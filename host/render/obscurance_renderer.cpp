@@ -5,7 +5,6 @@
 #include <future>
 #include <thread>
 #include <chrono>
-#include <cstring>
 
 #include <fmt/format.h>
 
@@ -72,9 +71,9 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
       stream_(context), timestamps_(context) {
   for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
-  if (settings.ambient == AmbientModel::Reached) ambient_.model = AmbientModel::Reached;
-  if (settings.ambient == AmbientModel::Reached || settings.secondaryReflectors > 0.0f) measureReach(scene, bvh);
-  defaultDMax_ = defaultDMax(scene, bvh, settings.camera);
+  if (settings.ambient != AmbientModel::Global) ambient_.model = settings.ambient;
+  defaultDMax_ = defaultDMax(scene, bvh, settings.camera); // first: the Seen fit needs dmax
+  if (settings.ambient != AmbientModel::Global || settings.secondaryReflectors > 0.0f) measureReach(scene, bvh);
   emissions_ = lights_.emission;
   configure(settings);
   if (reflectorsOn()) markReflectors();
@@ -100,12 +99,28 @@ void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh&
   auto before = std::move(reached_);
   reached_ = std::make_unique<ReachedSurfaces>(scene, bvh, reachReflectance_);
   ambient_.depth = settings_.maxDepth;
+  if (ambient_.model == AmbientModel::Seen) reached_->setSeenView(seenView());
   std::vector<scene::Bounds> padded;
-  const bool incremental = changed && before && ambient_.reach.size() == lights_.size();
-  if (incremental) {
+  if (changed && before) {
     const float pad = changedBoxPadding();
     for (scene::Bounds b : *changed) padded.push_back({b.lo - pad, b.hi + pad});
   }
+  measureAllReach(changed && before ? before.get() : nullptr, padded);
+  lastReach_.ms = 1e3 * secondsSince(start); // the reflectances and surface samples included
+}
+
+SeenView ObscuranceRenderer::seenView() const {
+  const scene::Camera& c = settings_.camera;
+  return {.position = c.position, .forward = c.forward, .up = c.up, .yfov = c.yfov,
+          .aspect = static_cast<float>(settings_.width) / static_cast<float>(std::max(settings_.height, 1u)),
+          .dMax = settings_.dMax > 0.0f ? settings_.dMax : defaultDMax_, .rho = static_cast<std::uint32_t>(settings_.rho),
+          .tau = settings_.tau, .colourBleeding = settings_.colourBleeding,
+          .averageReflectance = ambient_.averageReflectance};
+}
+
+void ObscuranceRenderer::measureAllReach(const ReachedSurfaces* before, const std::vector<scene::Bounds>& changed) {
+  const auto start = Clock::now();
+  const bool incremental = before && ambient_.reach.size() == lights_.size();
   std::vector<LightReach> previous = std::move(ambient_.reach);
   // Lights spread over the cores (measure is const and draws its own numbers): the CPU rays of
   // modern-hall's 13 lights take ~0.3 s on one core when measured whole.
@@ -113,7 +128,7 @@ void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh&
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
     for (std::size_t s = next++; s < lights_.size(); s = next++)
-      ambient_.reach[s] = incremental ? reached_->remeasure(*before, previous[s], lights_, s, padded)
+      ambient_.reach[s] = incremental ? reached_->remeasure(*before, previous[s], lights_, s, changed)
                                       : reached_->measure(lights_, s);
   };
   std::vector<std::future<void>> workers;
@@ -135,7 +150,7 @@ void ObscuranceRenderer::markReflectors() {
   SecondaryReflectorMarks marks;
   if (reflectorsOn())
     marks = markSecondaryReflectors(*scene_, ambient_.reach, settings_.secondaryReflectors, reached_->totalArea(),
-                                    ambient_.model == AmbientModel::Reached);
+                                    ambient_.model != AmbientModel::Global);
   reflectorsMarked_ = marks.count;
   unmarkedFirstBounce_ = marks.unmarkedFirstBounce;
   sceneBuffers_.setSecondaryReflectors(*scene_, std::move(marks.marked));
@@ -164,11 +179,17 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
     throw std::logic_error("ObscuranceRenderer::configure: secondary reflectors need the lights' reach; make the "
                            "renderer with them or with the Reached ambient model");
   const bool remark = settings.secondaryReflectors != settings_.secondaryReflectors;
+  const SeenView fittedTo = seenView();
   settings_ = settings;
   if (remark) markReflectors();
   dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax_;
-  if (bleedChanged || ambient_.depth != (reached_ ? settings.maxDepth : 0u)) {
-    ambient_.depth = reached_ ? settings.maxDepth : 0u;
+  const bool depthChanged = ambient_.depth != (reached_ ? settings.maxDepth : 0u);
+  ambient_.depth = reached_ ? settings.maxDepth : 0u;
+  // The Seen fit depends on the camera and the obscurance settings: fitted again when they change.
+  if (ambient_.model == AmbientModel::Seen && reached_ && !(fittedTo == seenView())) {
+    reached_->setSeenView(seenView());
+    measureAllReach();
+  } else if (bleedChanged || depthChanged) {
     updateAmbientWeights(ambient_, lights_, settings.colourBleeding);
   }
   reset();
@@ -247,7 +268,7 @@ gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
           .eye = glm::vec4(settings_.camera.position, sceneScale_),
           .band = glm::uvec4(0u),
           .reflectors = glm::vec4(ambientShareBeyondFirstBounce(ambient_.averageReflectance,
-                                                                ambient_.model == AmbientModel::Reached ? ambient_.depth : 0u),
+                                                                ambient_.model != AmbientModel::Global ? ambient_.depth : 0u),
                                   unmarkedFirstBounce_)};
 }
 
@@ -483,9 +504,13 @@ void ObscuranceRenderer::setEmissions(const std::vector<glm::vec3>& emissions) {
 }
 
 void ObscuranceRenderer::setAmbientModel(AmbientModel model) {
-  if (model == AmbientModel::Reached && !reached_)
+  if (model != AmbientModel::Global && !reached_)
     throw std::logic_error("setAmbientModel: this renderer did not measure what the lights reach");
   ambient_.model = model;
+  if (model == AmbientModel::Seen && reached_->seenPoints() == 0) { // fitted on first use
+    reached_->setSeenView(seenView());
+    measureAllReach();
+  }
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding); // the resolved A_t stays: I_a is a push
 }
 

@@ -131,7 +131,8 @@ public:
   // The emission scales E_s compose uses (default: the scene's own). I_a follows them [SPEC §3].
   void setEmissions(const std::vector<glm::vec3>& emissions);
   // Which I_a compose uses (no ray: I_a only weighs the ambient sums). Reached needs a renderer
-  // made with AmbientModel::Reached (its reach was measured); Global is always there.
+  // made with AmbientModel::Reached or Seen (its reach was measured; Seen is fitted on first use);
+  // Global is always there.
   void setAmbientModel(AmbientModel model);
   const std::vector<glm::vec3>& emissions() const { return emissions_; }
   // Composes the AOVs on the GPU with the current emissions, then tonemaps `combined` to the
@@ -212,6 +213,10 @@ private:
   // kept the lights, `changed` (the edited objects' old and new boxes) lets each light re-trace
   // only the rays the edit can change (ReachedSurfaces::remeasure: the same numbers).
   void measureReach(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<scene::Bounds>* changed = nullptr);
+  // Every light's reach (and Seen fit) with reached_ as it is, then I_a's weights; with `before`
+  // (the reach of the scene before an edit), re-tracing only the rays `changed` (padded) can change.
+  void measureAllReach(const ReachedSurfaces* before = nullptr, const std::vector<scene::Bounds>& changed = {});
+  SeenView seenView() const; // the camera and obscurance settings the Seen fit uses
   // How far beyond a changed box the rays' offset origins may start: 1e-3 of the scene's size and
   // reach (lib/ray.glsl offsets by a few hundred ulps of the coordinates).
   float changedBoxPadding() const;

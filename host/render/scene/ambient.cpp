@@ -82,20 +82,28 @@ void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colour
   // [RTO eq. 4] (grey) or [RTO eq. 12] (colour bleeding), per unit E_s. The paper's I_a is a
   // radiosity (E_i = pi L_e); our images are radiance, so I_a is divided by pi: for a Lambertian
   // reflector the indirect radiance is R(P) I_a W / pi. OURS [SPEC §5: no hidden scale].
-  // Reached: light s's kept flux over the area A_s it reaches, with that area's reflectance R_s and escapes.
-  const bool reached = term.model == AmbientModel::Reached && term.reach.size() == lights.size();
-  // Flux kept (1 - e_0) over the area, and a series of bounces each keeping q = R (1 - e_1): all of
-  // them (1 / (1 - q)), or the d - 1 a path of depth d holds (light -> Q_1 .. Q_j -> P, j < d).
-  auto weightFor = [&](std::size_t s, glm::vec3 r, double area, double escapeDirect, double escapeBounce,
-                       std::uint32_t depth) {
+  // Reached: light s's kept flux over the area A_s it reaches, with that area's reflectance R_s and
+  // escapes; Seen: the same series after a first bounce fitted at the camera's points.
+  const bool reached = term.model != AmbientModel::Global && term.reach.size() == lights.size();
+  const bool seen = reached && term.model == AmbientModel::Seen;
+  // A series of bounces each keeping q = R (1 - e_1): all of them (1 / (1 - q)), or the d - 1 a path
+  // of depth d holds (light -> Q_1 .. Q_j -> P, j < d).
+  auto seriesOf = [](glm::vec3 q, std::uint32_t depth) {
+    glm::vec3 out(0.0f);
+    for (int c = 0; c < 3; ++c) {
+      double qc = std::min(static_cast<double>(q[c]), static_cast<double>(kMaxAverageReflectance));
+      out[c] = static_cast<float>(depth == 0 ? 1.0 / (1.0 - qc) : (1.0 - std::pow(qc, depth - 1.0)) / (1.0 - qc));
+    }
+    return out;
+  };
+  auto series = [&](glm::vec3 r, double escapeBounce, std::uint32_t depth) {
+    return seriesOf(r * static_cast<float>(1.0 - escapeBounce), depth);
+  };
+  // The first bounce: flux kept (1 - e_0) over the area (x R for grey obscurance, whose W has no R(Q)).
+  auto firstBounce = [&](std::size_t s, glm::vec3 r, double area, double escapeDirect) {
     if (!(area > 0.0)) return glm::vec3(0.0f);
     glm::vec3 perArea = lights.unitFlux[s] * static_cast<float>((1.0 - escapeDirect) / (area * std::numbers::pi));
-    glm::vec3 series(0.0f);
-    for (int c = 0; c < 3; ++c) {
-      double q = static_cast<double>(r[c]) * (1.0 - escapeBounce);
-      series[c] = static_cast<float>(depth == 0 ? 1.0 / (1.0 - q) : (1.0 - std::pow(q, depth - 1.0)) / (1.0 - q));
-    }
-    return (colourBleeding ? glm::vec3(1.0f) : r) * series * perArea;
+    return (colourBleeding ? glm::vec3(1.0f) : r) * perArea;
   };
   term.weight.clear();
   term.globalWeight.clear();
@@ -104,7 +112,7 @@ void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colour
   for (std::size_t s = 0; s < lights.size(); ++s) {
     glm::vec3 r = term.averageReflectance;
     double area = term.totalArea;
-    term.globalWeight.push_back(weightFor(s, r, area, 0.0, 0.0, 0));
+    term.globalWeight.push_back(firstBounce(s, r, area, 0.0) * series(r, 0.0, 0));
     double escapeDirect = 0.0, escapeBounce = 0.0;
     if (reached && term.reach[s].area > 0.0) {
       r = clampReflectance(term.reach[s].reflectance, term.reflectanceClamped);
@@ -114,7 +122,12 @@ void updateAmbientWeights(AmbientTerm& term, const LightSet& lights, bool colour
       byPower += lights.power[s] * glm::dvec3(r);
       power += lights.power[s];
     }
-    term.weight.push_back(weightFor(s, r, area, escapeDirect, escapeBounce, reached ? term.depth : 0));
+    // Seen: the first bounce fitted at the camera's points (it holds R(Q) and the escapes already),
+    // the later ones with the q measured around them.
+    if (seen && term.reach[s].seenFitted)
+      term.weight.push_back(term.reach[s].seenFirstBounce * seriesOf(term.reach[s].seenBounce, term.depth));
+    else
+      term.weight.push_back(firstBounce(s, r, area, escapeDirect) * series(r, escapeBounce, reached ? term.depth : 0));
   }
   term.reachedReflectance = power > 0.0 ? glm::vec3(byPower / power) : term.averageReflectance;
 }

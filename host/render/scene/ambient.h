@@ -19,8 +19,10 @@
 namespace obscura::render {
 
 // Which surfaces share a light's flux in I_a: Reached (default, OURS after the paper's §6: those
-// the light reaches, reached_surfaces.h) or Global (the paper's: the whole scene).
-enum class AmbientModel { Reached, Global };
+// the light reaches, reached_surfaces.h), Seen (Reached with the first bounce fitted to what the
+// light's landing points send to the surfaces the camera sees, reached_surfaces.h) or Global (the
+// paper's: the whole scene).
+enum class AmbientModel { Reached, Global, Seen };
 
 struct AmbientTerm {
   AmbientModel model = AmbientModel::Global;

@@ -2,22 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <limits>
 #include <random>
 #include <string>
 
-
 namespace obscura::render {
-namespace {
-
-constexpr float kPi = std::numbers::pi_v<float>;
-constexpr float kInfinity = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // The streams of a light's measurement: one per ray (or per surface sample, whose tries share it).
-enum class Stream : std::uint32_t { LightRay = 1, Bounce = 2, Sample = 3 };
+enum class Stream : std::uint32_t { LightRay = 1, Bounce = 2, Sample = 3, Seen = 4 };
 
 // A counter-based generator (splitmix64, Steele, Lea & Flood 2014) for one stream: cheap to start
 // at any (light, stream, index), so that every ray has numbers of its own.
@@ -39,6 +34,13 @@ private:
   }
   std::uint64_t state_;
 };
+
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
 
 struct Frame {
   glm::vec3 t, b, n;
@@ -170,8 +172,16 @@ std::uint32_t lightSeed(const std::string& name) {
 
 } // namespace
 
+float obscuranceRho(float d, float dMax, std::uint32_t kind, float tau) {
+  const float x = std::clamp(d / dMax, 0.0f, 1.0f);
+  if (kind == gpu::kRhoAo) return x >= 1.0f ? 1.0f : 0.0f;
+  if (kind == gpu::kRhoExp) return (1.0f - std::exp(-tau * x)) / (1.0f - std::exp(-tau));
+  return std::sqrt(x);
+}
+
 ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<glm::vec3>& reflectance)
-    : scene_(&scene), bvh_(bvh), bounds_(scene.bounds), offset_(1e-5f * largestExtent(scene.bounds)) {
+    : scene_(&scene), bvh_(bvh), reflectance_(reflectance), bounds_(scene.bounds),
+      offset_(1e-5f * largestExtent(scene.bounds)) {
   std::vector<double> cdf;
   cdf.reserve(scene.triangles.size());
   for (const auto& t : scene.triangles) {
@@ -243,8 +253,9 @@ LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, con
   // normal). A light ray is traced again when its segment up to its old hit meets a changed box:
   // every other ray has the same first hit in the edited scene.
   struct Landing {
-    glm::vec3 position, normal;
-    bool moved = false; // re-traced: what was seen of it before says nothing now
+    glm::vec3 position, normal, reflectance;
+    glm::vec3 from, direction; // the light ray that landed there
+    bool moved = false;        // re-traced: what was seen of it before says nothing now
   };
   std::vector<Landing> landingOf(kLightRays); // by light ray; valid where landingT is finite
   rays.landingT.assign(kLightRays, std::numeric_limits<float>::quiet_NaN());
@@ -275,7 +286,7 @@ LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, con
     glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
     glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
     if (glm::dot(n, d) > 0.0f) n = -n; // the side the light arrives on
-    landingOf[i] = {ray.origin + t * d, n, retrace && replay};
+    landingOf[i] = {ray.origin + t * d, n, reflectance_[primitive], ray.origin, d, retrace && replay};
     ++landed;
     ++landedOn[primitive];
   }
@@ -375,7 +386,191 @@ LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, con
   reach.fraction = static_cast<double>(reached) / static_cast<double>(samples_.size());
   reach.area = totalArea_ * reach.fraction;
   reach.reflectance = glm::vec3(reflectance / static_cast<double>(reached));
+
+  // 3. Seen: the one-bounce irradiance at the camera's points, the landings as virtual point
+  // lights ("photons"): each carries its flux Phi_i and reflects R cos / pi per steradian, so
+  //   E_1(P) = sum_i Phi_i R_i cos_i cos_P / (pi max(r^2, r_c,i^2)) V(i, P),
+  // estimated from kSeenLandingsPerPoint random photons. r_c,i, the radius of photon i's share of
+  // the lit area, bounds the 1/r^2 of a landing next to P (that light is the direct light's
+  // neighbourhood, which the ambient term never resolves anyway).
+  // Measured whole after an edit too (its rays are a few per seen point): it reads only the
+  // landings, so a replayed measurement fits what a fresh one fits.
+  std::vector<Landing> landings;
+  for (std::uint32_t i = 0; i < kLightRays; ++i)
+    if (std::isfinite(rays.landingT[i])) landings.push_back(landingOf[i]);
+  StreamRng rng(seed, Stream::Seen, 0);
+  auto visible = [&](glm::vec3 from, glm::vec3 to) {
+    bvh::Ray ray{.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f};
+    ++rays.traced;
+    return !bvh::anyHit(bvh_, ray);
+  };
+  if (!seen_.empty() && !landings.empty() && glm::length(seenModel_) > 0.0) {
+    std::vector<Photon> photons;
+    const std::uint32_t type = lights.lights[light].info.x;
+    if (type == gpu::kLightDirectional || type == gpu::kLightBackground) {
+      photons = beamPhotons(lights, light, rng);
+      // The first landings keep the beams outside the seen box's shadow (the strata beamPhotons drew apart).
+      const double perRay = type == gpu::kLightDirectional
+                                ? std::numbers::pi * sceneRadius() * sceneRadius() / emitted // irradiance 1 x the disk's share
+                                : static_cast<double>(lights.unitFlux[light].x) / emitted;
+      for (const Landing& h : landings) {
+        if (beamCrossesSeenBox(h.from, h.direction)) continue;
+        photons.push_back({h.position, h.normal, h.reflectance, glm::dvec3(perRay),
+                           std::numbers::pi * sceneRadius() * sceneRadius() / emitted / std::numbers::pi});
+      }
+    } else {
+      const glm::dvec3 flux = glm::dvec3(lights.unitFlux[light]) * (1.0 - reach.escapeDirect) / static_cast<double>(landings.size());
+      const double rc2 = reach.area / (std::numbers::pi * static_cast<double>(landings.size()));
+      for (const Landing& h : landings) photons.push_back({h.position, h.normal, h.reflectance, flux, rc2});
+    }
+    glm::dvec3 target(0.0);
+    for (const SurfacePoint& p : seen_) {
+      glm::dvec3 sum(0.0);
+      for (std::uint32_t k = 0; k < kSeenLandingsPerPoint && !photons.empty(); ++k) {
+        const Photon& h = photons[rng.below(static_cast<std::uint32_t>(photons.size()))];
+        glm::vec3 d = h.position - p.position;
+        const float r2 = glm::dot(d, d);
+        if (!(r2 > 0.0f)) continue;
+        d /= std::sqrt(r2);
+        const float cosP = glm::dot(p.normal, d), cosL = -glm::dot(h.normal, d);
+        if (cosP <= 0.0f || cosL <= 0.0f) continue;
+        glm::vec3 from = p.position + offsetAt(p.position, offset_) * p.normal;
+        glm::vec3 to = h.position + offsetAt(h.position, offset_) * h.normal;
+        if (!visible(from, to)) continue;
+        sum += h.flux * glm::dvec3(h.reflectance) * static_cast<double>(cosP * cosL) / std::max(static_cast<double>(r2), h.rc2);
+      }
+      // Photons drawn uniformly: the sum over all of them is photons / K times this one.
+      const glm::dvec3 e1 = sum * (static_cast<double>(photons.size()) / kSeenLandingsPerPoint) / std::numbers::pi;
+      target += glm::dvec3(p.reflectance) * e1 / std::numbers::pi;
+    }
+    for (int c = 0; c < 3; ++c) reach.seenFirstBounce[c] = seenModel_[c] > 0.0 ? static_cast<float>(target[c] / seenModel_[c]) : 0.0f;
+    reach.seenBounce = seenBounce_;
+    reach.seenFitted = true;
+  }
   return reach;
+}
+
+float ReachedSurfaces::sceneRadius() const {
+  const scene::Bounds& b = scene_->bounds;
+  return 0.5f * glm::length(b.hi - b.lo) + 1e-3f; // samplePoint's sphere and disk
+}
+
+// The rectangle, in the plane across `direction` through the scene's centre (frame t, b), that
+// the seen box projects to, clipped to the disk of the scene's radius; area 0 when empty.
+ReachedSurfaces::BeamRect ReachedSurfaces::seenBoxAcross(glm::vec3 direction) const {
+  const scene::Bounds& bounds = scene_->bounds;
+  const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
+  BeamRect r;
+  Frame f = frameAround(direction);
+  r.t = f.t;
+  r.b = f.b;
+  r.lo = glm::vec2(std::numeric_limits<float>::max());
+  r.hi = glm::vec2(-std::numeric_limits<float>::max());
+  for (int corner = 0; corner < 8; ++corner) {
+    glm::vec3 c((corner & 1) ? seenHi_.x : seenLo_.x, (corner & 2) ? seenHi_.y : seenLo_.y, (corner & 4) ? seenHi_.z : seenLo_.z);
+    glm::vec2 uv(glm::dot(c - centre, f.t), glm::dot(c - centre, f.b));
+    r.lo = glm::min(r.lo, uv);
+    r.hi = glm::max(r.hi, uv);
+  }
+  const float radius = sceneRadius();
+  r.lo = glm::max(r.lo, glm::vec2(-radius));
+  r.hi = glm::min(r.hi, glm::vec2(radius));
+  return r;
+}
+
+bool ReachedSurfaces::beamCrossesSeenBox(glm::vec3 from, glm::vec3 direction) const {
+  const scene::Bounds& bounds = scene_->bounds;
+  const BeamRect r = seenBoxAcross(direction);
+  const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
+  glm::vec2 uv(glm::dot(from - centre, r.t), glm::dot(from - centre, r.b));
+  return r.area() > 0.0f && uv.x >= r.lo.x && uv.x < r.hi.x && uv.y >= r.lo.y && uv.y < r.hi.y;
+}
+
+// Lights from outside the scene (directional, sky) as parallel beams across a disk of the scene's
+// radius (the sky: a beam for every direction, uniform, radiance 1 times 4 pi; the sun: its one
+// direction, irradiance 1). A room in a large world (classroom's 221 m ground) gets almost none of
+// the first landings, so the beams that cross the seen box (grown by dmax) are drawn apart:
+// kSeenBeamRays uniform over the box's projection, each carrying irradiance x projected area / N;
+// measure() keeps the first landings outside that stratum. Landings only (misses carry nothing).
+std::vector<ReachedSurfaces::Photon> ReachedSurfaces::beamPhotons(const LightSet& lights, std::size_t light, StreamRng& rng) const {
+  auto uni = [](StreamRng& r) { return r.next(); };
+  const scene::Bounds& bounds = scene_->bounds;
+  const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
+  const float radius = sceneRadius();
+  const bool sky = lights.lights[light].info.x == gpu::kLightBackground;
+  std::vector<Photon> out;
+  for (std::uint32_t i = 0; i < kSeenBeamRays; ++i) {
+    const glm::vec3 direction = sky ? sphereDirection(uni(rng), uni(rng)) : glm::normalize(glm::vec3(lights.lights[light].direction));
+    const BeamRect r = seenBoxAcross(direction);
+    if (!(r.area() > 0.0f)) continue;
+    glm::vec2 uv(r.lo.x + uni(rng) * (r.hi.x - r.lo.x), r.lo.y + uni(rng) * (r.hi.y - r.lo.y));
+    if (glm::dot(uv, uv) > radius * radius) continue; // outside the disk: no light there
+    bvh::Ray ray{.origin = centre - 2.0f * radius * direction + uv.x * r.t + uv.y * r.b, .direction = direction};
+    bvh::Hit hit = bvh::closestHit(bvh_, ray);
+    if (!hit.hit()) continue;
+    const glm::uvec3 tri = scene_->triangles[hit.primitive];
+    glm::vec3 a = scene_->positions[tri.x], b = scene_->positions[tri.y], c = scene_->positions[tri.z];
+    glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+    if (glm::dot(n, direction) > 0.0f) n = -n;
+    const double share = static_cast<double>(r.area()) / kSeenBeamRays; // cross-section per ray
+    const double flux = (sky ? 4.0 * std::numbers::pi : 1.0) * share;
+    out.push_back({ray.origin + hit.t * direction, n, reflectance_[hit.primitive], glm::dvec3(flux), share / std::numbers::pi});
+  }
+  return out;
+}
+
+void ReachedSurfaces::setSeenView(const SeenView& view) {
+  seen_.clear();
+  seenModel_ = glm::dvec3(0.0);
+  seenLo_ = glm::vec3(std::numeric_limits<float>::max());
+  seenHi_ = glm::vec3(-std::numeric_limits<float>::max());
+  const scene::Scene& scene = *scene_;
+  const float tanHalf = std::tan(0.5f * view.yfov);
+  const glm::vec3 right = glm::normalize(glm::cross(view.forward, view.up));
+  glm::dvec3 bounce(0.0);
+  std::size_t bounceRays = 0;
+  std::mt19937 rng(0x5ee9u);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  for (std::uint32_t y = 0; y < kSeenGrid; ++y)
+    for (std::uint32_t x = 0; x < kSeenGrid; ++x) {
+      // A jittered grid over the image.
+      float sx = (2.0f * (static_cast<float>(x) + uni(rng)) / kSeenGrid - 1.0f) * tanHalf * view.aspect;
+      float sy = (1.0f - 2.0f * (static_cast<float>(y) + uni(rng)) / kSeenGrid) * tanHalf;
+      glm::vec3 d = glm::normalize(view.forward + sx * right + sy * view.up);
+      bvh::Hit hit = bvh::closestHit(bvh_, {.origin = view.position, .direction = d});
+      if (!hit.hit()) continue;
+      const glm::uvec3 tri = scene.triangles[hit.primitive];
+      glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
+      glm::vec3 n = glm::cross(b - a, c - a);
+      if (!(glm::length(n) > 0.0f)) continue;
+      n = glm::normalize(n);
+      if (glm::dot(n, d) > 0.0f) n = -n; // the side the camera sees
+      const SurfacePoint p{view.position + hit.t * d, n, reflectance_[hit.primitive]};
+      // W_c (or W) at P as obscurance.glsl estimates it: cosine rays of length dmax.
+      glm::dvec3 w(0.0);
+      for (std::uint32_t k = 0; k < kSeenObscuranceRays; ++k) {
+        // What comes back at all (any distance): the later bounces' q.
+        bvh::Hit any = bvh::closestHit(bvh_, {.origin = p.position + offsetAt(p.position, offset_) * n,
+                                              .direction = cosineDirection(n, uni(rng), uni(rng))});
+        if (any.hit()) bounce += glm::dvec3(reflectance_[any.primitive]);
+        ++bounceRays;
+        glm::vec3 dir = cosineDirection(n, uni(rng), uni(rng));
+        bvh::Hit q = bvh::closestHit(bvh_, {.origin = p.position + offsetAt(p.position, offset_) * n, .direction = dir,
+                                            .tmin = 0.0f, .tmax = view.dMax});
+        glm::vec3 r = view.colourBleeding ? view.averageReflectance : glm::vec3(1.0f);
+        float rho = 1.0f;
+        if (q.hit()) {
+          rho = obscuranceRho(q.t, view.dMax, view.rho, view.tau);
+          r = view.colourBleeding ? reflectance_[q.primitive] : glm::vec3(1.0f);
+        }
+        w += glm::dvec3(r) * static_cast<double>(rho);
+      }
+      seenModel_ += glm::dvec3(p.reflectance) * w / static_cast<double>(kSeenObscuranceRays);
+      seen_.push_back(p);
+      seenLo_ = glm::min(seenLo_, p.position - glm::vec3(view.dMax));
+      seenHi_ = glm::max(seenHi_, p.position + glm::vec3(view.dMax));
+    }
+  seenBounce_ = bounceRays ? glm::vec3(bounce / static_cast<double>(bounceRays)) : glm::vec3(0.0f);
 }
 
 } // namespace obscura::render

@@ -16,7 +16,20 @@
 //      open front lose that light; the paper's I_a assumes a closed scene).
 // I_a's weight for light s then uses A_s, R_s and the escapes in place of A_t and R_ave
 // (ambient.h): flux (1 - e_0) / (pi A_s) / (1 - R_s (1 - e_1)), which keeps I_a linear in every
-// emission. The rays run on the CPU (bvh::closestHit / anyHit): a few
+// emission.
+//
+// The Seen refinement (OURS, AmbientModel::Seen): a light's flux does not spread evenly over what
+// it reaches. A lamp in a basement or a skylight over a stairwell lights its own corner; the rest
+// of the reached area sees that light only after several bounces, or through a gap at a grazing
+// angle. So, for the points the camera sees, the one-bounce irradiance from light s is measured
+// with the landing points of step 1 as virtual point lights (each carrying flux/emitted, reflected
+// by its surface's R, one shadow ray to a few of them per point), and the first-bounce term of
+// I_a is fitted to it: the ambient term's first bounce is R(P) x W_c(P) x F_s, so
+//   F_s = sum_P R(P) E_1,s(P) / pi  /  sum_P R(P) W_c(P)          (per channel)
+// with W_c (or W, grey) measured at the same points with the render's rho and dmax. F_s replaces
+// flux (1 - e_0) / (pi A_s) and I_a's weight is F_s x the same series of later bounces. F_s is
+// still linear in the light's emission (flux per landing), so relighting holds; it is fitted to
+// one camera (like the default dmax). The rays run on the CPU (bvh::closestHit / anyHit): a few
 // thousand per light, deterministic for a given scene (fixed seeds), so an incremental edit and a
 // fresh render agree.
 //
@@ -27,6 +40,7 @@
 // move, finds in the edited scene what it found before.
 #pragma once
 #include <cstdint>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -65,8 +79,31 @@ struct LightReach {
   // `landings` rays that hit something (secondary_reflectors.h marks the strongly lit ones).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> landedTriangles;
   std::uint32_t landings = 0;
+  // Seen: the fitted first-bounce term F_s (see above); valid when seenFitted.
+  glm::vec3 seenFirstBounce{0.0f};
+  // Seen: q of the later bounces around the seen points, R (1 - e) of unbounded cosine rays from
+  // them (the same for every light: bounces after the first happen where the camera looks).
+  glm::vec3 seenBounce{0.0f};
+  bool seenFitted = false;
   ReachRays rays;
 };
+
+class StreamRng; // reached_surfaces.cpp: a random stream per ray
+
+// The camera's view for the Seen fit: where its rays land and the obscurance settings there.
+struct SeenView {
+  glm::vec3 position{0.0f}, forward{0.0f, 0.0f, -1.0f}, up{0.0f, 1.0f, 0.0f};
+  float yfov = 0.8f, aspect = 1.0f;
+  float dMax = 1.0f;
+  std::uint32_t rho = 0;  // gpu::kRhoSqrt, kRhoExp or kRhoAo
+  float tau = 3.0f;
+  bool colourBleeding = true;
+  glm::vec3 averageReflectance{0.5f}; // R(Q) of a miss within dmax
+  bool operator==(const SeenView&) const = default;
+};
+
+// rho(d) [RTO §3], the C++ twin of shaders/lib/obscurance.glsl's rho().
+float obscuranceRho(float d, float dMax, std::uint32_t kind, float tau);
 
 class ReachedSurfaces {
 public:
@@ -88,6 +125,11 @@ public:
 
   double totalArea() const { return totalArea_; }
 
+  // Seen points for the Seen fit (measure() then fits F_s); without them measure() leaves
+  // seenFitted false.
+  void setSeenView(const SeenView& view);
+  std::size_t seenPoints() const { return seen_.size(); }
+
   // Light rays per light and surface samples over the scene (OURS: a few thousand keep the
   // estimate within a percent or two of the reached fraction, tested, at ~0.01 s per light).
   static constexpr std::uint32_t kLightRays = 1024;
@@ -95,6 +137,12 @@ public:
   static constexpr std::uint32_t kVisibilityTries = 4; // shadow rays per sample and kind of target
   static constexpr std::uint8_t kNotSeen = 0xff;
   static constexpr std::uint32_t kTries = 2 * kVisibilityTries; // light points, then landing points
+  // Seen fit: camera points (a grid), obscurance rays at each, landings (virtual point lights)
+  // tested from each (OURS: ~16k shadow rays per light; the fit's spread over seeds is a few %).
+  static constexpr std::uint32_t kSeenGrid = 24;
+  static constexpr std::uint32_t kSeenObscuranceRays = 16;
+  static constexpr std::uint32_t kSeenLandingsPerPoint = 32;
+  static constexpr std::uint32_t kSeenBeamRays = 1024; // sun and sky: beams across the seen box
 
 private:
   struct SurfacePoint {
@@ -103,9 +151,28 @@ private:
   };
   struct Replay; // what remeasure reuses
   LightReach trace(const LightSet& lights, std::size_t light, const Replay* replay) const;
+  struct Photon { // a landing point as a virtual point light of the Seen fit
+    glm::vec3 position, normal, reflectance;
+    glm::dvec3 flux;
+    double rc2; // r_c^2: its share of the lit area / pi
+  };
+  struct BeamRect {
+    glm::vec3 t{0.0f}, b{0.0f};
+    glm::vec2 lo{0.0f}, hi{0.0f};
+    float area() const { return hi.x > lo.x && hi.y > lo.y ? (hi.x - lo.x) * (hi.y - lo.y) : 0.0f; }
+  };
+  float sceneRadius() const;
+  BeamRect seenBoxAcross(glm::vec3 direction) const;
+  bool beamCrossesSeenBox(glm::vec3 from, glm::vec3 direction) const;
+  std::vector<Photon> beamPhotons(const LightSet& lights, std::size_t light, StreamRng& rng) const;
   const scene::Scene* scene_;
   bvh::Bvh bvh_;
   std::vector<SurfacePoint> samples_;
+  std::vector<glm::vec3> reflectance_; // per triangle
+  std::vector<SurfacePoint> seen_;     // camera points (reflectance = R(P))
+  glm::dvec3 seenModel_{0.0};
+  glm::vec3 seenLo_{0.0f}, seenHi_{0.0f}; // the seen points' box grown by dmax
+  glm::vec3 seenBounce_{0.0f};            // q around the seen points (LightReach::seenBounce)          // sum_P R(P) W_c(P): the model's first bounce per unit F_s
   double totalArea_ = 0.0;
   scene::Bounds bounds_; // the scene's: where the sky's and the sun's light points lie
   float offset_ = 1e-5f; // ray-origin offset along the normal: 1e-5 of the scene's largest extent
