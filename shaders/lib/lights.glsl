@@ -122,8 +122,8 @@ bool useSpatialSelection(uint count) {
 // sum and the number of unbounded lights with power. A hit draws several light samples (N_s shadow
 // rays, the specular pass's vertex samples, MIS densities of lobe rays that reach a light) from the
 // same p and n, so the weights are computed once per point and kept here: the per-sample cost is a
-// walk over stored numbers, not count importance evaluations (each a dozen transcendental-free but
-// divergent loads and square roots), and lavapipe's loop limiter is charged once per point. The
+// walk over stored numbers, not `count` importance evaluations (each loads a light's bounds and
+// takes a few square roots), and lavapipe's loop limiter is charged once per point. The
 // numbers are the ones every sample would compute, in the same order, so images are unchanged.
 float gImportance[kMaxSpatialLights];
 float gImportanceTotal = 0.0;
