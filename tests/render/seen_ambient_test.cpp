@@ -180,9 +180,12 @@ TEST(SeenAmbient, SunOnASmallRoomInALargeWorldIsFittedFromBeamsAcrossTheSeenBox)
     return bvh::anyHit(tree, {.origin = q, .direction = -sunTravels}) ? 0.0 : static_cast<double>(cosine);
   });
   ASSERT_GT(expected, 0.0);
-  // Measured 12 % low (deterministic seeds): the clamp r_c of the photons on the sunlit floor next
-  // to the seen points takes more here than in the closed room. Without the beams the fit is 0.
-  EXPECT_NEAR(r.seenFirstBounce.x, expected, 0.15 * expected);
+  // Low by a quarter: over 12 seeds (the light's name seeds its streams) the fit is 0.75 of this
+  // estimate on average, 0.64 to 0.97, standard deviation 0.08: the clamp r_c of the photons on the
+  // sunlit floor next to the seen points takes more here than in the closed room. Asserted: within
+  // 3 standard deviations of that mean. Without the beams the fit is 0.
+  EXPECT_GT(r.seenFirstBounce.x, 0.5 * expected);
+  EXPECT_LT(r.seenFirstBounce.x, 1.0 * expected);
 }
 
 TEST(SeenAmbient, ALampTheCamerasRoomCannotSeeAddsNoAmbientLightThere) {
