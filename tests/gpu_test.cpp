@@ -1,5 +1,8 @@
 #include "gpu_test.h"
 
+#include <algorithm>
+#include <cstdlib>
+
 namespace obscura::test {
 
 gpu::Context& testContext() {
@@ -8,6 +11,14 @@ gpu::Context& testContext() {
 }
 
 std::string sharedScene(const std::string& relative) { return std::string(OBSCURA_SHARED_SCENES) + "/" + relative; }
+int largestChannelDifference(const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b) {
+  int worst = 0;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      worst = std::max(worst, std::abs(static_cast<int>((a[i] >> (8 * c)) & 255u) - static_cast<int>((b[i] >> (8 * c)) & 255u)));
+  return worst;
+}
+
 std::string repoPath(const std::string& relative) { return std::string(OBSCURA_SOURCE_DIR) + "/" + relative; }
 
 } // namespace obscura::test

@@ -1,6 +1,9 @@
 // gpu_test.h — the Vulkan context shared by GPU tests, and the rule that any validation message
 // fails the test that caused it.
 #pragma once
+#include <cstdint>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "gpu/context.h"
@@ -23,6 +26,10 @@ protected:
 private:
   std::uint64_t messagesBefore_ = 0;
 };
+
+// The largest difference, in levels of 255, between the R, G or B bytes of two displays (RGBA8
+// words of the same size, such as ObscuranceRenderer::display()).
+int largestChannelDifference(const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b);
 
 // Path of a scene in ../shared/scenes (the real test scenes nobody here wrote).
 std::string sharedScene(const std::string& relative);

@@ -422,12 +422,7 @@ protected:
     r.composeDisplay(exposure);
     const auto fast = r.display();
     ASSERT_EQ(full.size(), fast.size());
-    int worst = 0;
-    for (std::size_t i = 0; i < full.size(); ++i)
-      for (int c = 0; c < 3; ++c)
-        worst = std::max(worst, std::abs(static_cast<int>((full[i] >> (8 * c)) & 255u) -
-                                         static_cast<int>((fast[i] >> (8 * c)) & 255u)));
-    EXPECT_LE(worst, 2);
+    EXPECT_LE(largestChannelDifference(full, fast), 2);
   }
 };
 

@@ -1,5 +1,7 @@
 #include "render/scene/free_path.h"
 
+#include "render/scene/camera_grid.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -19,8 +21,7 @@ FreePath measureFreePath(const scene::Scene& scene, const bvh::Bvh& bvh, const s
   constexpr int kGrid = 48;
   FreePath out;
   const float aspect = camera.aspectRatio > 0.0f ? camera.aspectRatio : 4.0f / 3.0f;
-  const float tanHalf = std::tan(0.5f * camera.yfov);
-  const glm::vec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
+  const GridCamera view{camera.position, camera.forward, camera.up, camera.yfov, aspect};
   const float extent = 4.0f * boundsDMax(scene.bounds); // the largest side
   std::mt19937 rng(0xd15ca1u);
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
@@ -28,18 +29,9 @@ FreePath measureFreePath(const scene::Scene& scene, const bvh::Bvh& bvh, const s
   std::size_t escaped = 0;
   for (int y = 0; y < kGrid; ++y)
     for (int x = 0; x < kGrid; ++x) {
-      float sx = (2.0f * (static_cast<float>(x) + 0.5f) / kGrid - 1.0f) * tanHalf * aspect;
-      float sy = (1.0f - 2.0f * (static_cast<float>(y) + 0.5f) / kGrid) * tanHalf;
-      glm::vec3 d = glm::normalize(camera.forward + sx * right + sy * camera.up);
-      bvh::Hit hit = bvh::closestHit(bvh, {.origin = camera.position, .direction = d});
-      if (!hit.hit()) continue;
-      const glm::uvec3 t = scene.triangles[hit.primitive];
-      glm::vec3 a = scene.positions[t.x], b = scene.positions[t.y], c = scene.positions[t.z];
-      glm::vec3 n = glm::cross(b - a, c - a);
-      if (!(glm::length(n) > 0.0f)) continue;
-      n = glm::normalize(n);
-      if (glm::dot(n, d) > 0.0f) n = -n; // the side the camera sees
-      glm::vec3 p = camera.position + hit.t * d;
+      const auto seen = firstHitThroughGrid(scene, bvh, view, static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, kGrid);
+      if (!seen) continue;
+      const glm::vec3 p = seen->position, n = seen->normal;
       float offset = std::max(1e-5f * extent, 4e-6f * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}));
       // Cosine direction about n.
       glm::vec3 helper = std::abs(n.x) > 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);

@@ -1,5 +1,7 @@
 #include "render/scene/reached_surfaces.h"
 
+#include "render/scene/camera_grid.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -525,8 +527,7 @@ void ReachedSurfaces::setSeenView(const SeenView& view) {
   seenLo_ = glm::vec3(std::numeric_limits<float>::max());
   seenHi_ = glm::vec3(-std::numeric_limits<float>::max());
   const scene::Scene& scene = *scene_;
-  const float tanHalf = std::tan(0.5f * view.yfov);
-  const glm::vec3 right = glm::normalize(glm::cross(view.forward, view.up));
+  const GridCamera camera{view.position, view.forward, view.up, view.yfov, view.aspect};
   glm::dvec3 bounce(0.0);
   std::size_t bounceRays = 0;
   std::mt19937 rng(0x5ee9u);
@@ -534,18 +535,12 @@ void ReachedSurfaces::setSeenView(const SeenView& view) {
   for (std::uint32_t y = 0; y < kSeenGrid; ++y)
     for (std::uint32_t x = 0; x < kSeenGrid; ++x) {
       // A jittered grid over the image.
-      float sx = (2.0f * (static_cast<float>(x) + uni(rng)) / kSeenGrid - 1.0f) * tanHalf * view.aspect;
-      float sy = (1.0f - 2.0f * (static_cast<float>(y) + uni(rng)) / kSeenGrid) * tanHalf;
-      glm::vec3 d = glm::normalize(view.forward + sx * right + sy * view.up);
-      bvh::Hit hit = bvh::closestHit(bvh_, {.origin = view.position, .direction = d});
-      if (!hit.hit()) continue;
-      const glm::uvec3 tri = scene.triangles[hit.primitive];
-      glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
-      glm::vec3 n = glm::cross(b - a, c - a);
-      if (!(glm::length(n) > 0.0f)) continue;
-      n = glm::normalize(n);
-      if (glm::dot(n, d) > 0.0f) n = -n; // the side the camera sees
-      const SurfacePoint p{view.position + hit.t * d, n, reflectance_[hit.primitive]};
+      const float gx = static_cast<float>(x) + uni(rng);
+      const float gy = static_cast<float>(y) + uni(rng);
+      const auto hit = firstHitThroughGrid(scene, bvh_, camera, gx, gy, static_cast<int>(kSeenGrid));
+      if (!hit) continue;
+      const glm::vec3 n = hit->normal;
+      const SurfacePoint p{hit->position, n, reflectance_[hit->primitive]};
       // W_c (or W) at P as obscurance.glsl estimates it: cosine rays of length dmax.
       glm::dvec3 w(0.0);
       for (std::uint32_t k = 0; k < kSeenObscuranceRays; ++k) {
