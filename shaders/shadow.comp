@@ -42,7 +42,7 @@ void main() {
   uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x5bd1e995u);
   StepBudget budget = newStepBudget();
   const vec4 lightShift = rngNext4(rng); // the hit's light samples: one shifted low-discrepancy set
-  if ((pc.band.z & kShadeFlagPerLight) != 0u) {
+  if (shadesOneLight()) {
     const uint light = pc.band.w;
     uint taken;
     vec3 direct = directLightFromOne(sp, light, lightShift, budget, taken);

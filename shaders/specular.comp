@@ -72,7 +72,7 @@ void main() {
   const uint lightCount = pc.counts.x;
   const uint shadowRays = lightCount > 0u ? pc.counts.y : 0u;
   const uint maxDepth = uint(pc.params.w);
-  const bool oneLight = (pc.band.z & kShadeFlagPerLight) != 0u;
+  const bool oneLight = shadesOneLight();
   const uint addedLight = pc.band.w;
   const bool noDirect = (pc.band.z & kShadeFlagNoDirect) != 0u;
 

@@ -151,6 +151,7 @@ void relightScene(RelightOptions& o) {
   std::deque<scene::Scene> scenes;
   std::deque<bvh::Bvh> trees;
   render::ObscuranceRenderer renderer(context, loaded.scene, loaded.bvh, settings);
+  renderer.prepareForEdits();
   const scene::Scene* current = &loaded.scene;
   const bvh::Bvh* currentBvh = &loaded.bvh;
   nlohmann::json bvhUpdate; // how the last geometry edit updated the BVH, for edits.jsonl

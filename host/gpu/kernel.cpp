@@ -21,7 +21,8 @@ KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> sp
 }
 
 Kernel::Kernel(const Context& context, const KernelDesc& desc)
-    : context_(&context), name_(desc.name), bindings_(desc.bindings), pushBytes_(desc.pushConstantBytes) {
+    : context_(&context), name_(desc.name), bindings_(desc.bindings), pushBytes_(desc.pushConstantBytes),
+      spirv_(desc.spirv), specConstants_(desc.specConstants) {
   const auto& device = context.device();
   std::vector<vk::DescriptorSetLayoutBinding> layoutBindings;
   for (std::uint32_t i = 0; i < bindings_.size(); ++i)
@@ -39,28 +40,7 @@ Kernel::Kernel(const Context& context, const KernelDesc& desc)
                                                  .pushConstantRangeCount = pushBytes_ ? 1u : 0u,
                                                  .pPushConstantRanges = pushBytes_ ? &range : nullptr});
 
-  vk::raii::ShaderModule module = device.createShaderModule(
-      {.codeSize = desc.spirv.size_bytes(), .pCode = desc.spirv.data()});
-  std::vector<vk::SpecializationMapEntry> entries;
-  std::vector<std::uint32_t> values;
-  for (std::size_t i = 0; i < desc.specConstants.size(); ++i) {
-    entries.push_back({.constantID = desc.specConstants[i].id,
-                       .offset = static_cast<std::uint32_t>(i * 4),
-                       .size = 4});
-    values.push_back(desc.specConstants[i].value);
-  }
-  vk::SpecializationInfo specialization{.mapEntryCount = static_cast<std::uint32_t>(entries.size()),
-                                        .pMapEntries = entries.data(),
-                                        .dataSize = values.size() * 4,
-                                        .pData = values.data()};
-  vk::ComputePipelineCreateInfo pipelineInfo{
-      .stage = {.stage = vk::ShaderStageFlagBits::eCompute,
-                .module = *module,
-                .pName = "main",
-                .pSpecializationInfo = entries.empty() ? nullptr : &specialization},
-      .layout = *pipelineLayout_};
-  pipeline_ = vk::raii::Pipeline(device, nullptr, pipelineInfo);
-  context.setName(pipeline_, name_);
+  if (!desc.deferCompile) compile();
 
   std::uint32_t storage = 0, texel = 0;
   for (auto kind : bindings_) (kind == BindingKind::StorageBuffer ? storage : texel)++;
@@ -76,6 +56,33 @@ Kernel::Kernel(const Context& context, const KernelDesc& desc)
   vk::raii::DescriptorSets sets(device, {.descriptorPool = *pool_, .descriptorSetCount = setCount,
                                          .pSetLayouts = layouts.data()});
   for (auto& set : sets) sets_.push_back(std::move(set));
+}
+
+void Kernel::compile() const {
+  if (compiled()) return;
+  const auto& device = context_->device();
+  vk::raii::ShaderModule module = device.createShaderModule(
+      {.codeSize = spirv_.size_bytes(), .pCode = spirv_.data()});
+  std::vector<vk::SpecializationMapEntry> entries;
+  std::vector<std::uint32_t> values;
+  for (std::size_t i = 0; i < specConstants_.size(); ++i) {
+    entries.push_back({.constantID = specConstants_[i].id,
+                       .offset = static_cast<std::uint32_t>(i * 4),
+                       .size = 4});
+    values.push_back(specConstants_[i].value);
+  }
+  vk::SpecializationInfo specialization{.mapEntryCount = static_cast<std::uint32_t>(entries.size()),
+                                        .pMapEntries = entries.data(),
+                                        .dataSize = values.size() * 4,
+                                        .pData = values.data()};
+  vk::ComputePipelineCreateInfo pipelineInfo{
+      .stage = {.stage = vk::ShaderStageFlagBits::eCompute,
+                .module = *module,
+                .pName = "main",
+                .pSpecializationInfo = entries.empty() ? nullptr : &specialization},
+      .layout = *pipelineLayout_};
+  pipeline_ = vk::raii::Pipeline(device, nullptr, pipelineInfo);
+  context_->setName(pipeline_, name_);
 }
 
 const vk::raii::DescriptorSet& Kernel::descriptorSet(std::uint32_t set) const {
@@ -111,6 +118,7 @@ void Kernel::bind(std::uint32_t binding, const TexelBuffer& buffer, std::uint32_
 }
 
 void Kernel::bindCommon(const vk::raii::CommandBuffer& cmd, const void* push, std::uint32_t set) const {
+  compile();
   cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_);
   cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipelineLayout_, 0, {*descriptorSet(set)}, {});
   if (pushBytes_) {

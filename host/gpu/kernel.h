@@ -29,6 +29,10 @@ struct KernelDesc {
   // Descriptor sets: one per frame band (render/frame/frame_layout.h), each bound to that band's
   // buffers once; a dispatch names the set it uses.
   std::uint32_t setCount = 1;
+  // Compile the pipeline on the first dispatch (or `compile()`), not in the constructor: for the
+  // variants only edits use (probes, one light alone), which a plain render never dispatches. On
+  // lavapipe each pipeline is an LLVM compile of the whole shader, ~0.1 s of CPU apiece.
+  bool deferCompile = false;
 };
 
 // A kernel whose bindings are all storage buffers (the frame passes: compose, tonemap, ...).
@@ -49,6 +53,10 @@ public:
   void dispatchIndirect(const vk::raii::CommandBuffer& cmd, const Buffer& args, vk::DeviceSize offset,
                         const void* push = nullptr, std::uint32_t set = 0) const;
 
+  // Creates the pipeline now if its compile was deferred (KernelDesc::deferCompile).
+  void compile() const;
+  bool compiled() const { return static_cast<bool>(*pipeline_); }
+
   const std::string& name() const { return name_; }
   std::uint32_t setCount() const { return static_cast<std::uint32_t>(sets_.size()); }
 
@@ -62,7 +70,10 @@ private:
   std::uint32_t pushBytes_ = 0;
   vk::raii::DescriptorSetLayout setLayout_ = nullptr;
   vk::raii::PipelineLayout pipelineLayout_ = nullptr;
-  vk::raii::Pipeline pipeline_ = nullptr;
+  // What a deferred compile needs: the shader (static, embedded) and its specialisation.
+  std::span<const std::uint32_t> spirv_;
+  std::vector<SpecConstant> specConstants_;
+  mutable vk::raii::Pipeline pipeline_ = nullptr;
   vk::raii::DescriptorPool pool_ = nullptr;
   std::vector<vk::raii::DescriptorSet> sets_;
 };

@@ -244,6 +244,12 @@ void ObscuranceRenderer::bindAll() {
   }
 }
 
+void ObscuranceRenderer::prepareForEdits() const {
+  shadow_.compileEditKernels();
+  obscurance_.compileEditKernels();
+  specularPass_.compileEditKernels();
+}
+
 gpu::ShadePush ObscuranceRenderer::forLight(gpu::ShadePush push, std::uint32_t light) {
   push.band.z |= gpu::kShadeFlagPerLight;
   push.band.w = light;

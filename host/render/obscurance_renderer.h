@@ -161,6 +161,10 @@ public:
   // update I_a. Indices shift like a vector's.
   std::size_t addLight(const scene::PunctualLight& light);
   void removeLight(std::size_t index);
+  // Compiles the kernels that only edits use (the probes of a geometry edit, the passes for one
+  // light alone), which are otherwise compiled on an edit's first dispatch: a program that will
+  // edit (relight --edits, the window) calls this first, so that the first edit's time is its own.
+  void prepareForEdits() const;
   // A geometry edit [IVR §3.3]: `edited` (with its BVH) replaces the scene — the same lights,
   // materials and camera — and `changed` holds the world boxes of what changed (an object's old
   // and new places). Only the pixels those can change (dirty.comp) are retraced, for every sample

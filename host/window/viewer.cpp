@@ -88,6 +88,7 @@ Viewer::Viewer(const gpu::ContextOptions& device, scene::Scene scene, bvh::Bvh b
   config_.obscurance = settings;
   renderer_ = std::make_unique<render::ObscuranceRenderer>(context_, scenes_.back(), bvhs_.back(), settings);
   renderer_->configure(fullSettings());
+  renderer_->prepareForEdits(); // light drags and object moves are what the window is for
   denoiser_ = std::make_unique<render::Denoiser>(context_, *renderer_);
   const auto& names = renderer_->lights().names;
   for (std::size_t i = 0; i < names.size(); ++i)

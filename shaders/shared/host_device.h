@@ -278,6 +278,12 @@ OBS_CONST uint kSpecConstantProbe = 0u;
 // obscurance pass go to that variant. Left out, the branch costs the pass 40 % of its time on
 // lavapipe even when no ray takes it (docs/BENCHMARKS.md, issue 10).
 OBS_CONST uint kSpecConstantReflectors = 1u;
+// The specialisation constant (a bool) that makes a shading kernel shade one light alone (kPerLight,
+// lib/shading_bindings.glsl): kShadeFlagPerLight dispatches that do not probe go to that variant,
+// which leaves out the code for all lights at once (the specular pass's ambient gather and light
+// selection). Like the reflectors' branch, that code slows the per-light path on lavapipe even
+// when no invocation takes it (docs/BENCHMARKS.md, adding a light).
+OBS_CONST uint kSpecConstantPerLight = 2u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

@@ -5,6 +5,6 @@
 namespace obscura::render {
 
 ObscurancePass::ObscurancePass(const gpu::Context& context, std::uint32_t bands)
-    : PixelShadingPass(context, "obscurance", kSpirv_obscurance, bands, /*reflectorVariant=*/true) {}
+    : PixelShadingPass(context, "obscurance", kSpirv_obscurance, bands, {.reflectors = true}) {}
 
 } // namespace obscura::render

@@ -9,21 +9,38 @@
 
 namespace obscura::render {
 
+// The specialised variants a pixel shading pass compiles beside its kernel and its probing kernel.
+struct ShadingVariants {
+  // The shader gathers the secondary reflectors' light when specialised for it
+  // (kSpecConstantReflectors, lib/obscurance.glsl): that kernel takes the dispatches with
+  // kFlagSecondaryReflectors, and the others leave that code out.
+  bool reflectors = false;
+  // The shader shades one light alone when specialised for it (kSpecConstantPerLight): that kernel
+  // takes the kShadeFlagPerLight dispatches that do not probe.
+  bool perLight = false;
+};
+
 class PixelShadingPass {
 public:
-  // `reflectorVariant`: the shader gathers the secondary reflectors' light when specialised for
-  // it (kSpecConstantReflectors, lib/obscurance.glsl): a third kernel takes the dispatches with
-  // kFlagSecondaryReflectors, and the other two leave that code out.
   PixelShadingPass(const gpu::Context& context, const char* name, std::span<const std::uint32_t> spirv,
-                   std::uint32_t bands, bool reflectorVariant = false)
+                   std::uint32_t bands, ShadingVariants variants = {})
       : kernel_(context, shadingKernelDesc(name, spirv, bands)), probe_(context, probingKernelDesc(name, spirv, bands)),
-        reflectors_(reflectorVariant ? std::make_unique<gpu::Kernel>(context, reflectorKernelDesc(name, spirv, bands))
-                                     : nullptr) {}
+        reflectors_(variants.reflectors ? std::make_unique<gpu::Kernel>(context, reflectorKernelDesc(name, spirv, bands))
+                                        : nullptr),
+        perLight_(variants.perLight ? std::make_unique<gpu::Kernel>(context, perLightKernelDesc(name, spirv, bands))
+                                    : nullptr) {}
 
   void bind(std::uint32_t band, const ShadingInputs& in) {
     bindShadingInputs(kernel_, band, in);
     bindShadingInputs(probe_, band, in);
     if (reflectors_) bindShadingInputs(*reflectors_, band, in);
+    if (perLight_) bindShadingInputs(*perLight_, band, in);
+  }
+
+  // Compiles now the kernels only edits dispatch (deferred: KernelDesc::deferCompile).
+  void compileEditKernels() const {
+    probe_.compile();
+    if (perLight_) perLight_->compile();
   }
 
   // Every pixel of the band; or, with `dirtyOf` (and kShadeFlagDirtyOnly in the push), only the
@@ -37,7 +54,10 @@ public:
     // A geometry edit retraces every pixel while the reflectors are on (they are marked anew), so
     // nothing probes with them; the probing kernel has no reflectors' code.
     if (probe && reflectors) throw std::logic_error("PixelShadingPass: no probing variant with secondary reflectors");
-    const gpu::Kernel& kernel = probe ? probe_ : reflectors ? *reflectors_ : kernel_;
+    const gpu::Kernel& kernel = probe                                   ? probe_
+                                : reflectors                            ? *reflectors_
+                                : perLight_ && takesPerLightVariant(p) ? *perLight_
+                                                                        : kernel_;
     if (dirtyOf != nullptr) {
       kernel.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &p, band);
       return;
@@ -50,6 +70,7 @@ private:
   gpu::Kernel kernel_;
   gpu::Kernel probe_;
   std::unique_ptr<gpu::Kernel> reflectors_;
+  std::unique_ptr<gpu::Kernel> perLight_;
 };
 
 } // namespace obscura::render

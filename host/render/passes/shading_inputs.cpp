@@ -12,6 +12,7 @@ gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_
 gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
   gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
   desc.name += ".probe";
+  desc.deferCompile = true; // edits only
   desc.specConstants.push_back({.id = gpu::kSpecConstantProbe, .value = 1u});
   return desc;
 }
@@ -20,6 +21,14 @@ gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint3
   gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
   desc.name += ".reflectors";
   desc.specConstants.push_back({.id = gpu::kSpecConstantReflectors, .value = 1u});
+  return desc;
+}
+
+gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
+  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
+  desc.name += ".perlight";
+  desc.deferCompile = true; // added lights only (and per-light shadow sampling)
+  desc.specConstants.push_back({.id = gpu::kSpecConstantPerLight, .value = 1u});
   return desc;
 }
 

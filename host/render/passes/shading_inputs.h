@@ -28,6 +28,12 @@ gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_
 gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
 // The variant with the secondary reflectors' code (kSpecConstantReflectors): "<name>.reflectors".
 gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+// The variant for one light alone (kSpecConstantPerLight): "<name>.perlight".
+gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+// Whether a dispatch with `push` goes to the per-light variant: one light, not probing.
+inline bool takesPerLightVariant(const gpu::ShadePush& push) {
+  return (push.band.z & gpu::kShadeFlagPerLight) != 0 && (push.band.z & gpu::kShadeFlagProbe) == 0;
+}
 
 // Binds descriptor set `band` of a shading kernel.
 void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInputs& in);

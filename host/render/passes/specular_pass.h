@@ -11,6 +11,11 @@ public:
   SpecularPass(const gpu::Context& context, std::uint32_t bands);
 
   void bind(std::uint32_t band, const ShadingInputs& in);
+  // Compiles now the kernels only edits dispatch (deferred: KernelDesc::deferCompile).
+  void compileEditKernels() const {
+    probe_.compile();
+    perLight_.compile();
+  }
   // Clears band `band`'s queue, fills it and dispatches the paths (barriers included).
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
               const ObscuranceFrame& frame, const gpu::ShadePush& push) const;
@@ -18,7 +23,8 @@ public:
 private:
   gpu::Kernel queue_;
   gpu::Kernel paths_;
-  gpu::Kernel probe_; // paths_'s probing variant (kShadeFlagProbe)
+  gpu::Kernel probe_;    // paths_'s probing variant (kShadeFlagProbe)
+  gpu::Kernel perLight_; // paths_'s variant for an added light alone (kSpecConstantPerLight)
 };
 
 } // namespace obscura::render
