@@ -28,12 +28,15 @@ layout(std430, set = 0, binding = kBindingHitBounds) buffer HitBounds { vec4 hit
 
 layout(push_constant) uniform Push { ShadePush pc; };
 
-// The variant of a kernel for one light alone (kSpecConstantPerLight). The flag is still read in
-// the other variants, so that a probe of a per-light dispatch follows the same code.
+// The variant of a kernel for one light alone (kSpecConstantPerLight). The probing variant reads
+// the flag, so that a probe of a per-light dispatch follows the same code; the plain kernel leaves
+// the per-light code out (on lavapipe, code no invocation takes still costs: registers are
+// allocated over the whole shader).
 layout(constant_id = kSpecConstantPerLight) const bool kPerLight = false;
 
-// Whether this dispatch shades light pc.band.w alone (kShadeFlagPerLight).
-bool shadesOneLight() { return kPerLight || (pc.band.z & kShadeFlagPerLight) != 0u; }
+// Whether this dispatch shades light pc.band.w alone (kShadeFlagPerLight): the per-light variant,
+// or a probe of a per-light dispatch. The host sends every other per-light dispatch to that variant.
+bool shadesOneLight() { return kPerLight || (kProbe && (pc.band.z & kShadeFlagPerLight) != 0u); }
 
 // Whether this pass skips `pixel`: a retrace after a geometry edit runs the dirty pixels only, and
 // a probing pass the candidates that no probe has found dirty yet (mask 1, dirty.comp).

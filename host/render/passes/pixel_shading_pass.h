@@ -54,10 +54,11 @@ public:
     // A geometry edit retraces every pixel while the reflectors are on (they are marked anew), so
     // nothing probes with them; the probing kernel has no reflectors' code.
     if (probe && reflectors) throw std::logic_error("PixelShadingPass: no probing variant with secondary reflectors");
-    const gpu::Kernel& kernel = probe                                   ? probe_
-                                : reflectors                            ? *reflectors_
-                                : perLight_ && takesPerLightVariant(p) ? *perLight_
-                                                                        : kernel_;
+    // Only the per-light variant (and the probe) shades one light alone: the plain kernel has no
+    // code for it.
+    const bool perLight = takesPerLightVariant(p);
+    if (perLight && (!perLight_ || reflectors)) throw std::logic_error("PixelShadingPass: no per-light variant");
+    const gpu::Kernel& kernel = probe ? probe_ : reflectors ? *reflectors_ : perLight ? *perLight_ : kernel_;
     if (dirtyOf != nullptr) {
       kernel.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &p, band);
       return;
