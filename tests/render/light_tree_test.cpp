@@ -164,6 +164,7 @@ TEST(LightTree, EveryLightWithPowerIsOneLeafWhoseTrailLeadsToItAndNodesBoundThei
     }
   }
   EXPECT_EQ(internal + 1, bounded) << "a binary tree with one light per leaf";
+  std::printf("[ tree     ] %zu lights, %zu in the tree, depth %u\n", set.size(), bounded, header.w);
   double boundedPower = 0.0;
   for (const auto& l : set.lights)
     if (!render::isUnboundedLight(l.info.x)) boundedPower += l.params.y;
