@@ -45,6 +45,7 @@ layout(push_constant) uniform Push { PathPush pc; };
 layout(std430, set = 0, binding = kBindingPathRadiance) buffer RadianceBuffer { vec4 radiance[]; };
 layout(std430, set = 0, binding = kBindingPathLights) readonly buffer LightBuffer { GpuLight lights[]; };
 layout(std430, set = 0, binding = kBindingPathEmitters) readonly buffer EmitterBuffer { GpuEmitter emitters[]; };
+layout(std430, set = 0, binding = kBindingPathLightTree) readonly buffer LightTreeBuffer { GpuLightNode lightTree[]; };
 layout(std430, set = 0, binding = kBindingPathScales) readonly buffer ScaleBuffer { vec4 emissionScale[]; };
 
 #include "lib/intersect.glsl"

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "render/scene/light_tree.h"
 #include "render/scene/secondary_reflectors.h"
 #include "shading/bsdf.h"
 
@@ -223,6 +224,7 @@ void ObscuranceRenderer::reset() {
 void ObscuranceRenderer::uploadLights() {
   lightBuffers_.lights = gpu::uploadArray(*context_, lights_.lights, "lights.lights");
   lightBuffers_.emitters = gpu::uploadArray(*context_, lights_.emitters, "lights.emitters");
+  lightBuffers_.tree = gpu::uploadArray(*context_, buildLightTree(lights_.lights), "lights.tree");
   lightBuffers_.scales = gpu::uploadArray(*context_, emissionRows(lights_.emission), "lights.render_scales");
   emissionBuffer_ = gpu::uploadArray(*context_, emissionRows(emissions_), "compose.emissions");
   lightBounds_ = gpu::uploadArray(*context_, lightBounds(lights_), "dirty.light_bounds");
@@ -849,7 +851,7 @@ RenderStats ObscuranceRenderer::stats() const {
 
 std::uint64_t ObscuranceRenderer::deviceBytes() const {
   return sceneBuffers_.bytes() + frame_.bytes() + lightBuffers_.lights.size() + lightBuffers_.emitters.size() +
-         lightBuffers_.scales.size() + emissionBuffer_.size();
+         lightBuffers_.tree.size() + lightBuffers_.scales.size() + emissionBuffer_.size();
 }
 
 } // namespace obscura::render

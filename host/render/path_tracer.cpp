@@ -54,6 +54,7 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
                                  static_cast<double>(pathTraceBytesNeeded(settings.width, settings.height)) / 1048576.0));
   lightBuffer_ = gpu::uploadArray(context, lights_.lights, "pathtrace.lights");
   emitterBuffer_ = gpu::uploadArray(context, lights_.emitters, "pathtrace.emitters");
+  treeBuffer_ = gpu::uploadArray(context, buildLightTree(lights_.lights), "pathtrace.light_tree");
   scaleBuffer_ = gpu::uploadArray(context, emissionRows(lights_.emission), "pathtrace.emission");
   status_ = StatusCounters(context, "pathtrace.status");
   for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
@@ -63,6 +64,7 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
     kernel_.bind(gpu::kBindingPathRadiance, radiance_.back(), b);
     kernel_.bind(gpu::kBindingPathLights, lightBuffer_, b);
     kernel_.bind(gpu::kBindingPathEmitters, emitterBuffer_, b);
+    kernel_.bind(gpu::kBindingPathLightTree, treeBuffer_, b);
     kernel_.bind(gpu::kBindingPathScales, scaleBuffer_, b);
   }
   reset();

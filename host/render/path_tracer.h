@@ -14,6 +14,7 @@
 #include "render/aovs.h"
 #include "render/frame/frame_layout.h"
 #include "render/scene/light_set.h"
+#include "render/scene/light_tree.h"
 #include "render/scene/scene_buffers.h"
 #include "render/status_counters.h"
 #include "scene/scene.h"
@@ -73,7 +74,7 @@ private:
   PathTraceSettings settings_;
   SceneBuffers sceneBuffers_;
   LightSet lights_;
-  gpu::Buffer lightBuffer_, emitterBuffer_, scaleBuffer_;
+  gpu::Buffer lightBuffer_, emitterBuffer_, treeBuffer_, scaleBuffer_;
   FrameLayout layout_;
   std::vector<gpu::Buffer> radiance_; // per band
   StatusCounters status_;

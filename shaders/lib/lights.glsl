@@ -1,11 +1,12 @@
 // lights.glsl — the one direct-light estimator's sampling half: choosing a light and a point on it
 // for a shadow ray [RTO §4.1 step 2, SPEC §1.3], and the density of that choice (for MIS).
-// Needs the light bindings (kBindingLights, kBindingEmitters) declared by the including shader
-// as `lights[]` and `emitters[]`, and sampling.glsl.
+// Needs the light bindings (kBindingLights, kBindingEmitters, kBindingLightTree) declared by the
+// including shader as `lights[]`, `emitters[]` and `lightTree[]`, and sampling.glsl.
 //
 // Two estimators (kLightSampling* in host_device.h), chosen per dispatch through gLightSampling:
 // - Spatial (default): light i with probability importance_i(P, n) / sum_j importance_j(P, n)
-//   (lightImportance below); on an area light a triangle by area, then a direction uniform in the
+//   (lightImportance below) up to kMaxSpatialLights lights, by a descent of the light tree with
+//   the same importance on its nodes beyond; on an area light a triangle by area, then a direction uniform in the
 //   triangle's solid angle (Arvo 1995), so the estimator has no 1/r^2 at small emitters; area
 //   sampling only where the solid angle is too small for the spherical warp's float precision or
 //   too large (more than a hemisphere) for it.
@@ -65,21 +66,23 @@ float sinOfClampedDifference(float cosA, float sinA, float cosB, float sinB) {
   return cosA >= cosB ? 0.0 : sinA * cosB - cosA * sinB;
 }
 
-// An upper bound on the light light i can send to a receiver at p with normal n (facing the side
+// An upper bound on the light that lights of total power `power` within the bounding sphere
+// `sphere` (xyz centre, w radius), emitting within `cone` (axis xyz, w = cos theta_o; -1: any
+// direction) widened by theta_e (cosE), can send to a receiver at p with normal n (facing the side
 // that reflects), up to a common factor: power x cos(theta') x cos(theta_i') / d^2, where theta'
-// is the smallest angle between the light's emission cone and the direction to p, and theta_i'
-// the smallest angle between n and a direction into the light's bounding sphere (Conty Estevez &
-// Kulla, "Importance Sampling of Many Lights with Adaptive Tree Splitting", HPG 2018, eq. 3, as in
-// pbrt-v4's LightBounds::Importance, with a sphere for the box). It is 0 only where the light
-// cannot reach p's reflecting side, so selection by it stays unbiased. Directional lights are
-// not bounded here (lightSelection gives them their own share).
-float lightImportance(uint i, vec3 p, vec3 n) {
-  GpuLight light = lights[i];
-  float power = light.params.y;
+// is the smallest angle between the emission cone and the direction to p, and theta_i' the
+// smallest angle between n and a direction into the sphere (Conty Estevez & Kulla, "Importance
+// Sampling of Many Lights with Adaptive Tree Splitting", HPG 2018, eq. 3, as in pbrt-v4's
+// LightBounds::Importance, with a sphere for the box). A spot is uniform in its cone
+// (uniformInCone: no cos(theta') factor, nothing past theta_o + theta_e). It is 0 only where the
+// lights cannot reach p's reflecting side, so selection by it stays unbiased. One light
+// (lightImportance) and one node of the light tree (nodeImportance) are bounded by this same
+// function.
+float boundsImportance(float power, vec4 sphere, vec4 cone, float cosE, bool uniformInCone, vec3 p, vec3 n) {
   if (!(power > 0.0)) return 0.0;
-  vec3 toLight = light.position.xyz - p;
+  vec3 toLight = sphere.xyz - p;
   float d2 = dot(toLight, toLight);
-  float radius = light.info.x == kLightArea ? light.position.w : 0.0;
+  float radius = sphere.w;
   float r2 = radius * radius;
   if (d2 <= r2 * 1.0001 || d2 == 0.0) return power / max(r2, 1e-12); // p inside the bounds
   float d = sqrt(d2);
@@ -91,22 +94,35 @@ float lightImportance(uint i, vec3 p, vec3 n) {
   float cosIPrime = cosOfClampedDifference(cosI, sinI, cosB, sinB);
   if (cosIPrime <= 0.0) return 0.0;
   float importance = power * cosIPrime / d2;
-  uint type = light.info.x;
-  if (type == kLightArea || type == kLightSpot) {
+  float cosO = cone.w;
+  if (cosO > -1.0) {
     // Emitter: the angle between p (seen from the light) and the cone of emission directions.
-    float cosO = type == kLightArea ? light.direction.w : light.params.w;
-    if (cosO > -1.0) {
-      float sinO = sqrt(max(0.0, 1.0 - cosO * cosO));
-      float cosW = dot(light.direction.xyz, -w), sinW = sqrt(max(0.0, 1.0 - cosW * cosW));
-      float cosX = cosOfClampedDifference(cosW, sinW, cosO, sinO);
-      float sinX = sinOfClampedDifference(cosW, sinW, cosO, sinO);
-      float cosPrime = cosOfClampedDifference(cosX, sinX, cosB, sinB);
-      // An area light emits within 90 degrees of its normals; a spot nowhere past its outer cone.
-      if (type == kLightArea ? cosPrime <= 0.0 : cosPrime < 0.99999) return 0.0;
-      importance *= type == kLightArea ? cosPrime : 1.0;
-    }
+    float sinO = sqrt(max(0.0, 1.0 - cosO * cosO));
+    float cosW = dot(cone.xyz, -w), sinW = sqrt(max(0.0, 1.0 - cosW * cosW));
+    float cosX = cosOfClampedDifference(cosW, sinW, cosO, sinO);
+    float sinX = sinOfClampedDifference(cosW, sinW, cosO, sinO);
+    float cosPrime = cosOfClampedDifference(cosX, sinX, cosB, sinB);
+    // An area light emits within 90 degrees of its normals (cosE = 0); a spot nowhere past its
+    // outer cone (cosE = kSpotConeSlack, rounding slack).
+    if (uniformInCone ? cosPrime < cosE : cosPrime <= cosE) return 0.0;
+    importance *= uniformInCone ? 1.0 : cosPrime;
   }
   return importance;
+}
+
+// A spot's bound reaches this cosine past its outer cone (rounding slack; light_selection.h).
+const float kSpotConeSlack = 0.99999;
+
+// Light i's importance: its own bounds (the area light's sphere and normal cone, a point, a spot's
+// position and outer cone). Directional lights are not bounded here (lightSelection gives them
+// their own share).
+float lightImportance(uint i, vec3 p, vec3 n) {
+  GpuLight light = lights[i];
+  uint type = light.info.x;
+  bool area = type == kLightArea, spot = type == kLightSpot;
+  vec4 sphere = vec4(light.position.xyz, area ? light.position.w : 0.0);
+  vec4 cone = area ? light.direction : spot ? vec4(light.direction.xyz, light.params.w) : vec4(0.0, 0.0, 1.0, -1.0);
+  return boundsImportance(light.params.y, sphere, cone, spot ? kSpotConeSlack : 0.0, spot, p, n);
 }
 
 // Lights without bounds: directional lights and the background. They get an equal share of the
@@ -114,9 +130,95 @@ float lightImportance(uint i, vec3 p, vec3 n) {
 // same for infinite lights).
 bool isUnbounded(uint type) { return type == kLightDirectional || type == kLightBackground; }
 
+// Up to kMaxSpatialLights lights, the spatial selection weighs every light at the point (exact);
+// beyond, it descends the light tree (approximate weights, a bounded number of nodes).
 bool useSpatialSelection(uint count) {
   return gLightSampling == kLightSamplingSpatial && count <= kMaxSpatialLights;
 }
+bool useLightTree(uint count) {
+  return gLightSampling == kLightSamplingSpatial && count > kMaxSpatialLights;
+}
+
+// ---- The light tree (more than kMaxSpatialLights lights; layout: GpuLightNode in host_device.h)
+// Stochastic descent (Conty Estevez & Kulla 2018 §4; pbrt-v4's BVHLightSampler::Sample): from the
+// root, each internal node is left for one of its two children with probability proportional to
+// the child's importance at p, n (boundsImportance on the child's bounds), and u is rescaled into
+// the chosen child's interval, so one number drives the whole descent. A light's probability is
+// the product of the choices on its path; lightTreePdf walks that path again from the light's bit
+// trail. Unbounded lights keep the equal share they have in the flat selection.
+
+float nodeImportance(uint row, vec3 p, vec3 n) {
+  GpuLightNode node = lightTree[row];
+  return boundsImportance(node.emission.x, node.sphere, node.cone, node.emission.y, node.emission.z != 0.0, p, n);
+}
+
+// The probabilities of going from the internal node with children `refs.xy` to each child.
+vec2 lightTreeChildProbabilities(uvec4 refs, vec3 p, vec3 n) {
+  float a = nodeImportance(refs.x, p, n), b = nodeImportance(refs.y, p, n);
+  float total = a + b;
+  return total > 0.0 ? vec2(a / total, b / total) : vec2(0.0);
+}
+
+// The number of equal shares at p: one per unbounded light with power, one for the tree where its
+// root can light p (`lit`).
+float lightTreeShares(vec3 p, vec3 n, out bool lit) {
+  uvec4 header = lightTree[0].refs;
+  lit = header.x != kInvalidIndex && nodeImportance(header.x, p, n) > 0.0;
+  return float(header.y) + (lit ? 1.0 : 0.0);
+}
+
+uint selectLightFromTree(float u, vec3 p, vec3 n, out float selection) {
+  uvec4 header = lightTree[0].refs;
+  bool lit;
+  float shares = lightTreeShares(p, n, lit);
+  selection = 0.0;
+  if (shares == 0.0) return 0u;
+  // u in [0, unbounded / shares): the k-th unbounded light; beyond: down the tree.
+  float scaled = u * shares;
+  uint unbounded = header.y;
+  if (!lit || scaled < float(unbounded)) {
+    selection = 1.0 / shares;
+    return lightTree[1u + header.z + min(uint(scaled), unbounded - 1u)].refs.x;
+  }
+  float v = min(scaled - float(unbounded), kOneMinusEpsilon);
+  float probability = 1.0 / shares;
+  uint row = header.x;
+  for (uint depth = 0u; depth < kLightTreeMaxDepth; ++depth) {
+    uvec4 refs = lightTree[row].refs;
+    if (refs.y == kInvalidIndex) break; // a leaf
+    vec2 q = lightTreeChildProbabilities(refs, p, n);
+    bool second = !(v < q.x);
+    probability *= second ? q.y : q.x;
+    if (!(probability > 0.0)) return 0u; // neither child can light p
+    v = min(second ? (v - q.x) / q.y : v / q.x, kOneMinusEpsilon);
+    row = second ? refs.y : refs.x;
+  }
+  selection = probability;
+  return lightTree[row].refs.x;
+}
+
+// The probability that selectLightFromTree picks light `chosen` at p, n: the same choices, taken
+// along the light's trail.
+float lightTreePdf(uint chosen, vec3 p, vec3 n) {
+  bool lit;
+  float shares = lightTreeShares(p, n, lit);
+  if (shares == 0.0) return 0.0;
+  if (isUnbounded(lights[chosen].info.x)) return lights[chosen].params.y > 0.0 ? 1.0 / shares : 0.0;
+  uvec4 leaf = lightTree[1u + chosen].refs;
+  if (!lit || leaf.w == kInvalidIndex) return 0.0;
+  float probability = 1.0 / shares;
+  uint row = lightTree[0].refs.x;
+  for (uint depth = 0u; depth < leaf.w; ++depth) {
+    uvec4 refs = lightTree[row].refs;
+    vec2 q = lightTreeChildProbabilities(refs, p, n);
+    bool second = ((leaf.z >> depth) & 1u) != 0u;
+    probability *= second ? q.y : q.x;
+    row = second ? refs.y : refs.x;
+  }
+  return probability;
+}
+
+// ---- The flat selection (up to kMaxSpatialLights lights)
 
 // The spatial selection's weights at one shading point: every bounded light's importance, their
 // sum and the number of unbounded lights with power. A hit draws several light samples (N_s shadow
@@ -152,6 +254,7 @@ void prepareLightImportances(vec3 p, vec3 n, uint count) {
 
 // The probability that the estimator picks light `chosen` at p with normal n.
 float lightSelectionPdf(uint chosen, vec3 p, vec3 n, uint count) {
+  if (useLightTree(count)) return lightTreePdf(chosen, p, n);
   if (!useSpatialSelection(count)) return lights[chosen].params.y;
   prepareLightImportances(p, n, count);
   float total = gImportanceTotal;
@@ -163,6 +266,7 @@ float lightSelectionPdf(uint chosen, vec3 p, vec3 n, uint count) {
 
 // Picks a light for p with normal n; selection = its probability (0: no light can light p).
 uint selectLight(float u, vec3 p, vec3 n, uint count, out float selection) {
+  if (useLightTree(count)) return selectLightFromTree(u, p, n, selection);
   if (!useSpatialSelection(count)) {
     uint chosen = selectLightByPower(u, count);
     selection = lights[chosen].params.y;

@@ -1,4 +1,4 @@
-// shading_bindings.glsl — bindings 6..14 shared by the shading passes (shadow, obscurance,
+// shading_bindings.glsl — bindings 6..17 shared by the shading passes (shadow, obscurance,
 // specular): the G-buffer, the lights and the accumulation buffers [SPEC §3].
 #ifndef OBSCURA_SHADING_BINDINGS_GLSL
 #define OBSCURA_SHADING_BINDINGS_GLSL
@@ -10,6 +10,7 @@
 layout(std430, set = 0, binding = kBindingGBuffer) readonly buffer GBuffer { GBufferTexel gbuffer[]; };
 layout(std430, set = 0, binding = kBindingLights) readonly buffer LightBuffer { GpuLight lights[]; };
 layout(std430, set = 0, binding = kBindingEmitters) readonly buffer EmitterBuffer { GpuEmitter emitters[]; };
+layout(std430, set = 0, binding = kBindingLightTree) readonly buffer LightTreeBuffer { GpuLightNode lightTree[]; };
 // basis[light * pixelCount + pixel] += D_s contributions (unit emission), summed over samples.
 layout(std430, set = 0, binding = kBindingBasis) buffer BasisBuffer { vec4 basis[]; };
 // ambient[pixel].rgb += R(P) W_c (or R(P) W), .w += W, summed over samples.

@@ -118,9 +118,9 @@ OBS_CONST uint kLightBackground = 4u; // a constant sky around the scene (unit r
 // - Area: the paper's estimator [RTO §4.1]: the light by power, the point uniform by area.
 OBS_CONST uint kLightSamplingSpatial = 0u;
 OBS_CONST uint kLightSamplingArea = 1u;
-// Spatial selection evaluates every light's importance per sample; with more lights than this it
-// falls back to selection by power (a light BVH would lift the limit; lavapipe's loop limiter
-// counts each light visited).
+// Spatial selection evaluates every light's importance at each shading point, exactly, up to this
+// many lights; with more it descends the light tree (GpuLightNode) instead, which visits
+// 2 x depth nodes per sample (lavapipe's loop limiter counts each light or node visited).
 OBS_CONST uint kMaxSpatialLights = 64u;
 
 struct GpuLight {
@@ -142,6 +142,31 @@ struct GpuEmitter {
   vec4 v2;        // 32: xyz, w = 1 if it emits from both sides
   vec4 radiance;  // 48: rgb unit-emission radiance, w = unused
 };                // 64 bytes
+
+// ---- Light tree: a binary BVH over the bounded lights (area, point, spot) for spatial selection
+// with more than kMaxSpatialLights lights (Conty Estevez & Kulla, "Importance Sampling of Many
+// Lights with Adaptive Tree Splitting", HPG 2018; pbrt-v4's BVHLightSampler). Built on the host
+// (host/render/scene/light_tree.cpp), read by lights.glsl. One array of nodes (binding
+// kBindingLightTree / kBindingPathLightTree):
+// - row 0: the header: refs = (root row or kInvalidIndex when no bounded light has power, the
+//   number U of unbounded lights with power, the light count it was built for, the tree's depth);
+// - rows 1 + i, i < light count: light i's leaf (its bounds; refs.z, refs.w its trail: bit k is
+//   the child taken at depth k from the root, refs.w the depth of the leaf, kInvalidIndex for a
+//   light outside the tree: unbounded or without power);
+// - the next U rows: refs.x = the k-th unbounded light with power (directional, background);
+// - then the internal nodes.
+// A trail has 32 bits: the builder keeps every leaf within kLightTreeMaxDepth.
+OBS_CONST uint kLightTreeMaxDepth = 32u;
+struct GpuLightNode {
+  vec4 sphere;   // 0:  bounding sphere of the lights below: centre xyz, w = radius (0: a point)
+  vec4 cone;     // 16: axis xyz of the cone that holds their emission normals or spot directions,
+                 //     w = cos theta_o (-1: every direction, no orientation bound)
+  vec4 emission; // 32: x = power (selection weight: the lights' GpuLight.params.y, summed),
+                 //     y = cos theta_e (emission spread beyond theta_o: 0 for area lights), z = 1 if
+                 //     uniform within the cone (spots: no cosine factor), w = unused
+  uvec4 refs;    // 48: internal: first child row, second child row; leaf: light index,
+                 //     kInvalidIndex; z, w: see above
+};               // 64 bytes
 
 // ---- Texture table: all textures live in one uint buffer of RGBA8 texels.
 struct GpuTexture {
@@ -300,7 +325,8 @@ OBS_CONST uint kBindingLightScales = 14;     // vec4[lights]: E_s (to make seen 
 OBS_CONST uint kBindingDirty = 15;           // uint[]: the dirty mask and list (kDirtyListBase)
 OBS_CONST uint kBindingHitBounds = 16;       // = primary.comp's kBindingPrimaryHitBounds; specular
                                              // paths grow it with their vertices
-OBS_CONST uint kShadingBindingCount = 17;
+OBS_CONST uint kBindingLightTree = 17;       // GpuLightNode[]: the light tree (lights.glsl)
+OBS_CONST uint kShadingBindingCount = 18;
 
 // ---- Bindings of primary.comp after the scene's (0..5).
 OBS_CONST uint kBindingPrimaryGBuffer = 6;       // GBufferTexel[pixel]
@@ -337,7 +363,8 @@ OBS_CONST uint kBindingPathRadiance = 6u;   // vec4[pixels]: rgb sums, w = dropp
 OBS_CONST uint kBindingPathLights = 7u;     // GpuLight[] (= kBindingLights)
 OBS_CONST uint kBindingPathEmitters = 8u;   // GpuEmitter[] (= kBindingEmitters)
 OBS_CONST uint kBindingPathScales = 9u;     // vec4[lights]: E_s, each light's emission scale
-OBS_CONST uint kPathBindingCount = 10u;
+OBS_CONST uint kBindingPathLightTree = 10u; // GpuLightNode[] (= kBindingLightTree's contents)
+OBS_CONST uint kPathBindingCount = 11u;
 
 // ---- compose.comp: per pixel, AOV slots written (averaged over samples).
 OBS_CONST uint kComposeCombined = 0;   // C = sum_s E_s (D_s + M_s) + I_a A (+ specular)

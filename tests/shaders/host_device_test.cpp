@@ -20,6 +20,7 @@ static_assert(sizeof(GpuMaterial) == 80 && offsetof(GpuMaterial, textures) == 48
               offsetof(GpuMaterial, meanAlbedo) == 64);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, params) == 48);
 static_assert(sizeof(GpuEmitter) == 64 && offsetof(GpuEmitter, radiance) == 48);
+static_assert(sizeof(GpuLightNode) == 64 && offsetof(GpuLightNode, refs) == 48);
 static_assert(sizeof(GpuTexture) == 16);
 static_assert(sizeof(GpuRay) == 32);
 static_assert(sizeof(GpuHit) == 16 && offsetof(GpuHit, primitive) == 12);

@@ -38,6 +38,7 @@ void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInp
   kernel.bind(gpu::kBindingGBuffer, b.gbuffer, band);
   kernel.bind(gpu::kBindingLights, in.lights.lights, band);
   kernel.bind(gpu::kBindingEmitters, in.lights.emitters, band);
+  kernel.bind(gpu::kBindingLightTree, in.lights.tree, band);
   kernel.bind(gpu::kBindingBasis, b.basis, band);
   kernel.bind(gpu::kBindingAmbient, b.ambient, band);
   kernel.bind(gpu::kBindingSpecularBasis, b.specularBasis, band);

@@ -1,5 +1,5 @@
 // shading_inputs.h — what the shading passes (shadow, obscurance, specular) bind: the scene,
-// the lights, and one band of the frame (shaders/lib/shading_bindings.glsl, bindings 0..14).
+// the lights, and one band of the frame (shaders/lib/shading_bindings.glsl, bindings 0..17).
 #pragma once
 #include <span>
 
@@ -13,6 +13,7 @@ struct LightBuffers {
   gpu::Buffer lights;      // GpuLight[]
   gpu::Buffer emitters;    // GpuEmitter[]
   gpu::Buffer scales;      // vec4[]: the render-time E_s, which makes seen emission unit
+  gpu::Buffer tree;        // GpuLightNode[]: the light tree (light_tree.h)
 };
 
 struct ShadingInputs {
