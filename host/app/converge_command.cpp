@@ -39,6 +39,11 @@ namespace obscura::app {
 namespace {
 namespace fs = std::filesystem;
 
+// The default emission rays per sample: obscurances' indirect estimate has little noise, so the
+// coverage of bright emitters seen directly is worth rays of its own; path tracing's noise is
+// everywhere (docs/BENCHMARKS.md, "Emission rays").
+constexpr std::uint32_t kObscuranceEmissionSamples = 1, kPathEmissionSamples = 1;
+
 struct ConvergeOptions {
   std::string scenePath;
   std::string outputDir;
@@ -51,6 +56,10 @@ struct ConvergeOptions {
   float dMax = 0.0f; // 0: the renderer's default
   float secondaryReflectors = 0.0f; // > 0: one more method, obscurances with secondary reflectors
   std::vector<float> background;    // R,G,B of a sky (render --background); empty: none
+  // Camera rays per sample for the emission the camera sees (render --emission-samples), each
+  // method family with the count that serves it best (docs/BENCHMARKS.md).
+  std::uint32_t emissionSamples = kObscuranceEmissionSamples;
+  std::uint32_t pathEmissionSamples = kPathEmissionSamples;
   std::string commandLine;
   DeviceOptions device;
 };
@@ -124,7 +133,7 @@ public:
     const render::RenderStats* stats = nullptr;
     if (m.pathTrace) {
       render::PathTraceSettings s{.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_,
-                                  .lightSampling = m.lightSampling};
+                                  .lightSampling = m.lightSampling, .emissionSamples = o_.pathEmissionSamples};
       if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, loaded_.scene, loaded_.bvh, s);
       pathTracer_->configure(s);
       pathTracer_->render();
@@ -135,6 +144,7 @@ public:
       s.width = width_;
       s.height = height_;
       s.spp = spp;
+      s.emissionSamples = o_.emissionSamples;
       s.seed = seed;
       s.camera = camera_;
       s.shadowRays = m.raysPerHit;
@@ -174,8 +184,10 @@ public:
     fs::path exr = fs::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
     fs::path txt = exr;
     txt.replace_extension(".txt");
-    std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} light_sampling={}{}{}",
+    std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} "
+                                          "emission_samples={} light_sampling={}{}{}",
                                           o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
+                                          m.pathTrace ? o_.pathEmissionSamples : o_.emissionSamples,
                                           m.lightSampling == render::LightSampling::Area ? "area" : "spatial",
                                           m.pathTrace ? "" : fmt::format(" ambient=seen+reached+global dmax={} secondary_reflectors={}",
                                                                          o_.dMax, m.secondaryReflectors),
@@ -424,6 +436,13 @@ void addConvergeCommand(CLI::App& app) {
   cmd->add_option("--background", o->background, "R,G,B: a constant sky for both methods (as render --background)")
       ->delimiter(',')
       ->expected(3);
+  cmd->add_option("--emission-samples", o->emissionSamples,
+                  fmt::format("obscurance methods: camera rays per sample for the emission the camera sees (render "
+                              "--emission-samples; default {})", kObscuranceEmissionSamples))
+      ->check(CLI::Range(1u, gpu::kMaxEmissionSamples));
+  cmd->add_option("--pt-emission-samples", o->pathEmissionSamples,
+                  fmt::format("path tracing: the same (default {})", kPathEmissionSamples))
+      ->check(CLI::Range(1u, gpu::kMaxEmissionSamples));
   cmd->add_option("--secondary-reflectors", o->secondaryReflectors,
                   "T: study obscurances with secondary reflectors marked at T x mean direct irradiance too "
                   "(method obscurance-reflectors, with its own reference and bias floor)")
