@@ -68,11 +68,13 @@ struct Method {
   std::string name;
   bool pathTrace = false;
   render::LightSampling lightSampling = render::LightSampling::Spatial;
-  std::uint32_t raysPerHit = 5;   // shadow and obscurance rays per hit (obscurance methods)
+  std::uint32_t raysPerHit = 5;   // shadow (and obscurance, see below) rays per hit (obscurance methods)
   std::uint32_t budgetSpp = 8;    // the budget its summary is read at
   std::string what;
   float secondaryReflectors = 0.0f; // their marking threshold, 0 = off
   bool denoise = false;             // the frame denoised (render/denoise/), its GPU time counted
+  std::uint32_t obscuranceRays = 0; // obscurance rays per hit; 0: raysPerHit
+  std::uint32_t emissionSamples = 0; // camera rays per sample for the seen emission; 0: the study's
 };
 
 // The paper's budget [RTO §4.1]: 8 primary samples x (5 obscurance + 5 shadow rays) per hit.
@@ -85,6 +87,10 @@ const std::vector<Method> kMethods = {
      "spatial light sampling, 5+5 rays per hit, 8 spp (the paper's budget)"},
     {"obscurance-paper", false, render::LightSampling::Area, kPaperRays, kPaperSpp,
      "the paper's light sampling (by power, by area), 5+5 rays per hit, 8 spp"},
+    // The same 10 shading rays per hit, spent where modern-hall's noise is: its direct light
+    // holds 2/3 of the variance at 5 + 5, the obscurance 2 % (docs/BENCHMARKS.md).
+    {"obscurance-split", false, render::LightSampling::Spatial, 8, kPaperSpp,
+     "spatial light sampling, 8 shadow + 2 obscurance rays per hit, 8 spp", 0.0f, false, 2},
     {"obscurance-realtime", false, render::LightSampling::Spatial, 1, 1, "spatial, 1+1 rays per hit, 1 spp"},
     // The window's frames: the same, denoised (one frame alone, no history), error measured.
     {"obscurance-denoised", false, render::LightSampling::Spatial, kPaperRays, 1,
@@ -105,6 +111,13 @@ std::vector<Method> studyMethods(const ConvergeOptions& o) {
                          o.secondaryReflectors);
     m.secondaryReflectors = o.secondaryReflectors;
     methods.insert(methods.end() - 1, m);
+  }
+  if (o.emissionSamples > 1) { // what the emission rays change, in the same run
+    Method m = methods.front();
+    m.name = "obscurance-primary-emission";
+    m.what = "as obscurance, the seen emission from the primary rays alone (--emission-samples 1)";
+    m.emissionSamples = 1;
+    methods.insert(methods.begin() + 1, m);
   }
   return methods;
 }
@@ -144,11 +157,11 @@ public:
       s.width = width_;
       s.height = height_;
       s.spp = spp;
-      s.emissionSamples = o_.emissionSamples;
+      s.emissionSamples = m.emissionSamples ? m.emissionSamples : o_.emissionSamples;
       s.seed = seed;
       s.camera = camera_;
       s.shadowRays = m.raysPerHit;
-      s.obscuranceRays = m.raysPerHit;
+      s.obscuranceRays = m.obscuranceRays ? m.obscuranceRays : m.raysPerHit;
       s.lightSampling = m.lightSampling;
       s.ambient = render::AmbientModel::Seen; // the least biased I_a; Reached and Global composed beside it
       s.dMax = o_.dMax;
