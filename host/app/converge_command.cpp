@@ -39,9 +39,10 @@ namespace obscura::app {
 namespace {
 namespace fs = std::filesystem;
 
-// The default emission rays per sample: obscurances' indirect estimate has little noise, so the
-// coverage of bright emitters seen directly is worth rays of its own; path tracing's noise is
-// everywhere (docs/BENCHMARKS.md, "Emission rays").
+// The default emission rays per sample: the primary ray alone. They pay where bright emitters seen
+// directly set the error (the Cornell box: --emission-samples 16 --pt-emission-samples 4) and cost
+// more than they remove where the emitters are small on screen (modern-hall); docs/BENCHMARKS.md,
+// "Emission rays and the split of shading rays".
 constexpr std::uint32_t kObscuranceEmissionSamples = 1, kPathEmissionSamples = 1;
 
 struct ConvergeOptions {
