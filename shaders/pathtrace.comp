@@ -62,6 +62,7 @@ layout(std430, set = 0, binding = kBindingPathScales) readonly buffer ScaleBuffe
 #include "lib/shade.glsl"
 #include "lib/accumulate.glsl"
 #include "lib/band.glsl"
+#include "lib/emission_samples.glsl"
 
 // OURS: the largest survival probability of Russian roulette (see the header).
 const float kRrMaxSurvival = 0.95;
@@ -86,6 +87,11 @@ void main() {
   const uint rrDepth = pc.params.z;
   const uint strategy = pc.params.w;
   gLightSampling = pc.band.z;
+  // --emission-samples K: K > 1 estimates the emission the camera ray sees from K rays of their own
+  // (lib/emission_samples.glsl), as the obscurance renderer's M_s does; the path's vertex 1 then
+  // adds none.
+  const uint emissionSamples = min(pc.band.w, kMaxEmissionSamples);
+  const bool ownEmissionRays = emissionSamples > 1u;
 
   // The camera ray exactly as primary.comp makes it: the same per-pixel shift of the same R2
   // sub-pixel sequence, so sample i of both renderers goes through the same point of the pixel.
@@ -102,6 +108,14 @@ void main() {
   RayHit hit = traceWithBudget(budget, origin, direction, 0.0, 1.0 / 0.0, false);
 
   vec3 L = vec3(0.0);
+  if (ownEmissionRays) {
+    uint sky = floatBitsToUint(pc.camera.up.w);
+    for (uint j = 0u; j < emissionSamples; ++j) {
+      SeenEmitter e = traceEmissionSample(budget, pc.camera, p, vec2(size), pc.frame.z, j, emissionSamples, shift, lightCount);
+      L += (e.sky ? emissionScale[sky].rgb : e.radiance) / float(emissionSamples);
+    }
+    rays += emissionSamples;
+  }
   vec3 beta = vec3(1.0);        // path throughput: f cos / pdf products (and 1/q of roulette)
   bool specularBounce = true;   // the ray came from the camera or a mirror's delta lobe
   float bsdfPdfPrev = 0.0;      // solid-angle pdf of the BSDF sample that made the ray
@@ -120,7 +134,7 @@ void main() {
           float lightPdf = backgroundLightPdf(sky, previous, previousNormal, lightCount, direction);
           w = strategy == kPathStrategyLightOnly ? (lightPdf > 0.0 ? 0.0 : 1.0) : powerHeuristic(bsdfPdfPrev, lightPdf);
         }
-        L += beta * w * emissionScale[sky].rgb;
+        if (!(depth == 1u && ownEmissionRays)) L += beta * w * emissionScale[sky].rgb;
       }
       break;
     }
@@ -129,7 +143,7 @@ void main() {
 
     // ---- Emission seen along the ray [SPEC §5: one-sided unless doubleSided].
     vec3 emitted = materialEmission(m, s.uv, s.frontFacing);
-    if (any(greaterThan(emitted, vec3(0.0)))) {
+    if (any(greaterThan(emitted, vec3(0.0))) && !(depth == 1u && ownEmissionRays)) {
       float w = 1.0;
       if (!specularBounce && s.lightGroup < lightCount && strategy != kPathStrategyBsdfOnly) {
         // This point could also have come from sampleLight at the previous vertex [MIS].

@@ -12,6 +12,7 @@
 #include "lib/camera.glsl"
 #include "lib/accumulate.glsl"
 #include "lib/band.glsl"
+#include "lib/emission_samples.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 layout(push_constant) uniform Push { PrimaryPush pc; };
@@ -46,6 +47,8 @@ void main() {
   const uint lightCount = pc.band.z;
   const bool accumulateSums = (pc.band.w & kPrimaryFlagGBufferOnly) == 0u;
   const bool accumulateAovs = accumulateSums && (pc.band.w & kPrimaryFlagNoAovs) == 0u;
+  // --emission-samples K: K > 1 estimates M_s from K rays of their own (lib/emission_samples.glsl).
+  const uint emissionSamples = min(pc.band.w >> kPrimaryEmissionSamplesShift, kMaxEmissionSamples);
 
   uint rng = rngSeed(p, 0u, pc.frame.w); // the shift is per pixel, fixed over samples
   vec2 shift = vec2(rngNext(rng), rngNext(rng));
@@ -53,7 +56,9 @@ void main() {
   vec3 origin = pc.camera.origin.xyz;
   vec3 direction = cameraRayDirection(pc.camera, position, vec2(size));
 
-  RayHit hit = traceClosest(origin, direction, 0.0, 1.0 / 0.0);
+  // One loop budget for the camera ray and the emission rays (the loop limiter, LAVAPIPE.md).
+  StepBudget budget = newStepBudget();
+  RayHit hit = traceWithBudget(budget, origin, direction, 0.0, 1.0 / 0.0, false);
   if (hit.primitive == kTruncatedHit) atomicAdd(status[kStatusTruncated], 1u);
 
   GBufferTexel g;
@@ -107,12 +112,36 @@ void main() {
   hitBounds[2u * pixel + 1u] = hi;
 
   // M_s: the emission the camera sees, per light at unit emission, so that relighting scales a
-  // lamp the camera looks at with its light [SPEC §3]. Sample 0 starts every light's sum.
-  for (uint s = 0u; s < lightCount; ++s) {
-    vec4 seen = vec4(s == lightGroup ? unitSeen : vec3(0.0), 0.0);
-    if (first) OBS_ACCUMULATE_FIRST(emissionBasis, s * bp.count + pixel, seen)
-    else if (s == lightGroup) OBS_ACCUMULATE(emissionBasis, s * bp.count + pixel, seen)
+  // lamp the camera looks at with its light [SPEC §3]. Sample 0 starts every light's sum. Each
+  // sample adds the mean over its emission rays (the camera ray itself when K <= 1) of their unit
+  // emission to the light each one sees; consecutive rays on the same light are summed first.
+  if (first)
+    for (uint s = 0u; s < lightCount; ++s) OBS_ACCUMULATE_FIRST(emissionBasis, s * bp.count + pixel, vec4(0.0))
+  const bool ownRays = emissionSamples > 1u;
+  const uint rays = ownRays ? emissionSamples : 1u;
+  const uint sky = floatBitsToUint(pc.camera.up.w);
+  bool emissionTruncated = false;
+  uint runLight = kInvalidIndex;
+  vec3 run = vec3(0.0);
+  for (uint j = 0u; j <= rays; ++j) {
+    uint light = kInvalidIndex;
+    vec3 unit = vec3(0.0);
+    if (j < rays && !ownRays) {
+      light = lightGroup;
+      unit = unitSeen;
+    } else if (j < rays) {
+      SeenEmitter e = traceEmissionSample(budget, pc.camera, p, vec2(size), sampleIndex, j, rays, shift, lightCount);
+      light = e.lightGroup;
+      if (light != kInvalidIndex) unit = e.sky ? e.radiance : unitEmission(e.radiance, lightScales[light].rgb);
+    }
+    if (light != runLight || j == rays) {
+      if (runLight != kInvalidIndex) OBS_ACCUMULATE(emissionBasis, runLight * bp.count + pixel, vec4(run / float(rays), 0.0))
+      runLight = light;
+      run = vec3(0.0);
+    }
+    run += unit;
   }
+  if (budget.truncated && hit.primitive != kTruncatedHit) atomicAdd(status[kStatusTruncated], 1u);
 
   if (!accumulateAovs) return;
   accumulate(pixel, kAovAlbedo, g.albedo, first);

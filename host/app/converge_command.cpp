@@ -39,6 +39,12 @@ namespace obscura::app {
 namespace {
 namespace fs = std::filesystem;
 
+// The default emission rays per sample: the primary ray alone. They pay where bright emitters seen
+// directly set the error (the Cornell box: --emission-samples 16 --pt-emission-samples 4) and cost
+// more than they remove where the emitters are small on screen (modern-hall); docs/BENCHMARKS.md,
+// "Emission rays and the split of shading rays".
+constexpr std::uint32_t kObscuranceEmissionSamples = 1, kPathEmissionSamples = 1;
+
 struct ConvergeOptions {
   std::string scenePath;
   std::string outputDir;
@@ -51,6 +57,10 @@ struct ConvergeOptions {
   float dMax = 0.0f; // 0: the renderer's default
   float secondaryReflectors = 0.0f; // > 0: one more method, obscurances with secondary reflectors
   std::vector<float> background;    // R,G,B of a sky (render --background); empty: none
+  // Camera rays per sample for the emission the camera sees (render --emission-samples), each
+  // method family with the count that serves it best (docs/BENCHMARKS.md).
+  std::uint32_t emissionSamples = kObscuranceEmissionSamples;
+  std::uint32_t pathEmissionSamples = kPathEmissionSamples;
   std::string commandLine;
   DeviceOptions device;
 };
@@ -59,11 +69,13 @@ struct Method {
   std::string name;
   bool pathTrace = false;
   render::LightSampling lightSampling = render::LightSampling::Spatial;
-  std::uint32_t raysPerHit = 5;   // shadow and obscurance rays per hit (obscurance methods)
+  std::uint32_t raysPerHit = 5;   // shadow (and obscurance, see below) rays per hit (obscurance methods)
   std::uint32_t budgetSpp = 8;    // the budget its summary is read at
   std::string what;
   float secondaryReflectors = 0.0f; // their marking threshold, 0 = off
   bool denoise = false;             // the frame denoised (render/denoise/), its GPU time counted
+  std::uint32_t obscuranceRays = 0; // obscurance rays per hit; 0: raysPerHit
+  std::uint32_t emissionSamples = 0; // camera rays per sample for the seen emission; 0: the study's
 };
 
 // The paper's budget [RTO §4.1]: 8 primary samples x (5 obscurance + 5 shadow rays) per hit.
@@ -76,6 +88,10 @@ const std::vector<Method> kMethods = {
      "spatial light sampling, 5+5 rays per hit, 8 spp (the paper's budget)"},
     {"obscurance-paper", false, render::LightSampling::Area, kPaperRays, kPaperSpp,
      "the paper's light sampling (by power, by area), 5+5 rays per hit, 8 spp"},
+    // The same 10 shading rays per hit, spent where modern-hall's noise is: its direct light
+    // holds 2/3 of the variance at 5 + 5, the obscurance 2 % (docs/BENCHMARKS.md).
+    {"obscurance-split", false, render::LightSampling::Spatial, 8, kPaperSpp,
+     "spatial light sampling, 8 shadow + 2 obscurance rays per hit, 8 spp", 0.0f, false, 2},
     {"obscurance-realtime", false, render::LightSampling::Spatial, 1, 1, "spatial, 1+1 rays per hit, 1 spp"},
     // The window's frames: the same, denoised (one frame alone, no history), error measured.
     {"obscurance-denoised", false, render::LightSampling::Spatial, kPaperRays, 1,
@@ -96,6 +112,13 @@ std::vector<Method> studyMethods(const ConvergeOptions& o) {
                          o.secondaryReflectors);
     m.secondaryReflectors = o.secondaryReflectors;
     methods.insert(methods.end() - 1, m);
+  }
+  if (o.emissionSamples > 1) { // what the emission rays change, in the same run
+    Method m = methods.front();
+    m.name = "obscurance-primary-emission";
+    m.what = "as obscurance, the seen emission from the primary rays alone (--emission-samples 1)";
+    m.emissionSamples = 1;
+    methods.insert(methods.begin() + 1, m);
   }
   return methods;
 }
@@ -124,7 +147,7 @@ public:
     const render::RenderStats* stats = nullptr;
     if (m.pathTrace) {
       render::PathTraceSettings s{.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_,
-                                  .lightSampling = m.lightSampling};
+                                  .lightSampling = m.lightSampling, .emissionSamples = o_.pathEmissionSamples};
       if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, loaded_.scene, loaded_.bvh, s);
       pathTracer_->configure(s);
       pathTracer_->render();
@@ -135,10 +158,11 @@ public:
       s.width = width_;
       s.height = height_;
       s.spp = spp;
+      s.emissionSamples = m.emissionSamples ? m.emissionSamples : o_.emissionSamples;
       s.seed = seed;
       s.camera = camera_;
       s.shadowRays = m.raysPerHit;
-      s.obscuranceRays = m.raysPerHit;
+      s.obscuranceRays = m.obscuranceRays ? m.obscuranceRays : m.raysPerHit;
       s.lightSampling = m.lightSampling;
       s.ambient = render::AmbientModel::Seen; // the least biased I_a; Reached and Global composed beside it
       s.dMax = o_.dMax;
@@ -174,8 +198,10 @@ public:
     fs::path exr = fs::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
     fs::path txt = exr;
     txt.replace_extension(".txt");
-    std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} light_sampling={}{}{}",
+    std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} "
+                                          "emission_samples={} light_sampling={}{}{}",
                                           o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
+                                          m.pathTrace ? o_.pathEmissionSamples : o_.emissionSamples,
                                           m.lightSampling == render::LightSampling::Area ? "area" : "spatial",
                                           m.pathTrace ? "" : fmt::format(" ambient=seen+reached+global dmax={} secondary_reflectors={}",
                                                                          o_.dMax, m.secondaryReflectors),
@@ -424,6 +450,13 @@ void addConvergeCommand(CLI::App& app) {
   cmd->add_option("--background", o->background, "R,G,B: a constant sky for both methods (as render --background)")
       ->delimiter(',')
       ->expected(3);
+  cmd->add_option("--emission-samples", o->emissionSamples,
+                  fmt::format("obscurance methods: camera rays per sample for the emission the camera sees (render "
+                              "--emission-samples; default {})", kObscuranceEmissionSamples))
+      ->check(CLI::Range(1u, gpu::kMaxEmissionSamples));
+  cmd->add_option("--pt-emission-samples", o->pathEmissionSamples,
+                  fmt::format("path tracing: the same (default {})", kPathEmissionSamples))
+      ->check(CLI::Range(1u, gpu::kMaxEmissionSamples));
   cmd->add_option("--secondary-reflectors", o->secondaryReflectors,
                   "T: study obscurances with secondary reflectors marked at T x mean direct irradiance too "
                   "(method obscurance-reflectors, with its own reference and bias floor)")

@@ -168,10 +168,12 @@ void runRender(RenderOptions& o) {
       throw InputError("--save-state: only the obscurance method keeps per-light transport (--method obscurance)");
     render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
                                  .camera = camera, .maxDepth = settings.maxDepth,
-                                 .lightSampling = settings.lightSampling};
+                                 .lightSampling = settings.lightSampling,
+                                 .emissionSamples = settings.emissionSamples};
     render::PathTracer tracer(context, loaded.scene, loaded.bvh, pt);
     tracer.render(progress);
-    writeOutputs(o, tracer.image(), tracer.stats(), context, loaded, {{"method", "pathtrace"}, {"max_depth", pt.maxDepth}});
+    writeOutputs(o, tracer.image(), tracer.stats(), context, loaded,
+                 {{"method", "pathtrace"}, {"max_depth", pt.maxDepth}, {"emission_samples", pt.emissionSamples}});
     return;
   }
   // Only what the output shows is kept: a PNG of combined needs neither the primary AOVs nor the
@@ -238,7 +240,7 @@ void runRender(RenderOptions& o) {
                 {"secondary_reflector_triangles", renderer.secondaryReflectors()},
                 {"i_a", {ia.x, ia.y, ia.z}}, {"i_a_global", {iaGlobal.x, iaGlobal.y, iaGlobal.z}},
                 {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
-                {"r_ave", {rAve.x, rAve.y, rAve.z}}, {"ambient_intensity", {ia.x, ia.y, ia.z}},
+                {"emission_samples", settings.emissionSamples}, {"r_ave", {rAve.x, rAve.y, rAve.z}}, {"ambient_intensity", {ia.x, ia.y, ia.z}},
                 {"lights", renderer.lights().names}, {"bands", renderer.layout().bandCount()},
                 {"denoise", denoiseJson}},
                &display);

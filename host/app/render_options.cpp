@@ -35,6 +35,11 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
       ->check(CLI::Range(1u, 16384u));
   cmd.add_option("--height", o.height, "image height in pixels")->check(CLI::Range(1u, 16384u));
   cmd.add_option("--spp", o.spp, "primary samples per pixel")->check(CLI::Range(1u, 1u << 20));
+  cmd.add_option("--emission-samples", o.obscurance.emissionSamples,
+                 "K: camera rays per sample for the emission the camera sees (both methods; default 1, the sample's "
+                 "own ray). K > 1 traces K cheap rays of their own (no shading), which sharpens the edges of bright "
+                 "emitters seen directly")
+      ->check(CLI::Range(1u, gpu::kMaxEmissionSamples));
   cmd.add_option("--seed", o.seed, "random seed (same seed, same image)");
   cmd.add_option("--camera", o.camera, "index of the glTF camera to use (default: the first)")
       ->check(CLI::NonNegativeNumber);

@@ -76,7 +76,8 @@ void saveState(const std::string& dir, const render::ObscuranceRenderer& rendere
       {"specular", renderer.specular()},
       {"settings", {{"seed", s.seed}, {"shadow_rays", s.shadowRays}, {"obscurance_rays", s.obscuranceRays},
                     {"dmax", renderer.dMax()}, {"rho", static_cast<int>(s.rho)}, {"systematic", s.systematic},
-                    {"colour_bleeding", s.colourBleeding}, {"max_depth", s.maxDepth}}},
+                    {"colour_bleeding", s.colourBleeding}, {"max_depth", s.maxDepth},
+                    {"emission_samples", s.emissionSamples}}},
       {"average_reflectance", vec3Json(renderer.ambient().averageReflectance)},
       {"lights", nlohmann::json::array()}};
   for (std::size_t i = 0; i < lights.size(); ++i)

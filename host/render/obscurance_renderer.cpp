@@ -166,6 +166,9 @@ void ObscuranceRenderer::retraceAll() {
 }
 
 void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
+  if (settings.emissionSamples == 0 || settings.emissionSamples > gpu::kMaxEmissionSamples)
+    throw InputError(fmt::format("--emission-samples {}: camera rays per sample for the seen emission must be in 1..{}",
+                                 settings.emissionSamples, gpu::kMaxEmissionSamples));
   if (settings.width != frame_.layout().width || settings.height != frame_.layout().height ||
       settings.primaryAovs != frame_.contents().primaryAovs ||
       (settings.composedAovs ? gpu::kComposeSlots : 1u) != frame_.contents().composedSlots)
@@ -296,12 +299,16 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
       }
     });
     timestamps_.collect();
-    primaryRays_ += layout.pixels() * (last - samples_);
+    primaryRays_ += layout.pixels() * (last - samples_) * cameraRaysPerSample();
     samples_ = last;
     gbufferSample_ = last - 1;
     wallSeconds_ = wallBefore + secondsSince(start);
     if (progress) progress(samples_ - (end - samples), samples, secondsSince(start));
   }
+}
+
+std::uint64_t ObscuranceRenderer::cameraRaysPerSample() const {
+  return settings_.emissionSamples > 1 ? 1u + settings_.emissionSamples : 1u;
 }
 
 void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t s, std::uint32_t primaryFlags,
@@ -320,6 +327,9 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   // A probe's passes are timed as probe.<pass>.
   const bool probe = (shadeFlags & gpu::kShadeFlagProbe) != 0;
   const auto label = [probe](const char* pass) { return probe ? "probe." + std::string(pass) : std::string(pass); };
+  // The emission rays go with every primary pass that sums (its flags ask for them).
+  if ((primaryFlags & gpu::kPrimaryFlagGBufferOnly) == 0 && settings_.emissionSamples > 1)
+    primaryFlags |= settings_.emissionSamples << gpu::kPrimaryEmissionSamplesShift;
   if (tracePrimary) {
     timestamps_.begin(cmd, label("primary"));
     for (std::uint32_t b = 0; b < bands; ++b)
@@ -466,7 +476,7 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
       }
     });
     timestamps_.collect();
-    primaryRays_ += retraced * (last - first);
+    primaryRays_ += retraced * (last - first) * cameraRaysPerSample();
   }
   // The retraced pixels' G-buffer now holds the last sample; the others' still hold theirs.
   if (retraced > 0 && gbufferSample_ + 1 != samples_) gbufferSample_ = kNoSample;

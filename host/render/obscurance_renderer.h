@@ -65,6 +65,10 @@ enum class DirtyTest { Auto, Bounds, Probe };
 struct ObscuranceSettings {
   std::uint32_t width = 512, height = 512;
   std::uint32_t spp = 8;             // primary samples (iterations) per pixel
+  // Camera rays per primary sample for the emission the camera sees (M_s), 1..64: above 1, that
+  // many cheap rays of their own (a closest hit, no shading) estimate it instead of the primary
+  // ray, which sharpens the edges of bright emitters seen directly (lib/emission_samples.glsl).
+  std::uint32_t emissionSamples = 1;
   std::uint32_t seed = 1;
   scene::Camera camera;
   std::uint32_t shadowRays = 5;      // N_s per hit
@@ -295,6 +299,8 @@ private:
   // sample already.
   void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, std::uint32_t primaryFlags,
                     std::uint32_t shadeFlags, bool tracePrimary = true);
+  // Camera rays a summing primary pass traces per pixel and sample: its own, and the emission rays.
+  std::uint64_t cameraRaysPerSample() const;
   // The probing half of a geometry edit's dirty test: every sample so far replayed over the
   // candidates dirty.comp listed, each ray tested against the changed boxes (lib/probe.glsl).
   void probeCandidates();

@@ -29,6 +29,9 @@ gpu::KernelDesc pathKernelDesc(std::uint32_t bands) {
 const PathTraceSettings& checked(const PathTraceSettings& settings) {
   if (settings.width == 0 || settings.height == 0) throw InputError("path tracing: the image has no pixels");
   if (settings.spp == 0) throw InputError("path tracing: --spp must be at least 1");
+  if (settings.emissionSamples == 0 || settings.emissionSamples > gpu::kMaxEmissionSamples)
+    throw InputError(fmt::format("path tracing: --emission-samples {} is not in 1..{}", settings.emissionSamples,
+                                 gpu::kMaxEmissionSamples));
   if (settings.maxDepth > kMaxPathDepth)
     throw InputError(fmt::format("path tracing: depth {} is above the limit of {}", settings.maxDepth, kMaxPathDepth));
   return settings;
@@ -101,7 +104,8 @@ void PathTracer::iterate(std::uint32_t samples, const ProgressFn& progress) {
                      .frame = glm::uvec4(settings_.width, settings_.height, 0u, settings_.seed),
                      .params = glm::uvec4(lightCount, settings_.maxDepth, settings_.rrDepth,
                                           static_cast<std::uint32_t>(settings_.strategy)),
-                     .band = glm::uvec4(0u, 0u, static_cast<std::uint32_t>(settings_.lightSampling), 0u)};
+                     .band = glm::uvec4(0u, 0u, static_cast<std::uint32_t>(settings_.lightSampling),
+                                         settings_.emissionSamples)};
   push.camera.right.w = sceneScale(scene_->bounds); // the ray-origin offset's scale (ray.glsl)
   const std::uint32_t end = samples_ + samples;
   while (samples_ < end) {

@@ -39,6 +39,8 @@ struct PathTraceSettings {
   std::uint32_t rrDepth = 3;       // Russian roulette after this many vertices (>= maxDepth: never)
   PathStrategy strategy = PathStrategy::Mis;
   LightSampling lightSampling = LightSampling::Spatial; // next-event estimation's light sampling
+  // Camera rays per path for the emission the camera sees, 1..64 (as ObscuranceSettings's).
+  std::uint32_t emissionSamples = 1;
 };
 
 // The largest maxDepth accepted (each vertex costs loop passes of lavapipe's limiter; a deeper

@@ -227,6 +227,11 @@ OBS_CONST uint kPrimaryFlagGBufferOnly = 1u;
 OBS_CONST uint kPrimaryFlagNoAovs = 2u;
 // Only pixels the dirty mask marks run (a geometry edit retraces them); the others keep their sums.
 OBS_CONST uint kPrimaryFlagDirtyOnly = 4u;
+// The flags' bits from here up: --emission-samples K (K > 1: M_s from K camera rays of their own
+// per sample, lib/emission_samples.glsl; 0 or 1: from the primary ray).
+OBS_CONST uint kPrimaryEmissionSamplesShift = 8u;
+// The largest K: K traversals per sample share the loop limiter's budget (LAVAPIPE.md).
+OBS_CONST uint kMaxEmissionSamples = 64u;
 
 // ---- Push constants of the bench/trace kernel.
 struct TracePush {
@@ -354,7 +359,8 @@ struct PathPush {
   GpuCamera camera; // 0: camera.right.w = scene size (scales the ray-origin offset, ray.glsl)
   uvec4 frame;      // 64: width, height, sample index, seed
   uvec4 params;     // 80: light count (0 = no light with power), max depth d, RR depth, strategy
-  uvec4 band;       // 96: first row, rows, light sampling (kLightSampling*), unused
+  uvec4 band;       // 96: first row, rows, light sampling (kLightSampling*), emission samples K
+                    //     (K > 1: the camera ray's emission from K rays of their own)
 };                  // 112 bytes
 OBS_CONST uint kPathStrategyMis = 0u;       // MIS of light and BSDF sampling (the reference)
 OBS_CONST uint kPathStrategyLightOnly = 1u; // area lights by light sampling only (tests)

@@ -244,7 +244,9 @@ TEST_F(CliBadInput, NegativeOrZeroCountsAreRefused) {
        {render + "--width -16", render + "--height -1", render + "--spp -1 --method pathtrace",
         render + "--spp 0 --method pathtrace", render + "--max-depth 0", render + "--obs-rays -2",
         render + "--shadow-rays -1", render + "--tau 0 --rho exp", converge + "--width 0", converge + "--max-spp 0",
-        converge + "--pt-max-spp 0", converge + "--reference-factor 0"}) {
+        converge + "--pt-max-spp 0", converge + "--reference-factor 0", render + "--emission-samples 0",
+        render + "--emission-samples 65 --method pathtrace", converge + "--emission-samples 0",
+        converge + "--pt-emission-samples 65"}) {
     const auto r = runObscura(args);
     EXPECT_NE(r.exitCode, 0) << args << "\n" << r.output;
     EXPECT_NE(r.exitCode, -1) << args << "\n" << r.output;

@@ -44,10 +44,11 @@ TEST_F(Cli, RendersTheDefaultSceneToPngAndExrWithMetrics) {
 
 // A small study end to end: every method's curve in the CSV, each obscurance method's speed-up in
 // three error measures and the bias floor in the summary, the equal-time PNGs, and a second run
-// that takes both references from the cache.
+// that takes both references from the cache. With emission rays, the same method without them too.
 TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   const std::string args = "converge " + cornellBox() + " -o " + path("study") +
-                           " --width 16 --max-spp 8 --pt-max-spp 8 --reference-factor 4 --secondary-reflectors 1";
+                           " --width 16 --max-spp 8 --pt-max-spp 8 --reference-factor 4 --secondary-reflectors 1"
+                           " --emission-samples 4 --pt-emission-samples 2";
   auto r = runObscura(args);
   ASSERT_EQ(r.exitCode, 0) << r.output;
   for (const char* part : {"equal-noise speed-up", "bias floor", "crossover", "rmse_trimmed", "equal time",
@@ -60,7 +61,8 @@ TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   std::map<std::string, int> rows;
   while (std::getline(csv, line)) ++rows[line.substr(0, line.find(','))];
   const std::map<std::string, int> expected = {
-      {"obscurance", 4}, {"obscurance-paper", 4}, {"obscurance-realtime", 4}, {"obscurance-reflectors", 4},
+      {"obscurance", 4}, {"obscurance-primary-emission", 4}, {"obscurance-paper", 4}, {"obscurance-split", 4},
+      {"obscurance-realtime", 4}, {"obscurance-reflectors", 4},
       {"obscurance-denoised", 4}, {"obscurance-realtime-denoised", 4}, {"pathtrace", 4}}; // 1, 2, 4, 8 spp
   EXPECT_EQ(rows, expected);
   std::ifstream json(path("study/cornell-box.convergence.json"));

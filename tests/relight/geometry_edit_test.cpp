@@ -121,9 +121,12 @@ protected:
           ++changed;
     EXPECT_GT(changed, 0u);
     EXPECT_LE(changed, retraced);
+    old_ = old;
+    moved_ = moved;
     return retraced;
   }
   scene::Scene edited_;
+  io::Image old_, moved_; // the last moveAndCompare's frames before and after the edit
   bvh::Bvh editedBvh_;
   bool blind_ = false; // roomWithObject's blind
 };
@@ -191,6 +194,28 @@ TEST_F(GeometryEdit, ObjectMovedInFromOutsideTheRoomMatchesAFullRender) {
   const std::uint64_t retraced =
       moveAndCompare({6.0f, 2.8f, -1.2f}, {1.0f, 2.8f, -1.2f}, 1.0f, true, true, 0.0f, boundsOnly);
   EXPECT_LT(retraced, 48u * 36u);
+}
+
+TEST_F(GeometryEdit, OccluderBeforeTheSeenLampWithEmissionSamplesMatchesAFullRender) {
+  // The camera looks level, so it sees the lamp; the object slides under it into the line of
+  // sight and hides part of it. The seen emission is summed from emission rays of their own
+  // (--emission-samples), which the retraced pixels must trace again like their primary rays.
+  const auto levelWithEmissionRays = [](render::ObscuranceSettings& s) {
+    s.camera = lookCamera({0, 1.5f, 4.5f}, {0, 0, -1}, {0, 1, 0}, 0.9f);
+    s.emissionSamples = 8;
+  };
+  const std::uint64_t retraced =
+      moveAndCompare({-1.2f, 2.5f, 1.5f}, {0.1f, 2.5f, 1.5f}, 0.5f, true, false, 0.0f, levelWithEmissionRays);
+  EXPECT_LT(retraced, 48u * 36u);
+  const int c = old_.channelIndex("emission.R");
+  double seenBefore = 0.0, seenAfter = 0.0;
+  for (int y = 0; y < old_.height; ++y)
+    for (int x = 0; x < old_.width; ++x) {
+      seenBefore += old_.at(x, y, c);
+      seenAfter += moved_.at(x, y, c);
+    }
+  EXPECT_GT(seenBefore, 0.0) << "the camera sees the lamp";
+  EXPECT_LT(seenAfter, 0.9 * seenBefore) << "the object hides part of it";
 }
 
 TEST_F(GeometryEdit, ShadowAtASpecularPathsVertexIsRetraced) {

@@ -1,0 +1,59 @@
+// emission_samples.glsl — camera rays of their own for the emission the camera sees
+// (--emission-samples K; obscurances' M_s in primary.comp, the path tracer's camera-ray emission in
+// pathtrace.comp).
+//
+// Where an emitter's edge crosses a pixel, the pixel's seen emission is its covered fraction times
+// a radiance far above everything around it: with N primary samples the fraction is estimated
+// from N points, and those few pixels can hold most of an image's squared error (the Cornell
+// box's ceiling lamp: docs/BENCHMARKS.md). The emission needs no shading, only the hit's material,
+// so K cheap rays per primary sample (a closest hit and, on an emitter only, its surface) estimate
+// it instead of the primary ray alone: the mean of their emissions is an unbiased estimate of the
+// pixel's box-filtered seen emission [SPEC §5], like the primary ray's, with K times the points.
+// Requires scene_bindings.glsl, bvh.glsl, surface.glsl, material.glsl, camera.glsl.
+#ifndef OBSCURA_EMISSION_SAMPLES_GLSL
+#define OBSCURA_EMISSION_SAMPLES_GLSL
+
+// What a camera ray sees of the lights: the light group (kInvalidIndex: nothing that emits) and
+// the radiance, a surface's emission or, for the sky (`sky`), unit radiance the caller scales by
+// the sky's E_s.
+struct SeenEmitter {
+  uint lightGroup;
+  vec3 radiance;
+  bool sky;
+};
+
+// Sub-pixel position of emission ray j of primary sample `sampleIndex`, K per sample: element
+// sampleIndex K + j of the pixel's R2 sequence (camera.glsl), so the rays of the first N samples
+// are its first N K elements, as well stratified over the pixel as N K primary samples would be.
+vec2 emissionSampleOffset(uint sampleIndex, uint j, uint count, vec2 shift) {
+  return pixelSampleOffset(sampleIndex * count + j, shift);
+}
+
+// The emitter `hit` (a camera ray's closest hit) shows. `skySlot`: the background light's slot
+// (>= lightCount: none). A surface's geometry is only rebuilt when its material emits.
+SeenEmitter emitterSeen(RayHit hit, vec3 origin, vec3 direction, uint skySlot, uint lightCount) {
+  SeenEmitter e = SeenEmitter(kInvalidIndex, vec3(0.0), false);
+  if (rayHitValid(hit) && hit.primitive != kInvalidIndex) {
+    uint material = floatBitsToUint(triangleShading[hit.primitive].n0.w);
+    if (all(equal(materials[material].emission.rgb, vec3(0.0)))) return e;
+    Surface s = surfaceAt(hit, origin, direction);
+    e.lightGroup = s.lightGroup;
+    e.radiance = materialEmission(materials[s.material], s.uv, s.frontFacing);
+  } else if (hit.primitive != kTruncatedHit && skySlot < lightCount) { // a miss, not a truncation
+    e.lightGroup = skySlot;
+    e.radiance = vec3(1.0);
+    e.sky = true;
+  }
+  return e;
+}
+
+// Traces emission ray j of sample `sampleIndex` (K = `count` per sample) through pixel `p`.
+SeenEmitter traceEmissionSample(inout StepBudget budget, GpuCamera camera, uvec2 p, vec2 size, uint sampleIndex,
+                                uint j, uint count, vec2 shift, uint lightCount) {
+  vec2 position = vec2(p) + emissionSampleOffset(sampleIndex, j, count, shift);
+  vec3 direction = cameraRayDirection(camera, position, size);
+  RayHit hit = traceWithBudget(budget, camera.origin.xyz, direction, 0.0, 1.0 / 0.0, false);
+  return emitterSeen(hit, camera.origin.xyz, direction, floatBitsToUint(camera.up.w), lightCount);
+}
+
+#endif
