@@ -110,9 +110,6 @@ float boundsImportance(float power, vec4 sphere, vec4 cone, float cosE, bool uni
   return importance;
 }
 
-// A spot's bound reaches this cosine past its outer cone (rounding slack; light_selection.h).
-const float kSpotConeSlack = 0.99999;
-
 // Light i's importance: its own bounds (the area light's sphere and normal cone, a point, a spot's
 // position and outer cone). Directional lights are not bounded here (lightSelection gives them
 // their own share).

@@ -122,6 +122,9 @@ OBS_CONST uint kLightSamplingArea = 1u;
 // many lights; with more it descends the light tree (GpuLightNode) instead, which visits
 // 2 x depth nodes per sample (lavapipe's loop limiter counts each light or node visited).
 OBS_CONST uint kMaxSpatialLights = 64u;
+// The importance bound of a spot reaches this cosine past its outer cone (rounding slack; no
+// cosine factor inside the cone): lights.glsl and its C++ twin, render/scene/light_selection.h.
+OBS_CONST float kSpotConeSlack = 0.99999f;
 
 struct GpuLight {
   vec4 position;  // 0:  point/spot: world position, w = range (0 = infinite); area: centre of the

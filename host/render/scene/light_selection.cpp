@@ -46,7 +46,7 @@ ImportanceBounds importanceBounds(const gpu::GpuLight& light) {
   b.radius = area ? light.position.w : 0.0f;
   b.axis = area || spot ? glm::vec3(light.direction) : glm::vec3(0.0f, 0.0f, 1.0f);
   b.cosO = area ? light.direction.w : spot ? light.params.w : -1.0f;
-  b.cosE = spot ? kSpotConeSlack : 0.0f;
+  b.cosE = spot ? gpu::kSpotConeSlack : 0.0f;
   b.uniformInCone = spot;
   return b;
 }

@@ -28,9 +28,6 @@ struct ImportanceBounds {
 ImportanceBounds importanceBounds(const gpu::GpuLight& light);
 ImportanceBounds importanceBounds(const gpu::GpuLightNode& node);
 
-// The spread of a spot's bound past its outer cone: rounding slack, no cosine factor inside.
-inline constexpr float kSpotConeSlack = 0.99999f;
-
 // Conty Estevez & Kulla 2018 eq. 3 (lights.glsl boundsImportance).
 float boundsImportance(const ImportanceBounds& b, glm::vec3 p, glm::vec3 n);
 float lightImportance(const gpu::GpuLight& light, glm::vec3 p, glm::vec3 n);
