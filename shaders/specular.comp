@@ -20,6 +20,9 @@
 // With kShadeFlagProbe (a geometry edit's dirty test, lib/probe.glsl) the same paths are followed
 // in the edited scene: the lobe rays are traced, every other ray only tested against the changed
 // boxes, nothing is summed, and the pixel is marked dirty when one meets a box.
+// With kShadeFlagPathHits the frame keeps this sample's lobe hits: the plain kernel writes them,
+// and the per-light and probing variants specialised with kReplayHits read them instead of tracing
+// the lobe rays again (lib/path_hits.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -38,6 +41,7 @@
 #include "lib/accumulate.glsl"
 #include "lib/obscurance.glsl"
 #include "lib/band.glsl"
+#include "lib/path_hits.glsl"
 
 layout(local_size_x = kWorkgroupSize1D) in;
 
@@ -75,6 +79,10 @@ void main() {
   const bool oneLight = shadesOneLight();
   const uint addedLight = pc.band.w;
   const bool noDirect = (pc.band.z & kShadeFlagNoDirect) != 0u;
+  // The frame keeps this sample's lobe hits (the host checks that the depth fits): the plain kernel
+  // writes them; the variants that follow the paths again (an added light, a probe) take them
+  // instead of tracing when specialised with kReplayHits (lib/path_hits.glsl).
+  const bool keepHits = !kProbe && !kPerLight && !kReplayHits && (pc.band.z & kShadeFlagPathHits) != 0u;
 
   ShadingPoint sp = shadingPointFromGBuffer(gbuffer[pixel], pc.eye.xyz);
   uint pathRng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu); // lobe samples only
@@ -100,8 +108,15 @@ void main() {
     throughput *= weight;
     if (all(equal(throughput, vec3(0.0)))) break;
     vec3 origin = offsetRayOrigin(sp.position, sp.ng);
-    RayHit h = traceFollowed(budget, origin, wi, 0.0, 1.0 / 0.0); // traced even when probing
-    ++rays;
+    const uint hitSlot = pathHitSlot(pc.frame.z, pixel, pixelCount, depth);
+    RayHit h;
+    if (kReplayHits) {
+      h = probedPathHit(hitSlot, origin, wi);
+    } else {
+      h = traceFollowed(budget, origin, wi, 0.0, 1.0 / 0.0); // traced even when probing
+      ++rays;
+      if (keepHits) keepPathHit(hitSlot, h);
+    }
     if (gProbeMet) break; // a probe that met a changed box: the pixel is dirty, the rest is moot
     if (!rayHitValid(h) || h.primitive == kInvalidIndex) {
       escaped = true;

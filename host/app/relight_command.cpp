@@ -147,6 +147,8 @@ void relightScene(RelightOptions& o) {
       edits.begin(), edits.end(), [](const relight::Edit& e) {
         return e.kind == relight::Edit::Kind::AddLight || e.kind == relight::Edit::Kind::AddQuad;
       }));
+  // An added light and a geometry edit's probe follow the frame's specular paths by their kept hits.
+  settings.keptPathSamples = settings.spp;
   // Each geometry edit makes the next scene; the renderer keeps a pointer to the current one.
   std::deque<scene::Scene> scenes;
   std::deque<bvh::Bvh> trees;
@@ -274,9 +276,10 @@ void relightScene(RelightOptions& o) {
     const double totalMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     nlohmann::json line = {{"edit", n}, {"kind", e.kindName()}, {"name", e.name}, {"pixels_retraced", retraced}};
     line.update(passFigures(before, renderer.stats()));
-    if (!bvhUpdate.is_null()) {
-      line["bvh"] = std::exchange(bvhUpdate, nlohmann::json());
-      // What the lights reach (CPU rays of the Reached ambient model), measured again for the edit.
+    if (!bvhUpdate.is_null()) line["bvh"] = std::exchange(bvhUpdate, nlohmann::json());
+    if (!line["bvh"].is_null() || e.kind == relight::Edit::Kind::AddLight) {
+      // What the lights reach (CPU rays of the Reached ambient model), measured again for the edit
+      // (an added light: its own, on a thread beside its GPU work).
       const auto reach = renderer.lastReachUpdate();
       line["reach"] = {{"rays", reach.rays}, {"ms", reach.ms}};
     }

@@ -46,6 +46,20 @@ const std::vector<std::string>& obscuranceAovNames() {
   return names;
 }
 
+namespace {
+
+// The samples whose lobe hits a frame keeps: as many as asked, within kKeptPathHitBytes and a
+// quarter of the device's memory.
+std::uint32_t pathHitSamples(const gpu::Context& context, const ObscuranceSettings& settings, bool specular) {
+  if (!specular || settings.keptPathSamples == 0) return 0;
+  const std::uint64_t perSample =
+      std::uint64_t(settings.width) * settings.height * ObscuranceFrame::kPathHitBytesPerSample;
+  const std::uint64_t budget = std::min(kKeptPathHitBytes, context.info().deviceLocalBytes / 4);
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(settings.keptPathSamples, budget / std::max<std::uint64_t>(perSample, 1)));
+}
+
+} // namespace
+
 bool sceneHasGlossy(const scene::Scene& scene) {
   std::vector<bool> glossy;
   for (const auto& m : scene.materials) glossy.push_back(isGlossy(m.metallic, m.roughness));
@@ -62,7 +76,8 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
       frame_(context, settings.width, settings.height, static_cast<std::uint32_t>(lights_.size()),
              FrameContents{.specular = runSpecular_, .primaryAovs = settings.primaryAovs,
                            .composedSlots = settings.composedAovs ? gpu::kComposeSlots : 1u,
-                           .spareLightSlots = settings.spareLightSlots},
+                           .spareLightSlots = settings.spareLightSlots,
+                           .pathHitSamples = pathHitSamples(context, settings, runSpecular_)},
              settings.maxBufferBytes),
       primary_(context, frame_.layout().bandCount()), shadow_(context, frame_.layout().bandCount()),
       obscurance_(context, frame_.layout().bandCount()), specularPass_(context, frame_.layout().bandCount()),
@@ -70,6 +85,8 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
       resolve_(context, frame_.layout().bandCount()), lightMix_(context, frame_.layout().bandCount()),
       dirty_(context, frame_.layout().bandCount()), sceneScale_(sceneScale(scene.bounds)),
       stream_(context), timestamps_(context) {
+  bvhOrder_ = bvh.order;
+  bvhNodes_ = bvh.nodes.size();
   for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
   if (settings.ambient != AmbientModel::Global) ambient_.model = settings.ambient;
@@ -206,6 +223,7 @@ void ObscuranceRenderer::markResolveStale(std::uint32_t fromLight, bool ambient)
 
 void ObscuranceRenderer::reset() {
   markResolveStale(0, true);
+  pathHitsValid_ = true; // the samples to come write them anew
   samples_ = 0;
   gbufferSample_ = kNoSample;
   primaryRays_ = 0;
@@ -252,7 +270,12 @@ void ObscuranceRenderer::bindAll() {
 void ObscuranceRenderer::prepareForEdits() const {
   shadow_.compileEditKernels();
   obscurance_.compileEditKernels();
-  specularPass_.compileEditKernels();
+  specularPass_.compileEditKernels(frame_.contents().pathHitSamples > 0);
+}
+
+std::uint32_t ObscuranceRenderer::pathHitsFlag(std::uint32_t sample, bool replaying) const {
+  const bool kept = sample < frame_.contents().pathHitSamples && settings_.maxDepth <= gpu::kPathHitsPerSample + 1;
+  return kept && (!replaying || pathHitsValid_) ? gpu::kShadeFlagPathHits : 0u;
 }
 
 gpu::ShadePush ObscuranceRenderer::forLight(gpu::ShadePush push, std::uint32_t light) {
@@ -319,13 +342,16 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   const gpu::GpuCamera camera = primaryCamera();
   gpu::ShadePush push = shadePush(s);
   push.band.z = shadeFlags;
+  // A probe follows the kept lobe hits; every other pass writes them (a per-light shadow sampling's
+  // per-light dispatches follow the hits the plain dispatch just wrote for the same pixels).
+  const bool probe = (shadeFlags & gpu::kShadeFlagProbe) != 0;
+  push.band.z |= pathHitsFlag(s, probe);
   // A retrace runs over the dirty pixels' list (dirty.comp), dispatched indirectly.
   const bool dirtyOnly = (shadeFlags & gpu::kShadeFlagDirtyOnly) != 0;
   if (dirtyOnly != ((primaryFlags & gpu::kPrimaryFlagDirtyOnly) != 0))
     throw std::logic_error("recordSample: the primary and shading passes retrace different pixels");
   const ObscuranceFrame* dirtyOf = dirtyOnly ? &frame_ : nullptr;
   // A probe's passes are timed as probe.<pass>.
-  const bool probe = (shadeFlags & gpu::kShadeFlagProbe) != 0;
   const auto label = [probe](const char* pass) { return probe ? "probe." + std::string(pass) : std::string(pass); };
   // The emission rays go with every primary pass that sums (its flags ask for them).
   if ((primaryFlags & gpu::kPrimaryFlagGBufferOnly) == 0 && settings_.emissionSamples > 1)
@@ -412,6 +438,12 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
   const bool sameSurfaces = edited.materials.size() == scene_->materials.size() &&
                             edited.textures.size() == scene_->textures.size();
   scene_ = &edited;
+  // A rebuilt BVH lays the triangles out anew: the kept lobe hits name other triangles now.
+  if (bvh.nodes.size() != bvhNodes_ || bvh.order != bvhOrder_) {
+    pathHitsValid_ = false;
+    bvhOrder_ = bvh.order;
+    bvhNodes_ = bvh.nodes.size();
+  }
   // Moved occluders change what every light reaches: where the emitters and surfaces stayed, only
   // the rays that meet the changed boxes are traced again.
   if (reached_) measureReach(edited, bvh, emittersMoved || !sameSurfaces ? nullptr : changed);
@@ -706,18 +738,37 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
   markResolveStale(static_cast<std::uint32_t>(index), false);
   appendPunctual(lights_, light, scene_->bounds);
   updateSelection(lights_);
-  if (reached_) ambient_.reach.push_back(reached_->measure(lights_, index));
   emissions_.push_back(lights_.emission.back());
-  updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   uploadLights();
+  // What the new light reaches (CPU rays, for I_a) is measured on a thread of its own while its
+  // rays are traced: compose needs it, the passes do not (lights_ stays as it is meanwhile).
+  std::future<LightReach> reach;
+  if (reached_) {
+    reach = std::async(std::launch::async, [this, index] {
+      const auto start = Clock::now();
+      LightReach r = reached_->measure(lights_, index);
+      lastReach_ = {r.rays.traced, 1e3 * secondsSince(start)};
+      return r;
+    });
+  }
+  const auto reachIn = [&] {
+    if (reach.valid()) ambient_.reach.push_back(reach.get());
+    updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
+  };
   if (reflectorsOn()) {
     // What the new light marks reflects every light's light: all of it again.
+    reachIn();
     markReflectors();
     retraceAll();
     return index;
   }
-
-  traceAddedLight(static_cast<std::uint32_t>(index));
+  try {
+    traceAddedLight(static_cast<std::uint32_t>(index));
+  } catch (...) {
+    if (reach.valid()) reach.wait(); // it reads lights_
+    throw;
+  }
+  reachIn();
   return index;
 }
 
@@ -753,7 +804,8 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
           gpu::computeBarrier(cmd);
           primaryPixels += layout.pixels();
         }
-        const gpu::ShadePush push = forLight(shadePush(s), light);
+        gpu::ShadePush push = forLight(shadePush(s), light);
+        push.band.z |= pathHitsFlag(s, true); // the specular paths by their kept hits
         timestamps_.begin(cmd, "shadow");
         for (std::uint32_t b = 0; b < layout.bandCount(); ++b) shadow_.record(cmd, b, layout, push);
         timestamps_.end(cmd, "shadow");

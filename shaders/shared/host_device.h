@@ -303,6 +303,18 @@ OBS_CONST uint kShadeFlagNoDirect = 4u;
 // pixel 2 in the dirty mask when one meets a box. Only a specular lobe ray is traced, in the edited
 // scene, so that the path goes on, and tested up to its hit. Nothing is accumulated.
 OBS_CONST uint kShadeFlagProbe = 8u;
+// The frame keeps this sample's specular path hits (ObscuranceFrame's pathHits, kBindingPathHits):
+// the plain specular kernel writes the hit of every lobe ray it traces, and the kernels that follow
+// the same paths again (an added light's per-light variant, a geometry edit's probe) read them
+// instead of tracing. The host sets it only while the kept hits are those of the frame's scene.
+OBS_CONST uint kShadeFlagPathHits = 16u;
+// Lobe rays kept per pixel and sample: a path's scattering vertices after the primary hit, up to
+// the paper's depth of 6 (SPEC §1.3). Deeper paths (--max-depth > 6) keep none.
+OBS_CONST uint kPathHitsPerSample = 5u;
+// A kept hit is one uvec4: t, u, v (float bits) and the hit triangle's texel in bvhItems (its
+// original index is that texel's w), or one of these for a lobe ray that found no triangle.
+OBS_CONST uint kPathHitMiss = 0xffffffffu;
+OBS_CONST uint kPathHitTruncated = 0xfffffffeu;
 // The specialisation constant (a bool) that makes a shading kernel its probing variant (kProbe,
 // lib/probe.glsl); kShadeFlagProbe dispatches go to that kernel.
 OBS_CONST uint kSpecConstantProbe = 0u;
@@ -317,6 +329,10 @@ OBS_CONST uint kSpecConstantReflectors = 1u;
 // selection). Like the reflectors' branch, that code slows the per-light path on lavapipe even
 // when no invocation takes it (docs/BENCHMARKS.md, adding a light).
 OBS_CONST uint kSpecConstantPerLight = 2u;
+// The specialisation constant (a bool) that makes the specular kernel's per-light and probing
+// variants follow the paths by the frame's kept lobe hits (kShadeFlagPathHits dispatches) instead
+// of tracing them (kReplayHits, lib/path_hits.glsl).
+OBS_CONST uint kSpecConstantReplayHits = 3u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 
@@ -334,7 +350,9 @@ OBS_CONST uint kBindingDirty = 15;           // uint[]: the dirty mask and list 
 OBS_CONST uint kBindingHitBounds = 16;       // = primary.comp's kBindingPrimaryHitBounds; specular
                                              // paths grow it with their vertices
 OBS_CONST uint kBindingLightTree = 17;       // GpuLightNode[]: the light tree (lights.glsl)
-OBS_CONST uint kShadingBindingCount = 18;
+OBS_CONST uint kBindingPathHits = 18;        // uvec4[(sample * pixels + pixel) * kPathHitsPerSample + k]:
+                                             // specular paths' lobe hits (kShadeFlagPathHits)
+OBS_CONST uint kShadingBindingCount = 19;
 
 // ---- Bindings of primary.comp after the scene's (0..5).
 OBS_CONST uint kBindingPrimaryGBuffer = 6;       // GBufferTexel[pixel]

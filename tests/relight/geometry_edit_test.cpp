@@ -64,6 +64,7 @@ render::ObscuranceSettings editSettings(float secondaryReflectors = 0.0f) {
   s.shadowRays = 2;
   s.obscuranceRays = 4;
   s.dMax = 0.4f; // fixed: the default follows the scene's bounds
+  s.keptPathSamples = s.spp; // as relight --edits: a probe follows the specular paths' kept hits
   s.camera = lookCamera({0, 1.5f, 4.5f}, glm::normalize(glm::vec3(0, -0.25f, -1)), {0, 1, 0}, 0.9f);
   return s;
 }
@@ -236,6 +237,60 @@ TEST_F(GeometryEdit, PerLightPenumbraRaysBeyondTheFirstFourAreProbed) {
                    s.shadowSampling = render::ShadowSampling::PerLight;
                    s.dirtyTest = render::DirtyTest::Probe; // a matte room: Auto would not probe
                  });
+}
+
+TEST_F(GeometryEdit, ProbingByKeptPathHitsRetracesWhatProbingByTracingDoes) {
+  // The probe follows the mirror floor's paths by the hits the render kept (lib/path_hits.glsl)
+  // instead of tracing their lobe rays in the edited scene: it must find the same dirty pixels.
+  const glm::vec3 from{-0.8f, 1.2f, -1.0f}, to{0.8f, 1.2f, -1.0f};
+  const std::uint64_t byKeptHits = moveAndCompare(from, to, 0.5f, true, true);
+  const io::Image keptFrame = moved_;
+  const std::uint64_t byTracing =
+      moveAndCompare(from, to, 0.5f, true, true, 0.0f, [](render::ObscuranceSettings& s) { s.keptPathSamples = 0; });
+  EXPECT_EQ(byKeptHits, byTracing);
+  const int c = moved_.channelIndex("specular.R");
+  for (int y = 0; y < moved_.height; ++y)
+    for (int x = 0; x < moved_.width; ++x)
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(keptFrame.at(x, y, c)), std::bit_cast<std::uint32_t>(moved_.at(x, y, c)));
+}
+
+TEST_F(GeometryEdit, KeptPathHitsAreNotFollowedAfterTheBvhIsRebuilt) {
+  // The kept hits name triangles by their place in the BVH's layout. A geometry edit that rebuilds
+  // the BVH (an insert does) lays them out anew: an added light must then trace the paths again,
+  // and give what a renderer that kept no hits gives, bit for bit.
+  const glm::vec3 from{-0.8f, 1.2f, -1.0f}, to{0.8f, 1.2f, -1.0f};
+  const scene::Scene before = roomWithObject(from, 0.5f, true, true);
+  const bvh::Bvh beforeBvh = bvh::build(render::triangleSoup(before));
+  edited_ = roomWithObject(to, 0.5f, true, true);
+  bvh::BuildOptions otherLayout;
+  otherLayout.maxLeafSize = 1; // another layout than beforeBvh's, as a rebuild after an insert may give
+  editedBvh_ = bvh::build(render::triangleSoup(edited_), otherLayout);
+  ASSERT_NE(editedBvh_.order, beforeBvh.order);
+  scene::PunctualLight bulb;
+  bulb.name = "bulb";
+  bulb.type = scene::PunctualType::Point;
+  bulb.position = {0.5f, 2.0f, 1.0f};
+  bulb.intensity = 4.0f;
+  std::vector<render::Transport> transports;
+  for (std::uint32_t kept : {4u, 0u}) {
+    render::ObscuranceSettings settings = editSettings();
+    settings.keptPathSamples = kept;
+    settings.spareLightSlots = 1;
+    render::ObscuranceRenderer r(context(), before, beforeBvh, settings);
+    r.render();
+    r.updateGeometry(edited_, editedBvh_, {objectBox(from, 0.5f), objectBox(to, 0.5f)});
+    r.addLight(bulb);
+    transports.push_back(r.transport());
+  }
+  const std::size_t added = transports[0].specularDirect.size() - 1;
+  std::size_t lit = 0;
+  for (std::size_t p = 0; p < transports[0].pixels(); ++p) {
+    ASSERT_EQ(std::memcmp(&transports[0].specularDirect[added][p], &transports[1].specularDirect[added][p],
+                          sizeof(glm::vec3)), 0)
+        << "pixel " << p;
+    lit += transports[0].specularDirect[added][p].x > 0.0f ? 1 : 0;
+  }
+  EXPECT_GT(lit, 0u);
 }
 
 TEST_F(GeometryEdit, LightMixAfterAMoveResolvesTheRetracedPixelsAlone) {

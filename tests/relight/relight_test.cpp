@@ -75,6 +75,7 @@ render::ObscuranceSettings roomSettings(std::uint32_t seed) {
   s.obscuranceRays = 4;
   s.camera = lookCamera({0.2f, 1.0f, 3.2f}, glm::normalize(glm::vec3(-0.1f, -0.05f, -1.0f)), {0, 1, 0}, 0.9f);
   s.spareLightSlots = 1; // the added-light tests
+  s.keptPathSamples = s.spp; // as relight --edits: an added light follows the kept lobe hits
   return s;
 }
 
@@ -303,6 +304,44 @@ TEST_F(Relight, AddedLightIsGatheredAlongTheSpecularPathsOfAGlossyFloor) {
   RoomLights edited = glossy;
   edited.withAdded = true;
   expectStatisticallyEqual(r.image(), edited);
+}
+
+// The kept lobe hits (ObscuranceSettings::keptPathSamples, lib/path_hits.glsl) let an added light
+// follow the glossy floor's specular paths without tracing their lobe rays: the same paths, vertex
+// for vertex, so the same transport bit for bit as following them by tracing again, with fewer rays.
+TEST_F(Relight, AddedLightByTheKeptPathHitsEqualsTracingThePathsAgain) {
+  RoomLights glossy;
+  glossy.glossyFloor = true;
+  scene_ = room(glossy);
+  bvh_ = bvh::build(render::triangleSoup(scene_));
+  std::vector<render::Transport> transports;
+  std::vector<std::uint64_t> specularRays;
+  for (std::uint32_t kept : {0u, 32u}) {
+    render::ObscuranceSettings settings = roomSettings(7);
+    settings.keptPathSamples = kept;
+    render::ObscuranceRenderer r(context(), scene_, bvh_, settings);
+    ASSERT_EQ(r.frame().contents().pathHitSamples, kept);
+    r.render();
+    const std::uint64_t before = r.stats().passes.at("specular").rays;
+    r.addLight(addedLight());
+    specularRays.push_back(r.stats().passes.at("specular").rays - before);
+    EXPECT_EQ(r.stats().truncatedTraversals, 0u);
+    transports.push_back(r.transport());
+  }
+  const render::Transport &traced = transports[0], &replayed = transports[1];
+  ASSERT_EQ(traced.specularDirect.size(), replayed.specularDirect.size());
+  const std::size_t added = traced.specularDirect.size() - 1;
+  std::size_t lit = 0;
+  for (std::size_t p = 0; p < traced.pixels(); ++p) {
+    ASSERT_EQ(std::memcmp(&traced.specularDirect[added][p], &replayed.specularDirect[added][p], sizeof(glm::vec3)), 0)
+        << "pixel " << p;
+    ASSERT_EQ(std::memcmp(&traced.direct[added][p], &replayed.direct[added][p], sizeof(glm::vec3)), 0) << "pixel " << p;
+    lit += traced.specularDirect[added][p].x > 0.0f ? 1 : 0;
+  }
+  EXPECT_GT(lit, 0u) << "the added light reaches the camera through the floor";
+  // Traced again: a lobe ray and a shadow ray per vertex; replayed, the shadow rays alone.
+  EXPECT_GT(specularRays[1], 0u);
+  EXPECT_LT(specularRays[1], specularRays[0]);
 }
 
 // An emissive quad is a light and an object: its light is traced at every pixel, and the pixels

@@ -38,6 +38,10 @@ struct FrameContents {
   // Lights that may be added: the per-light buffers have this many spare slots from the start,
   // so adding a light clears one slot instead of re-allocating and copying every basis buffer.
   std::uint32_t spareLightSlots = 0;
+  // Samples whose specular paths' lobe hits are kept (gpu::kPathHitsPerSample per pixel and sample),
+  // so that an added light's gather and a geometry edit's probe follow the paths without tracing
+  // them (shaders/lib/path_hits.glsl). Only with `specular`.
+  std::uint32_t pathHitSamples = 0;
 };
 
 
@@ -54,6 +58,7 @@ public:
                            // pixels with its indirect dispatch (dirty.comp; host_device.h), then
                            // the changed boxes for the probing passes (dirtyBoxesBase)
     gpu::Buffer sampleCounts; // per pixel, the samples its sums hold (primary.comp); compose divides by it
+    gpu::Buffer pathHits;     // per kept sample and pixel, its specular path's lobe hits (lib/path_hits.glsl)
   };
 
   // `maxBufferBytes` 0 = the device's per-buffer limit (a smaller one tests banding).
@@ -72,6 +77,8 @@ public:
   const Band& band(std::size_t i) const { return bands_[i]; }
   std::uint32_t lightCount() const { return lights_; }
   bool specular() const { return contents_.specular; }
+  // Bytes per pixel of one kept sample's lobe hits.
+  static constexpr std::uint64_t kPathHitBytesPerSample = gpu::kPathHitsPerSample * 16;
   const FrameContents& contents() const { return contents_; }
 
   const gpu::Buffer& status() const { return status_.buffer(); }

@@ -32,6 +32,13 @@ gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32
   return desc;
 }
 
+gpu::KernelDesc replayingHitsKernelDesc(gpu::KernelDesc desc) {
+  desc.name += ".replay";
+  desc.deferCompile = true;
+  desc.specConstants.push_back({.id = gpu::kSpecConstantReplayHits, .value = 1u});
+  return desc;
+}
+
 void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInputs& in) {
   in.scene.bindTo(kernel, band, &in.frame.status());
   const auto& b = in.frame.band(band);
@@ -47,6 +54,7 @@ void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInp
   kernel.bind(gpu::kBindingLightScales, in.lights.scales, band);
   kernel.bind(gpu::kBindingDirty, b.dirty, band);
   kernel.bind(gpu::kBindingHitBounds, b.hitBounds, band);
+  kernel.bind(gpu::kBindingPathHits, b.pathHits, band);
 }
 
 } // namespace obscura::render

@@ -11,12 +11,14 @@ public:
   SpecularPass(const gpu::Context& context, std::uint32_t bands);
 
   void bind(std::uint32_t band, const ShadingInputs& in);
-  // Compiles now the kernels only edits dispatch (deferred: KernelDesc::deferCompile).
-  void compileEditKernels() const {
-    probe_.compile();
-    perLight_.compile();
+  // Compiles now the kernels only edits dispatch (deferred: KernelDesc::deferCompile): those
+  // that replay the kept lobe hits where the frame keeps them, else those that trace.
+  void compileEditKernels(bool keptHits) const {
+    (keptHits ? probeReplay_ : probe_).compile();
+    (keptHits ? perLightReplay_ : perLight_).compile();
   }
-  // Clears band `band`'s queue, fills it and dispatches the paths (barriers included).
+  // Clears band `band`'s queue, fills it and dispatches the paths (barriers included). A per-light
+  // or probing dispatch with kShadeFlagPathHits follows the kept hits (the .replay kernels).
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
               const ObscuranceFrame& frame, const gpu::ShadePush& push) const;
 
@@ -25,6 +27,8 @@ private:
   gpu::Kernel paths_;
   gpu::Kernel probe_;    // paths_'s probing variant (kShadeFlagProbe)
   gpu::Kernel perLight_; // paths_'s variant for an added light alone (kSpecConstantPerLight)
+  // probe_ and perLight_ following the frame's kept lobe hits (kSpecConstantReplayHits)
+  gpu::Kernel probeReplay_, perLightReplay_;
 };
 
 } // namespace obscura::render
