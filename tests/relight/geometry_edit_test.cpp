@@ -28,7 +28,9 @@ namespace {
 // A room lit by a ceiling lamp (or unlit: obscurance alone), with a small floating "object" (a
 // horizontal double quad) at `object`; with `blind`, a fixed double quad under half of the lamp
 // (penumbrae everywhere below).
-scene::Scene roomWithObject(glm::vec3 object, float size, bool lamp = true, bool glossyFloor = false, bool blind = false) {
+// With `secondLamp`, a second ceiling lamp over the right of the room.
+scene::Scene roomWithObject(glm::vec3 object, float size, bool lamp = true, bool glossyFloor = false, bool blind = false,
+                            bool secondLamp = false) {
   SceneBuilder b;
   auto white = b.lambertian(glm::vec3(0.7f));
   auto floor = glossyFloor ? b.glossy(glm::vec3(0.8f), 1.0f, 0.05f) : white;
@@ -37,6 +39,7 @@ scene::Scene roomWithObject(glm::vec3 object, float size, bool lamp = true, bool
   b.quad({-2, 0, -2}, {0, 0, 4}, {4, 0, 0}, floor);  // floor, faces +y
   b.quad({-2, 0, -2}, {4, 0, 0}, {0, 3, 0}, white);  // back wall, faces +z
   if (lamp) b.quad({-0.3f, 2.99f, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f}, emitter, "lamp");
+  if (secondLamp) b.quad({1.4f, 2.99f, -0.3f}, {0.4f, 0, 0}, {0, 0, 0.6f}, emitter, "right_lamp");
   if (blind) {
     b.quad({-0.4f, 2.8f, -0.4f}, {0, 0, 0.8f}, {0.4f, 0, 0}, green);
     b.quad({-0.4f, 2.8f, -0.4f}, {0.4f, 0, 0}, {0, 0, 0.8f}, green);
@@ -79,9 +82,9 @@ protected:
                                const std::function<void(render::ObscuranceSettings&)>& tweak = {}) {
     render::ObscuranceSettings settings = editSettings(secondaryReflectors);
     if (tweak) tweak(settings);
-    const scene::Scene before = roomWithObject(from, size, lamp, glossyFloor, blind_);
+    const scene::Scene before = roomWithObject(from, size, lamp, glossyFloor, blind_, secondLamp_);
     const bvh::Bvh beforeBvh = bvh::build(render::triangleSoup(before));
-    edited_ = roomWithObject(to, size, lamp, glossyFloor, blind_);
+    edited_ = roomWithObject(to, size, lamp, glossyFloor, blind_, secondLamp_);
     // As `relight --edits` does for a move: the BVH refitted, not rebuilt.
     editedBvh_ = beforeBvh;
     bvh::refit(editedBvh_, render::triangleSoup(edited_));
@@ -129,7 +132,8 @@ protected:
   scene::Scene edited_;
   io::Image old_, moved_; // the last moveAndCompare's frames before and after the edit
   bvh::Bvh editedBvh_;
-  bool blind_ = false; // roomWithObject's blind
+  bool blind_ = false;      // roomWithObject's blind
+  bool secondLamp_ = false; // and its second lamp
 };
 
 TEST_F(GeometryEdit, MovedOccluderMatchesAFullRenderAndItsShadowIsRetraced) {
@@ -237,6 +241,18 @@ TEST_F(GeometryEdit, PerLightPenumbraRaysBeyondTheFirstFourAreProbed) {
                    s.shadowSampling = render::ShadowSampling::PerLight;
                    s.dirtyTest = render::DirtyTest::Probe; // a matte room: Auto would not probe
                  });
+}
+
+TEST_F(GeometryEdit, ProbedMoveUnderOneOfTwoLampsMatchesAFullRender) {
+  // Two lamps; the object moves just under the right one, so its shadows change only in the right
+  // lamp's light, cast from a lamp chosen for few samples where the left one is nearer: the probe
+  // must replay which light each sample chose. (A probe that skipped the samples of lights whose
+  // shafts miss the boxes, tried and dropped as slower, failed here when it took one light's
+  // shafts for another's.)
+  secondLamp_ = true;
+  const std::uint64_t retraced =
+      moveAndCompare({1.45f, 2.7f, -0.1f}, {1.7f, 2.7f, 0.05f}, 0.25f, true, false, 0.0f, probed);
+  EXPECT_LT(retraced, 48u * 36u);
 }
 
 TEST_F(GeometryEdit, ProbingByKeptPathHitsRetracesWhatProbingByTracingDoes) {
