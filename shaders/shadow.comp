@@ -5,6 +5,8 @@
 // basis buffers D_s at unit emission [SPEC §3]:
 //   D_s += f(P, wo, wi) L_e cos(theta_P) / pdf_omega / N_s
 // (with MIS weights on a glossy lobe that specular.comp samples too, lib/shade.glsl).
+// With kShadeFlagKeptRays the plain kernel keeps each shadow ray (lib/kept_rays.glsl), and the
+// probing variant specialised with kReplayRays tests those instead of drawing the light samples.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -20,6 +22,7 @@
 #include "lib/shade.glsl"
 #include "lib/accumulate.glsl"
 #include "lib/band.glsl"
+#include "lib/kept_rays.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
@@ -36,6 +39,11 @@ void main() {
   if (g.albedo.a == 0.0) return; // no hit: nothing to light
 
   ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);
+  if (kReplayRays) { // a probe by the kept rays (never for one light alone: those are not kept)
+    probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.frame.z, pixel, pixelCount, 0u, pc.counts.y);
+    endProbe(pixel);
+    return;
+  }
   // A probe whose shafts from the hit to the lights all miss the boxes draws no light sample.
   const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, pc.counts.x);
   if (!drawn) return;
@@ -53,6 +61,7 @@ void main() {
     return;
   }
   uint count = drawn ? pc.counts.y : 0u;
+  const bool keepRays = !kProbe && !kPerLight && (pc.band.z & kShadeFlagKeptRays) != 0u;
   float invCount = 1.0 / float(count);
   float misSamples = (pc.counts.w & kFlagGlossyMis) != 0u ? float(count) : 0.0;
   for (uint k = 0u; k < count; ++k) {
@@ -60,6 +69,7 @@ void main() {
     vec3 contribution;
     uint light;
     directLightSample(sp, u, pc.counts.x, misSamples, budget, contribution, light);
+    if (keepRays) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, pixelCount, 0u, k)] = gShadowRay;
     OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(contribution * invCount, 0.0))
   }
   if (kProbe) endProbe(pixel);

@@ -20,9 +20,10 @@
 // With kShadeFlagProbe (a geometry edit's dirty test, lib/probe.glsl) the same paths are followed
 // in the edited scene: the lobe rays are traced, every other ray only tested against the changed
 // boxes, nothing is summed, and the pixel is marked dirty when one meets a box.
-// With kShadeFlagPathHits the frame keeps this sample's lobe hits: the plain kernel writes them,
-// and the per-light and probing variants specialised with kReplayHits read them instead of tracing
-// the lobe rays again (lib/path_hits.glsl).
+// With kShadeFlagKeptRays the frame keeps this sample's lobe hits and its vertices' shadow rays:
+// the plain kernel writes them, and the per-light and probing variants specialised with kReplayRays
+// read them instead of tracing the lobe rays and drawing the probed light samples again
+// (lib/kept_rays.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -41,7 +42,7 @@
 #include "lib/accumulate.glsl"
 #include "lib/obscurance.glsl"
 #include "lib/band.glsl"
-#include "lib/path_hits.glsl"
+#include "lib/kept_rays.glsl"
 
 layout(local_size_x = kWorkgroupSize1D) in;
 
@@ -81,8 +82,8 @@ void main() {
   const bool noDirect = (pc.band.z & kShadeFlagNoDirect) != 0u;
   // The frame keeps this sample's lobe hits (the host checks that the depth fits): the plain kernel
   // writes them; the variants that follow the paths again (an added light, a probe) take them
-  // instead of tracing when specialised with kReplayHits (lib/path_hits.glsl).
-  const bool keepHits = !kProbe && !kPerLight && !kReplayHits && (pc.band.z & kShadeFlagPathHits) != 0u;
+  // instead of tracing when specialised with kReplayRays (lib/kept_rays.glsl).
+  const bool keepHits = !kProbe && !kPerLight && !kReplayRays && (pc.band.z & kShadeFlagKeptRays) != 0u;
 
   ShadingPoint sp = shadingPointFromGBuffer(gbuffer[pixel], pc.eye.xyz);
   uint pathRng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu); // lobe samples only
@@ -110,7 +111,7 @@ void main() {
     vec3 origin = offsetRayOrigin(sp.position, sp.ng);
     const uint hitSlot = pathHitSlot(pc.frame.z, pixel, pixelCount, depth);
     RayHit h;
-    if (kReplayHits) {
+    if (kReplayRays) {
       h = probedPathHit(hitSlot, origin, wi);
     } else {
       h = traceFollowed(budget, origin, wi, 0.0, 1.0 / 0.0); // traced even when probing
@@ -150,22 +151,29 @@ void main() {
     // MIS only where a lobe sample follows from this vertex (the loop goes on past it).
     float misSamples = glossyMis && depth + 1u < maxDepth ? float(shadowRays) : 0.0;
     const vec4 lightShift = rngNext4(rng); // this vertex's light samples: one shifted low-discrepancy set
-    // A probe whose shafts from the vertex to the lights all miss the boxes draws no light sample.
-    const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, lightCount);
-    if (oneLight) {
-      uint taken = 0u;
-      vec3 direct = vec3(0.0);
-      if (drawn) direct = directLightFromOne(sp, addedLight, lightShift, budget, taken);
-      OBS_ACCUMULATE(specularBasis, addedLight * pixelCount + pixel, vec4(throughput * direct, 0.0))
-      rays += taken;
-      continue;
-    }
-    for (uint k = 0u; k < (noDirect || !drawn ? 0u : shadowRays); ++k) {
-      vec4 u = kroneckerPoint4(k, lightShift);
-      vec3 contribution;
-      uint light;
-      directLightSample(sp, u, lightCount, misSamples, budget, contribution, light);
-      OBS_ACCUMULATE(specularBasis, light * pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
+    if (kProbe && kReplayRays) {
+      // The vertex's kept shadow rays (never kept for one light alone, nor without direct light:
+      // the host keeps no rays with per-light shadow sampling).
+      probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.frame.z, pixel, pixelCount, depth, shadowRays);
+    } else {
+      // A probe whose shafts from the vertex to the lights all miss the boxes draws no light sample.
+      const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, lightCount);
+      if (oneLight) {
+        uint taken = 0u;
+        vec3 direct = vec3(0.0);
+        if (drawn) direct = directLightFromOne(sp, addedLight, lightShift, budget, taken);
+        OBS_ACCUMULATE(specularBasis, addedLight * pixelCount + pixel, vec4(throughput * direct, 0.0))
+        rays += taken;
+        continue;
+      }
+      for (uint k = 0u; k < (noDirect || !drawn ? 0u : shadowRays); ++k) {
+        vec4 u = kroneckerPoint4(k, lightShift);
+        vec3 contribution;
+        uint light;
+        directLightSample(sp, u, lightCount, misSamples, budget, contribution, light);
+        if (keepHits) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, pixelCount, depth, k)] = gShadowRay;
+        OBS_ACCUMULATE(specularBasis, light * pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
+      }
     }
     // Secondary reflectors only at primary hits: here the ambient keeps its whole I_a.
     vec4 aw = gatherObscurance(sp, rng, budget, kInvalidIndex, pixelCount);

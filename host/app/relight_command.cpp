@@ -148,7 +148,7 @@ void relightScene(RelightOptions& o) {
         return e.kind == relight::Edit::Kind::AddLight || e.kind == relight::Edit::Kind::AddQuad;
       }));
   // An added light and a geometry edit's probe follow the frame's specular paths by their kept hits.
-  settings.keptPathSamples = settings.spp;
+  settings.keptRaySamples = settings.spp;
   // Each geometry edit makes the next scene; the renderer keeps a pointer to the current one.
   std::deque<scene::Scene> scenes;
   std::deque<bvh::Bvh> trees;

@@ -48,14 +48,21 @@ const std::vector<std::string>& obscuranceAovNames() {
 
 namespace {
 
-// The samples whose lobe hits a frame keeps: as many as asked, within kKeptPathHitBytes and a
-// quarter of the device's memory.
-std::uint32_t pathHitSamples(const gpu::Context& context, const ObscuranceSettings& settings, bool specular) {
-  if (!specular || settings.keptPathSamples == 0) return 0;
-  const std::uint64_t perSample =
-      std::uint64_t(settings.width) * settings.height * ObscuranceFrame::kPathHitBytesPerSample;
-  const std::uint64_t budget = std::min(kKeptPathHitBytes, context.info().deviceLocalBytes / 4);
-  return static_cast<std::uint32_t>(std::min<std::uint64_t>(settings.keptPathSamples, budget / std::max<std::uint64_t>(perSample, 1)));
+// Shadow rays per primary hit a frame keeps: N_s, where it can keep them.
+std::uint32_t keptShadowRays(const ObscuranceSettings& settings) {
+  return settings.shadowRays <= gpu::kMaxKeptShadowRays ? settings.shadowRays : 0u;
+}
+
+// The samples whose rays a frame keeps: as many as asked, within kKeptRayBytes and a quarter of
+// the device's memory; none where it could not keep every shadow ray.
+std::uint32_t keptRaySamples(const gpu::Context& context, const ObscuranceSettings& settings, bool specular) {
+  if (!specular || settings.keptRaySamples == 0 || keptShadowRays(settings) != settings.shadowRays ||
+      settings.shadowSampling != ShadowSampling::Selection)
+    return 0;
+  const std::uint64_t perSample = std::uint64_t(settings.width) * settings.height *
+                                  ObscuranceFrame::keptRayBytesPerSample(keptShadowRays(settings));
+  const std::uint64_t budget = std::min(kKeptRayBytes, context.info().deviceLocalBytes / 3);
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(settings.keptRaySamples, budget / std::max<std::uint64_t>(perSample, 1)));
 }
 
 } // namespace
@@ -77,7 +84,8 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
              FrameContents{.specular = runSpecular_, .primaryAovs = settings.primaryAovs,
                            .composedSlots = settings.composedAovs ? gpu::kComposeSlots : 1u,
                            .spareLightSlots = settings.spareLightSlots,
-                           .pathHitSamples = pathHitSamples(context, settings, runSpecular_)},
+                           .keptRaySamples = keptRaySamples(context, settings, runSpecular_),
+                           .keptShadowRays = keptShadowRays(settings)},
              settings.maxBufferBytes),
       primary_(context, frame_.layout().bandCount()), shadow_(context, frame_.layout().bandCount()),
       obscurance_(context, frame_.layout().bandCount()), specularPass_(context, frame_.layout().bandCount()),
@@ -223,7 +231,7 @@ void ObscuranceRenderer::markResolveStale(std::uint32_t fromLight, bool ambient)
 
 void ObscuranceRenderer::reset() {
   markResolveStale(0, true);
-  pathHitsValid_ = true; // the samples to come write them anew
+  keptRaysValid_ = true; // the samples to come write them anew
   samples_ = 0;
   gbufferSample_ = kNoSample;
   primaryRays_ = 0;
@@ -268,14 +276,17 @@ void ObscuranceRenderer::bindAll() {
 }
 
 void ObscuranceRenderer::prepareForEdits() const {
-  shadow_.compileEditKernels();
-  obscurance_.compileEditKernels();
-  specularPass_.compileEditKernels(frame_.contents().pathHitSamples > 0);
+  shadow_.compileEditKernels(frame_.contents().keptRaySamples > 0);
+  obscurance_.compileEditKernels(false);
+  specularPass_.compileEditKernels(frame_.contents().keptRaySamples > 0);
 }
 
-std::uint32_t ObscuranceRenderer::pathHitsFlag(std::uint32_t sample, bool replaying) const {
-  const bool kept = sample < frame_.contents().pathHitSamples && settings_.maxDepth <= gpu::kPathHitsPerSample + 1;
-  return kept && (!replaying || pathHitsValid_) ? gpu::kShadeFlagPathHits : 0u;
+std::uint32_t ObscuranceRenderer::keptRaysFlag(std::uint32_t sample, bool replaying) const {
+  // Per-light shadow sampling takes 4 to 64 rays per light: those are not kept.
+  const bool kept = sample < frame_.contents().keptRaySamples && settings_.maxDepth <= gpu::kPathHitsPerSample + 1 &&
+                    settings_.shadowRays <= frame_.contents().keptShadowRays &&
+                    settings_.shadowSampling == ShadowSampling::Selection;
+  return kept && (!replaying || keptRaysValid_) ? gpu::kShadeFlagKeptRays : 0u;
 }
 
 gpu::ShadePush ObscuranceRenderer::forLight(gpu::ShadePush push, std::uint32_t light) {
@@ -345,7 +356,7 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   // A probe follows the kept lobe hits; every other pass writes them (a per-light shadow sampling's
   // per-light dispatches follow the hits the plain dispatch just wrote for the same pixels).
   const bool probe = (shadeFlags & gpu::kShadeFlagProbe) != 0;
-  push.band.z |= pathHitsFlag(s, probe);
+  push.band.z |= keptRaysFlag(s, probe);
   // A retrace runs over the dirty pixels' list (dirty.comp), dispatched indirectly.
   const bool dirtyOnly = (shadeFlags & gpu::kShadeFlagDirtyOnly) != 0;
   if (dirtyOnly != ((primaryFlags & gpu::kPrimaryFlagDirtyOnly) != 0))
@@ -440,7 +451,7 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
   scene_ = &edited;
   // A rebuilt BVH lays the triangles out anew: the kept lobe hits name other triangles now.
   if (bvh.nodes.size() != bvhNodes_ || bvh.order != bvhOrder_) {
-    pathHitsValid_ = false;
+    keptRaysValid_ = false;
     bvhOrder_ = bvh.order;
     bvhNodes_ = bvh.nodes.size();
   }
@@ -805,7 +816,7 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
           primaryPixels += layout.pixels();
         }
         gpu::ShadePush push = forLight(shadePush(s), light);
-        push.band.z |= pathHitsFlag(s, true); // the specular paths by their kept hits
+        push.band.z |= keptRaysFlag(s, true); // the specular paths by their kept hits
         timestamps_.begin(cmd, "shadow");
         for (std::uint32_t b = 0; b < layout.bandCount(); ++b) shadow_.record(cmd, b, layout, push);
         timestamps_.end(cmd, "shadow");

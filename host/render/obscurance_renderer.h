@@ -88,11 +88,13 @@ struct ObscuranceSettings {
   // Lights addLight may add (their basis buffers are reserved up front; 4 bytes x 16 per pixel
   // each). `relight --edits` reserves one per add_light edit.
   std::uint32_t spareLightSlots = 0;
-  // Samples (the first ones) whose specular paths' lobe hits the frame keeps, 80 bytes per pixel
-  // each, within kKeptPathHitBytes: an added light's gather and a geometry edit's probe then follow
-  // those samples' paths without tracing them (shaders/lib/path_hits.glsl). Programs that edit
-  // (relight --edits, the window) ask for them; a plain render keeps none.
-  std::uint32_t keptPathSamples = 0;
+  // Samples (the first ones) whose rays the frame keeps in a glossy scene, within kKeptRayBytes:
+  // the specular paths' lobe hits (80 bytes per pixel) and the shadow rays at the primary hits and
+  // the paths' vertices (16 bytes each; N_s up to gpu::kMaxKeptShadowRays, light selection only). An added light's gather and a geometry
+  // edit's probes then follow those samples' rays without tracing or drawing them again
+  // (shaders/lib/kept_rays.glsl). Programs that edit (relight --edits, the window) ask for them;
+  // a plain render keeps none.
+  std::uint32_t keptRaySamples = 0;
   ShadowSampling shadowSampling = ShadowSampling::Selection;
   LightSampling lightSampling = LightSampling::Spatial;
   AmbientModel ambient = AmbientModel::Reached; // which surfaces share a light's flux in I_a
@@ -112,9 +114,10 @@ struct ObscuranceSettings {
   DirtyTest dirtyTest = DirtyTest::Auto;
 };
 
-// The most device memory the kept lobe hits may take (ObscuranceSettings::keptPathSamples): at
-// 800x600, 13 samples.
-inline constexpr std::uint64_t kKeptPathHitBytes = 512ull << 20;
+// The most device memory the kept rays may take (ObscuranceSettings::keptRaySamples), and at
+// most a third of the device's: with 5 shadow rays per hit (560 bytes per pixel and sample), 9
+// samples at 400x300, 2 at 800x600.
+inline constexpr std::uint64_t kKeptRayBytes = 640ull << 20;
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.
 float defaultDMax(const scene::Bounds& bounds);
@@ -256,9 +259,9 @@ private:
   std::uint64_t retraceDirty(const std::vector<scene::Bounds>& changed, bool everyPixel,
                              std::uint32_t tracedLight = gpu::kInvalidIndex);
   gpu::ShadePush shadePush(std::uint32_t sample) const;
-  // kShadeFlagPathHits where the frame keeps sample `sample`'s lobe hits: for a pass that writes
+  // kShadeFlagKeptRays where the frame keeps sample `sample`'s lobe hits: for a pass that writes
   // them, or (`replaying`) for one that follows them, only while they are the current scene's.
-  std::uint32_t pathHitsFlag(std::uint32_t sample, bool replaying) const;
+  std::uint32_t keptRaysFlag(std::uint32_t sample, bool replaying) const;
   // `push` for a dispatch of `light` alone (kShadeFlagPerLight).
   static gpu::ShadePush forLight(gpu::ShadePush push, std::uint32_t light);
   gpu::GpuCamera primaryCamera() const; // with the background's slot
@@ -293,10 +296,10 @@ private:
   // so that an added light's rays start from it without a primary pass.
   static constexpr std::uint32_t kNoSample = ~0u;
   std::uint32_t gbufferSample_ = kNoSample;
-  // The kept lobe hits (frame_.contents().pathHitSamples) name triangles by their texel in the
-  // BVH's layout: they stay valid across a refit (a move, a removal) and not across a rebuild
+  // The kept rays (frame_.contents().keptRaySamples): their lobe hits name triangles by their
+  // texel in the BVH's layout: they stay valid across a refit (a move, a removal) and not across a rebuild
   // (an insert, a quad), until the next reset renders them anew.
-  bool pathHitsValid_ = true;
+  bool keptRaysValid_ = true;
   std::vector<std::uint32_t> bvhOrder_; // the layout the hits refer to: triangle order...
   std::size_t bvhNodes_ = 0;            // ...after this many nodes
 

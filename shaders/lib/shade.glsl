@@ -117,12 +117,17 @@ vec3 directLightFromOne(ShadingPoint sp, uint light, vec4 lightShift, inout Step
   return sum / float(rays);
 }
 
+// The last shadow ray directLightFrom traced from its origin: direction and length (0 when it
+// traced none), for the frame to keep (lib/kept_rays.glsl).
+vec4 gShadowRay = vec4(0.0);
+
 // The shadow ray of light sample `ls`; `visible` says whether it reached the light (false also
 // when the light faces away or lies below the surface: nothing to trace).
 void directLightFrom(ShadingPoint sp, LightSample ls, float lightSamples, inout StepBudget budget,
                      out vec3 contribution, out bool visible) {
   contribution = vec3(0.0);
   visible = false;
+  gShadowRay = vec4(0.0);
   float cosG = dot(sp.ng, ls.wi);
   float cosS = dot(sp.ns, ls.wi);
   if (cosG <= 0.0 || all(equal(ls.weight, vec3(0.0)))) return;
@@ -138,6 +143,7 @@ void directLightFrom(ShadingPoint sp, LightSample ls, float lightSamples, inout 
     tmax = length(d);
     direction = d / tmax;
   }
+  gShadowRay = vec4(direction, tmax);
   RayHit h = traceWithBudget(budget, origin, direction, 0.0, tmax, true);
   if (kProbe) return; // a probe only tests the ray
   if (h.primitive != kInvalidIndex) return; // occluded (or truncated, reported by the caller)

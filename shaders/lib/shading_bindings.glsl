@@ -26,8 +26,10 @@ layout(std430, set = 0, binding = kBindingDirty) buffer DirtyMask { uint dirty[]
 // Per pixel, the box of its hits and specular path vertices (primary.comp starts it; specular.comp
 // grows it), for the dirty pixels of a geometry edit.
 layout(std430, set = 0, binding = kBindingHitBounds) buffer HitBounds { vec4 hitBounds[]; };
-// The specular paths' lobe hits of the samples the frame keeps (kShadeFlagPathHits, lib/path_hits.glsl).
+// The specular paths' lobe hits of the samples the frame keeps (kShadeFlagKeptRays, lib/kept_rays.glsl).
 layout(std430, set = 0, binding = kBindingPathHits) buffer PathHits { uvec4 pathHits[]; };
+// The primary hits' shadow rays of the samples the frame keeps (kShadeFlagKeptRays, lib/kept_rays.glsl).
+layout(std430, set = 0, binding = kBindingKeptShadowRays) buffer KeptShadowRays { vec4 keptShadowRays[]; };
 
 layout(push_constant) uniform Push { ShadePush pc; };
 

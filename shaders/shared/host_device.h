@@ -303,11 +303,14 @@ OBS_CONST uint kShadeFlagNoDirect = 4u;
 // pixel 2 in the dirty mask when one meets a box. Only a specular lobe ray is traced, in the edited
 // scene, so that the path goes on, and tested up to its hit. Nothing is accumulated.
 OBS_CONST uint kShadeFlagProbe = 8u;
-// The frame keeps this sample's specular path hits (ObscuranceFrame's pathHits, kBindingPathHits):
-// the plain specular kernel writes the hit of every lobe ray it traces, and the kernels that follow
-// the same paths again (an added light's per-light variant, a geometry edit's probe) read them
-// instead of tracing. The host sets it only while the kept hits are those of the frame's scene.
-OBS_CONST uint kShadeFlagPathHits = 16u;
+// The frame keeps this sample's rays that a replay would draw again (lib/kept_rays.glsl): the
+// specular paths' lobe hits (kBindingPathHits) and the primary hits' shadow rays
+// (kBindingKeptShadowRays, light sampling by selection). The plain kernels write them; the kernels
+// that follow the same rays again (an added light's per-light gather, a geometry edit's probes)
+// read them instead of tracing or drawing them. The host sets it only while they are the frame's.
+OBS_CONST uint kShadeFlagKeptRays = 16u;
+// Shadow rays per primary hit a frame can keep (N_s up to this; the paper's is 5).
+OBS_CONST uint kMaxKeptShadowRays = 8u;
 // Lobe rays kept per pixel and sample: a path's scattering vertices after the primary hit, up to
 // the paper's depth of 6 (SPEC §1.3). Deeper paths (--max-depth > 6) keep none.
 OBS_CONST uint kPathHitsPerSample = 5u;
@@ -330,9 +333,10 @@ OBS_CONST uint kSpecConstantReflectors = 1u;
 // when no invocation takes it (docs/BENCHMARKS.md, adding a light).
 OBS_CONST uint kSpecConstantPerLight = 2u;
 // The specialisation constant (a bool) that makes the specular kernel's per-light and probing
-// variants follow the paths by the frame's kept lobe hits (kShadeFlagPathHits dispatches) instead
-// of tracing them (kReplayHits, lib/path_hits.glsl).
-OBS_CONST uint kSpecConstantReplayHits = 3u;
+// variants follow the paths by the frame's kept lobe hits, and the shadow kernel's probing variant
+// test the kept shadow rays (kShadeFlagKeptRays dispatches), instead of tracing or drawing them
+// (kReplayRays, lib/kept_rays.glsl).
+OBS_CONST uint kSpecConstantReplayRays = 3u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 
@@ -351,8 +355,10 @@ OBS_CONST uint kBindingHitBounds = 16;       // = primary.comp's kBindingPrimary
                                              // paths grow it with their vertices
 OBS_CONST uint kBindingLightTree = 17;       // GpuLightNode[]: the light tree (lights.glsl)
 OBS_CONST uint kBindingPathHits = 18;        // uvec4[(sample * pixels + pixel) * kPathHitsPerSample + k]:
-                                             // specular paths' lobe hits (kShadeFlagPathHits)
-OBS_CONST uint kShadingBindingCount = 19;
+                                             // specular paths' lobe hits (kShadeFlagKeptRays)
+OBS_CONST uint kBindingKeptShadowRays = 19;  // vec4[(sample * pixels + pixel) * N_s + k]: direction,
+                                             // length (0: no ray) of the primary hits' shadow rays
+OBS_CONST uint kShadingBindingCount = 20;
 
 // ---- Bindings of primary.comp after the scene's (0..5).
 OBS_CONST uint kBindingPrimaryGBuffer = 6;       // GBufferTexel[pixel]

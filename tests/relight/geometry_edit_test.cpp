@@ -67,7 +67,7 @@ render::ObscuranceSettings editSettings(float secondaryReflectors = 0.0f) {
   s.shadowRays = 2;
   s.obscuranceRays = 4;
   s.dMax = 0.4f; // fixed: the default follows the scene's bounds
-  s.keptPathSamples = s.spp; // as relight --edits: a probe follows the specular paths' kept hits
+  s.keptRaySamples = s.spp; // as relight --edits: a probe follows the specular paths' kept hits
   s.camera = lookCamera({0, 1.5f, 4.5f}, glm::normalize(glm::vec3(0, -0.25f, -1)), {0, 1, 0}, 0.9f);
   return s;
 }
@@ -256,13 +256,13 @@ TEST_F(GeometryEdit, ProbedMoveUnderOneOfTwoLampsMatchesAFullRender) {
 }
 
 TEST_F(GeometryEdit, ProbingByKeptPathHitsRetracesWhatProbingByTracingDoes) {
-  // The probe follows the mirror floor's paths by the hits the render kept (lib/path_hits.glsl)
+  // The probe follows the mirror floor's paths by the hits the render kept (lib/kept_rays.glsl)
   // instead of tracing their lobe rays in the edited scene: it must find the same dirty pixels.
   const glm::vec3 from{-0.8f, 1.2f, -1.0f}, to{0.8f, 1.2f, -1.0f};
   const std::uint64_t byKeptHits = moveAndCompare(from, to, 0.5f, true, true);
   const io::Image keptFrame = moved_;
   const std::uint64_t byTracing =
-      moveAndCompare(from, to, 0.5f, true, true, 0.0f, [](render::ObscuranceSettings& s) { s.keptPathSamples = 0; });
+      moveAndCompare(from, to, 0.5f, true, true, 0.0f, [](render::ObscuranceSettings& s) { s.keptRaySamples = 0; });
   EXPECT_EQ(byKeptHits, byTracing);
   const int c = moved_.channelIndex("specular.R");
   for (int y = 0; y < moved_.height; ++y)
@@ -290,7 +290,7 @@ TEST_F(GeometryEdit, KeptPathHitsAreNotFollowedAfterTheBvhIsRebuilt) {
   std::vector<render::Transport> transports;
   for (std::uint32_t kept : {4u, 0u}) {
     render::ObscuranceSettings settings = editSettings();
-    settings.keptPathSamples = kept;
+    settings.keptRaySamples = kept;
     settings.spareLightSlots = 1;
     render::ObscuranceRenderer r(context(), before, beforeBvh, settings);
     r.render();

@@ -75,7 +75,7 @@ render::ObscuranceSettings roomSettings(std::uint32_t seed) {
   s.obscuranceRays = 4;
   s.camera = lookCamera({0.2f, 1.0f, 3.2f}, glm::normalize(glm::vec3(-0.1f, -0.05f, -1.0f)), {0, 1, 0}, 0.9f);
   s.spareLightSlots = 1; // the added-light tests
-  s.keptPathSamples = s.spp; // as relight --edits: an added light follows the kept lobe hits
+  s.keptRaySamples = s.spp; // as relight --edits: an added light follows the kept lobe hits
   return s;
 }
 
@@ -306,7 +306,7 @@ TEST_F(Relight, AddedLightIsGatheredAlongTheSpecularPathsOfAGlossyFloor) {
   expectStatisticallyEqual(r.image(), edited);
 }
 
-// The kept lobe hits (ObscuranceSettings::keptPathSamples, lib/path_hits.glsl) let an added light
+// The kept lobe hits (ObscuranceSettings::keptRaySamples, lib/kept_rays.glsl) let an added light
 // follow the glossy floor's specular paths without tracing their lobe rays: the same paths, vertex
 // for vertex, so the same transport bit for bit as following them by tracing again, with fewer rays.
 TEST_F(Relight, AddedLightByTheKeptPathHitsEqualsTracingThePathsAgain) {
@@ -318,9 +318,9 @@ TEST_F(Relight, AddedLightByTheKeptPathHitsEqualsTracingThePathsAgain) {
   std::vector<std::uint64_t> specularRays;
   for (std::uint32_t kept : {0u, 32u}) {
     render::ObscuranceSettings settings = roomSettings(7);
-    settings.keptPathSamples = kept;
+    settings.keptRaySamples = kept;
     render::ObscuranceRenderer r(context(), scene_, bvh_, settings);
-    ASSERT_EQ(r.frame().contents().pathHitSamples, kept);
+    ASSERT_EQ(r.frame().contents().keptRaySamples, kept);
     r.render();
     const std::uint64_t before = r.stats().passes.at("specular").rays;
     r.addLight(addedLight());

@@ -41,7 +41,10 @@ std::vector<FrameBufferKind> ObscuranceFrame::bufferKinds(const FrameContents& c
     kinds.push_back({"queue", 4, false});
     kinds.push_back({"specular_basis", kAccumulator, true});
     kinds.push_back({"specular_ambient", kAccumulator, false});
-    if (contents.pathHitSamples > 0) kinds.push_back({"path_hits", contents.pathHitSamples * kPathHitBytesPerSample, false});
+    if (contents.keptRaySamples > 0) {
+      kinds.push_back({"path_hits", contents.keptRaySamples * kPathHitBytesPerSample, false});
+      kinds.push_back({"kept_shadow_rays", contents.keptRaySamples * keptShadowRayBytesPerSample(contents.keptShadowRays), false});
+    }
   }
   return kinds;
 }
@@ -102,8 +105,10 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.dirty = gpu::Buffer(context, (2 * px + gpu::kQueueHeader + gpu::kDirtyBoxWords + 8 * slots) * 4, kStorage | Usage::eIndirectBuffer,
                           "frame.dirty" + tag);
     b.sampleCounts = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.sample_counts" + tag);
-    b.pathHits = gpu::Buffer(context, specular ? atLeastOne(px * contents.pathHitSamples * kPathHitBytesPerSample) : kVec4,
+    b.pathHits = gpu::Buffer(context, specular ? atLeastOne(px * contents.keptRaySamples * kPathHitBytesPerSample) : kVec4,
                              kStorage, "frame.path_hits" + tag);
+    b.shadowRays = gpu::Buffer(context, specular ? atLeastOne(px * contents.keptRaySamples * keptShadowRayBytesPerSample(contents.keptShadowRays)) : kVec4,
+                               kStorage, "frame.kept_shadow_rays" + tag);
     bands_.push_back(std::move(b));
   }
   status_ = StatusCounters(context, "frame.status");
@@ -114,7 +119,7 @@ std::uint64_t ObscuranceFrame::bytes() const {
   for (const auto& b : bands_)
     for (const gpu::Buffer* buffer : {&b.gbuffer, &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
                                       &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty,
-                                      &b.sampleCounts, &b.pathHits})
+                                      &b.sampleCounts, &b.pathHits, &b.shadowRays})
       total += buffer->size();
   return total;
 }

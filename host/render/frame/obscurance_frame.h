@@ -38,10 +38,12 @@ struct FrameContents {
   // Lights that may be added: the per-light buffers have this many spare slots from the start,
   // so adding a light clears one slot instead of re-allocating and copying every basis buffer.
   std::uint32_t spareLightSlots = 0;
-  // Samples whose specular paths' lobe hits are kept (gpu::kPathHitsPerSample per pixel and sample),
-  // so that an added light's gather and a geometry edit's probe follow the paths without tracing
-  // them (shaders/lib/path_hits.glsl). Only with `specular`.
-  std::uint32_t pathHitSamples = 0;
+  // Samples whose rays are kept (shaders/lib/kept_rays.glsl): the specular paths' lobe hits
+  // (gpu::kPathHitsPerSample per pixel and sample) and the primary hits' shadow rays
+  // (keptShadowRays per pixel and sample), so that an added light's gather and a geometry edit's
+  // probes follow them without tracing or drawing them again. Only with `specular`.
+  std::uint32_t keptRaySamples = 0;
+  std::uint32_t keptShadowRays = 0; // N_s, at most gpu::kMaxKeptShadowRays
 };
 
 
@@ -58,7 +60,8 @@ public:
                            // pixels with its indirect dispatch (dirty.comp; host_device.h), then
                            // the changed boxes for the probing passes (dirtyBoxesBase)
     gpu::Buffer sampleCounts; // per pixel, the samples its sums hold (primary.comp); compose divides by it
-    gpu::Buffer pathHits;     // per kept sample and pixel, its specular path's lobe hits (lib/path_hits.glsl)
+    gpu::Buffer pathHits;     // per kept sample and pixel, its specular path's lobe hits (lib/kept_rays.glsl)
+    gpu::Buffer shadowRays;   // per kept sample and pixel, the shadow rays at its primary hit and path vertices
   };
 
   // `maxBufferBytes` 0 = the device's per-buffer limit (a smaller one tests banding).
@@ -79,6 +82,14 @@ public:
   bool specular() const { return contents_.specular; }
   // Bytes per pixel of one kept sample's lobe hits.
   static constexpr std::uint64_t kPathHitBytesPerSample = gpu::kPathHitsPerSample * 16;
+  // Bytes per pixel of one kept sample's shadow rays (at the primary hit and the path's vertices),
+  // and of all its kept rays.
+  static std::uint64_t keptShadowRayBytesPerSample(std::uint32_t shadowRays) {
+    return 16ull * shadowRays * (gpu::kPathHitsPerSample + 1);
+  }
+  static std::uint64_t keptRayBytesPerSample(std::uint32_t shadowRays) {
+    return kPathHitBytesPerSample + keptShadowRayBytesPerSample(shadowRays);
+  }
   const FrameContents& contents() const { return contents_; }
 
   const gpu::Buffer& status() const { return status_.buffer(); }

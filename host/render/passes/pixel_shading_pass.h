@@ -18,6 +18,10 @@ struct ShadingVariants {
   // The shader shades one light alone when specialised for it (kSpecConstantPerLight): that kernel
   // takes the kShadeFlagPerLight dispatches that do not probe.
   bool perLight = false;
+  // The shader's probing kernel has a variant that tests the frame's kept rays instead of drawing
+  // them (kSpecConstantReplayRays, lib/kept_rays.glsl): it takes the probing dispatches with
+  // kShadeFlagKeptRays that do not shade one light alone.
+  bool replayKeptRays = false;
 };
 
 class PixelShadingPass {
@@ -28,18 +32,23 @@ public:
         reflectors_(variants.reflectors ? std::make_unique<gpu::Kernel>(context, reflectorKernelDesc(name, spirv, bands))
                                         : nullptr),
         perLight_(variants.perLight ? std::make_unique<gpu::Kernel>(context, perLightKernelDesc(name, spirv, bands))
-                                    : nullptr) {}
+                                    : nullptr),
+        probeReplay_(variants.replayKeptRays
+                         ? std::make_unique<gpu::Kernel>(context, replayingKeptRaysKernelDesc(probingKernelDesc(name, spirv, bands)))
+                         : nullptr) {}
 
   void bind(std::uint32_t band, const ShadingInputs& in) {
     bindShadingInputs(kernel_, band, in);
     bindShadingInputs(probe_, band, in);
     if (reflectors_) bindShadingInputs(*reflectors_, band, in);
     if (perLight_) bindShadingInputs(*perLight_, band, in);
+    if (probeReplay_) bindShadingInputs(*probeReplay_, band, in);
   }
 
-  // Compiles now the kernels only edits dispatch (deferred: KernelDesc::deferCompile).
-  void compileEditKernels() const {
-    probe_.compile();
+  // Compiles now the kernels only edits dispatch (deferred: KernelDesc::deferCompile): the probe
+  // that tests the kept rays where the frame keeps them (`keptRays`), else the one that draws them.
+  void compileEditKernels(bool keptRays) const {
+    (keptRays && probeReplay_ ? *probeReplay_ : probe_).compile();
     if (perLight_) perLight_->compile();
   }
 
@@ -58,7 +67,9 @@ public:
     // code for it.
     const bool perLight = takesPerLightVariant(p);
     if (perLight && (!perLight_ || reflectors)) throw std::logic_error("PixelShadingPass: no per-light variant");
-    const gpu::Kernel& kernel = probe ? probe_ : reflectors ? *reflectors_ : perLight ? *perLight_ : kernel_;
+    const bool replay = probeReplay_ && probe && (push.band.z & gpu::kShadeFlagKeptRays) != 0 &&
+                        (push.band.z & gpu::kShadeFlagPerLight) == 0;
+    const gpu::Kernel& kernel = replay ? *probeReplay_ : probe ? probe_ : reflectors ? *reflectors_ : perLight ? *perLight_ : kernel_;
     if (dirtyOf != nullptr) {
       kernel.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &p, band);
       return;
@@ -72,6 +83,7 @@ private:
   gpu::Kernel probe_;
   std::unique_ptr<gpu::Kernel> reflectors_;
   std::unique_ptr<gpu::Kernel> perLight_;
+  std::unique_ptr<gpu::Kernel> probeReplay_;
 };
 
 } // namespace obscura::render

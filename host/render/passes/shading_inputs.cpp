@@ -32,10 +32,10 @@ gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32
   return desc;
 }
 
-gpu::KernelDesc replayingHitsKernelDesc(gpu::KernelDesc desc) {
+gpu::KernelDesc replayingKeptRaysKernelDesc(gpu::KernelDesc desc) {
   desc.name += ".replay";
   desc.deferCompile = true;
-  desc.specConstants.push_back({.id = gpu::kSpecConstantReplayHits, .value = 1u});
+  desc.specConstants.push_back({.id = gpu::kSpecConstantReplayRays, .value = 1u});
   return desc;
 }
 
@@ -55,6 +55,7 @@ void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInp
   kernel.bind(gpu::kBindingDirty, b.dirty, band);
   kernel.bind(gpu::kBindingHitBounds, b.hitBounds, band);
   kernel.bind(gpu::kBindingPathHits, b.pathHits, band);
+  kernel.bind(gpu::kBindingKeptShadowRays, b.shadowRays, band);
 }
 
 } // namespace obscura::render

@@ -31,9 +31,9 @@ gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_
 gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
 // The variant for one light alone (kSpecConstantPerLight): "<name>.perlight".
 gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
-// The same shader's variant (of the per-light or probing one) that follows specular paths by the
-// frame's kept lobe hits (kSpecConstantReplayHits): "<desc.name>.replay".
-gpu::KernelDesc replayingHitsKernelDesc(gpu::KernelDesc desc);
+// The same shader's variant (of the per-light or probing one) that follows the frame's kept rays
+// instead of tracing or drawing them (kSpecConstantReplayRays): "<desc.name>.replay".
+gpu::KernelDesc replayingKeptRaysKernelDesc(gpu::KernelDesc desc);
 // Whether a dispatch with `push` goes to the per-light variant: one light, not probing.
 inline bool takesPerLightVariant(const gpu::ShadePush& push) {
   return (push.band.z & gpu::kShadeFlagPerLight) != 0 && (push.band.z & gpu::kShadeFlagProbe) == 0;

@@ -12,8 +12,8 @@ SpecularPass::SpecularPass(const gpu::Context& context, std::uint32_t bands)
       paths_(context, shadingKernelDesc("specular", kSpirv_specular, bands)),
       probe_(context, probingKernelDesc("specular", kSpirv_specular, bands)),
       perLight_(context, perLightKernelDesc("specular", kSpirv_specular, bands)),
-      probeReplay_(context, replayingHitsKernelDesc(probingKernelDesc("specular", kSpirv_specular, bands))),
-      perLightReplay_(context, replayingHitsKernelDesc(perLightKernelDesc("specular", kSpirv_specular, bands))) {}
+      probeReplay_(context, replayingKeptRaysKernelDesc(probingKernelDesc("specular", kSpirv_specular, bands))),
+      perLightReplay_(context, replayingKeptRaysKernelDesc(perLightKernelDesc("specular", kSpirv_specular, bands))) {}
 
 void SpecularPass::bind(std::uint32_t band, const ShadingInputs& in) {
   bindShadingInputs(queue_, band, in);
@@ -35,7 +35,7 @@ void SpecularPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band
   queue_.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
                   gpu::groupsFor(layout.bands[band].rows, gpu::kWorkgroupSizeY), 1, &p, band);
   gpu::computeBarrier(cmd);
-  const bool replay = (push.band.z & gpu::kShadeFlagPathHits) != 0;
+  const bool replay = (push.band.z & gpu::kShadeFlagKeptRays) != 0;
   const gpu::Kernel& paths = (push.band.z & gpu::kShadeFlagProbe) != 0 ? (replay ? probeReplay_ : probe_)
                              : takesPerLightVariant(p)                ? (replay ? perLightReplay_ : perLight_)
                                                                       : paths_;

@@ -1,5 +1,6 @@
-// path_hits.glsl — the specular paths' lobe hits a frame keeps (kShadeFlagPathHits), so that the
-// passes which follow the same paths again need not trace them.
+// kept_rays.glsl — the rays a frame keeps (kShadeFlagKeptRays), so that the passes which follow
+// the same rays again need neither trace nor draw them: the specular paths' lobe hits and the
+// primary hits' shadow rays.
 //
 // A path is a function of its lobe samples (their own generator in specular.comp) and of what its
 // lobe rays hit. The plain specular kernel writes each lobe ray's hit; an added light's gather
@@ -8,13 +9,19 @@
 // the cost of one 16-byte load per vertex instead of a closest-hit traversal. A probe tests the
 // kept segment up to the kept hit against the changed boxes: if it meets neither the old nor the
 // new place of what moved, the edited scene has the same first hit on that ray (lib/probe.glsl).
-#ifndef OBSCURA_PATH_HITS_GLSL
-#define OBSCURA_PATH_HITS_GLSL
+//
+// A shading point's shadow rays are a function of the point and of its light samples, whose
+// drawing (light selection over every light's importance, a point on the light by solid angle)
+// is what a probe spent most of its time on: the plain shadow and specular kernels keep each ray's
+// direction and length, at the primary hit and at every path vertex, and the probes test those
+// segments, from the origin the G-buffer or the path's kept hit gives, against the changed boxes.
+#ifndef OBSCURA_KEPT_RAYS_GLSL
+#define OBSCURA_KEPT_RAYS_GLSL
 
-// A variant of the specular kernel (kSpecConstantReplayHits) that takes the kept hits instead of
-// tracing: a specialisation, not a run-time flag, so that the traversal of the lobe rays is not
-// compiled in (on lavapipe a branch no lane takes still runs at least one pass of its loops).
-layout(constant_id = kSpecConstantReplayHits) const bool kReplayHits = false;
+// A variant of a kernel (kSpecConstantReplayRays) that takes the kept rays instead of tracing or
+// drawing them: a specialisation, not a run-time flag, so that the code it skips is not compiled
+// in (on lavapipe a branch no lane takes still runs at least one pass of its loops).
+layout(constant_id = kSpecConstantReplayRays) const bool kReplayRays = false;
 
 // Where lobe ray `depth` (1 = the one leaving the primary hit) of `pixel`'s sample `s` is kept.
 uint pathHitSlot(uint s, uint pixel, uint pixelCount, uint depth) {
@@ -56,6 +63,20 @@ RayHit probedPathHit(uint slot, vec3 origin, vec3 direction) {
     probeSegment(origin, direction, 0.0, rayHitValid(h) && h.primitive != kInvalidIndex ? h.t : 1.0 / 0.0);
   }
   return h;
+}
+
+// Where shadow ray `k` of `pixel`'s sample `s` is kept, at its primary hit (`vertex` 0) or at a
+// specular path's vertex (1..kPathHitsPerSample): N_s = pc.counts.y per vertex.
+uint keptShadowRaySlot(uint s, uint pixel, uint pixelCount, uint vertex, uint k) {
+  return ((s * pixelCount + pixel) * (kPathHitsPerSample + 1u) + vertex) * pc.counts.y + k;
+}
+
+// A probe's test of the `count` kept shadow rays of a shading point whose rays leave from `origin`.
+void probeKeptShadowRays(vec3 origin, uint s, uint pixel, uint pixelCount, uint vertex, uint count) {
+  for (uint k = 0u; k < count; ++k) {
+    const vec4 ray = keptShadowRays[keptShadowRaySlot(s, pixel, pixelCount, vertex, k)];
+    if (ray.w > 0.0) probeSegment(origin, ray.xyz, 0.0, ray.w);
+  }
 }
 
 #endif
