@@ -10,9 +10,9 @@
 // the candidates; the probing passes (lib/probe.glsl) replay the candidates' rays and mark 2 those
 // one of whose rays meets a changed box; kDirtyStageList then keeps the 2s (as 1) and lists them.
 #extension GL_GOOGLE_include_directive : require
-#extension GL_KHR_shader_subgroup_ballot : require
 #include "shared/host_device.h"
 #include "lib/shaft.glsl"
+#include "lib/queue_append.glsl"
 
 layout(local_size_x = kWorkgroupSize1D) in;
 layout(std430, binding = kBindingDirtyParams) readonly buffer Params { DirtyPush pc; };
@@ -60,21 +60,14 @@ uint touched(uint pixel, uvec2 framePixel) {
   return maybeTouched(pixel) ? 1u : 0u;
 }
 
-// Appends `pixel` to the band's list (the host reset its header to (0, 1, 1, 0)), and with
-// `counted` counts it in the status. The lanes that list a pixel take consecutive slots in lane
-// order, so neighbours stay neighbours, with one atomic per SIMD group instead of one per pixel
-// (on lavapipe the atomics on the one counter were a third of the pass on modern-hall).
+// Appends `pixel` to the band's list (lib/queue_append.glsl: one atomic per SIMD group), and with
+// `counted` counts it in the status (one atomic per group too).
 void list(uint pixel, bool counted) {
-  const uint base = dirtyListBase(pc.frame.x * pc.frame.y);
-  const uvec4 lanes = subgroupBallot(true);
-  const uint count = subgroupBallotBitCount(lanes);
-  uint first = 0u;
-  if (subgroupElect()) {
-    first = atomicAdd(dirty[base + kQueueCount], count);
-    atomicMax(dirty[base + kQueueGroupsX], (first + count - 1u) / kWorkgroupSize1D + 1u);
-    if (counted) atomicAdd(status[kStatusDirtyPixels], count);
+  OBS_QUEUE_APPEND(dirty, dirtyListBase(pc.frame.x * pc.frame.y), pixel)
+  if (counted) {
+    const uint listed = subgroupBallotBitCount(subgroupBallot(true));
+    if (subgroupElect()) atomicAdd(status[kStatusDirtyPixels], listed);
   }
-  dirty[base + kQueueHeader + subgroupBroadcastFirst(first) + subgroupBallotExclusiveBitCount(lanes)] = pixel;
 }
 
 void main() {

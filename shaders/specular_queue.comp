@@ -7,6 +7,7 @@
 #include "lib/scene_bindings.glsl"
 #include "lib/shading_bindings.glsl"
 #include "lib/band.glsl"
+#include "lib/queue_append.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
@@ -18,7 +19,5 @@ void main() {
   if (skipClean(pixel)) return;
   GBufferTexel g = gbuffer[pixel];
   if (g.albedo.a == 0.0 || materials[floatBitsToUint(g.shadingNormal.w)].params.w == 0.0) return;
-  uint slot = atomicAdd(queue[kQueueCount], 1u);
-  queue[kQueueHeader + slot] = pixel;
-  atomicMax(queue[kQueueGroupsX], slot / kWorkgroupSize1D + 1u);
+  OBS_QUEUE_APPEND(queue, 0u, pixel)
 }

@@ -114,25 +114,46 @@ gpu::GpuCamera ObscuranceRenderer::primaryCamera() const {
 
 void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh& bvh,
                                       const std::vector<scene::Bounds>* changed) {
+  applyReach(measureReachOf(scene, bvh, changed));
+}
+
+ObscuranceRenderer::ReachMeasurement ObscuranceRenderer::measureReachOf(const scene::Scene& scene, const bvh::Bvh& bvh,
+                                                                        const std::vector<scene::Bounds>* changed) const {
   const auto start = Clock::now();
+  ReachMeasurement m;
   // Every triangle's mean reflectance: a move or a removal keeps them (averaging modern-hall's
   // textures takes ~0.25 s); an insert brings its own.
   if (!changed || reachReflectance_.size() != scene.triangles.size()) {
     std::vector<glm::vec3> meanAlbedo;
-    for (const auto& m : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(m));
-    reachReflectance_ = triangleReflectances(scene, meanAlbedo);
+    for (const auto& material : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(material));
+    m.reflectance = triangleReflectances(scene, meanAlbedo);
+  } else {
+    m.reflectance = reachReflectance_;
   }
-  auto before = std::move(reached_);
-  reached_ = std::make_unique<ReachedSurfaces>(scene, bvh, reachReflectance_);
-  ambient_.depth = settings_.maxDepth;
-  if (ambient_.model == AmbientModel::Seen) reached_->setSeenView(seenView());
+  m.reached = std::make_unique<ReachedSurfaces>(scene, bvh, m.reflectance);
+  if (ambient_.model == AmbientModel::Seen) m.reached->setSeenView(seenView());
   std::vector<scene::Bounds> padded;
-  if (changed && before) {
+  if (changed && reached_) {
     const float pad = changedBoxPadding();
     for (scene::Bounds b : *changed) padded.push_back({b.lo - pad, b.hi + pad});
   }
-  measureAllReach(changed && before ? before.get() : nullptr, padded);
-  lastReach_.ms = 1e3 * secondsSince(start); // the reflectances and surface samples included
+  m.reach = reachOfEveryLight(*m.reached, changed ? reached_.get() : nullptr, padded);
+  for (const LightReach& r : m.reach) m.update.rays += r.rays.traced;
+  m.update.ms = 1e3 * secondsSince(start); // the reflectances and surface samples included
+  return m;
+}
+
+void ObscuranceRenderer::applyReach(ReachMeasurement m) {
+  reachReflectance_ = std::move(m.reflectance);
+  reached_ = std::move(m.reached);
+  ambient_.reach = std::move(m.reach);
+  ambient_.depth = settings_.maxDepth;
+  updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
+  lastReach_ = m.update;
+}
+
+void ObscuranceRenderer::finishReach() {
+  if (pendingReach_.valid()) applyReach(pendingReach_.get());
 }
 
 SeenView ObscuranceRenderer::seenView() const {
@@ -144,24 +165,30 @@ SeenView ObscuranceRenderer::seenView() const {
           .averageReflectance = ambient_.averageReflectance};
 }
 
-void ObscuranceRenderer::measureAllReach(const ReachedSurfaces* before, const std::vector<scene::Bounds>& changed) {
-  const auto start = Clock::now();
+std::vector<LightReach> ObscuranceRenderer::reachOfEveryLight(const ReachedSurfaces& reached,
+                                                             const ReachedSurfaces* before,
+                                                             const std::vector<scene::Bounds>& changed) const {
   const bool incremental = before && ambient_.reach.size() == lights_.size();
-  std::vector<LightReach> previous = std::move(ambient_.reach);
+  const std::vector<LightReach>& previous = ambient_.reach;
   // Lights spread over the cores (measure is const and draws its own numbers): the CPU rays of
   // modern-hall's 13 lights take ~0.3 s on one core when measured whole.
-  ambient_.reach.assign(lights_.size(), LightReach{});
+  std::vector<LightReach> reach(lights_.size());
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
     for (std::size_t s = next++; s < lights_.size(); s = next++)
-      ambient_.reach[s] = incremental ? reached_->remeasure(*before, previous[s], lights_, s, changed)
-                                      : reached_->measure(lights_, s);
+      reach[s] = incremental ? reached.remeasure(*before, previous[s], lights_, s, changed) : reached.measure(lights_, s);
   };
   std::vector<std::future<void>> workers;
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   for (unsigned w = 1; w < std::min<std::size_t>(cores, lights_.size()); ++w) workers.push_back(std::async(std::launch::async, worker));
   worker();
   for (auto& w : workers) w.get();
+  return reach;
+}
+
+void ObscuranceRenderer::measureAllReach() {
+  const auto start = Clock::now();
+  ambient_.reach = reachOfEveryLight(*reached_, nullptr, {});
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   lastReach_ = {0, 1e3 * secondsSince(start)};
   for (const LightReach& r : ambient_.reach) lastReach_.rays += r.rays.traced;
@@ -420,7 +447,14 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   const auto start = Clock::now();
   const double wallBefore = wallSeconds_;
   const bool emittersMoved = replaceScene(edited, bvh, &changed);
-  const std::uint64_t retraced = retraceDirty(changed, emittersMoved);
+  std::uint64_t retraced = 0;
+  try {
+    retraced = retraceDirty(changed, emittersMoved);
+  } catch (...) {
+    if (pendingReach_.valid()) pendingReach_.wait(); // it reads the renderer
+    throw;
+  }
+  finishReach();
   wallSeconds_ = wallBefore + secondsSince(start);
   return retraced;
 }
@@ -457,7 +491,17 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
   }
   // Moved occluders change what every light reaches: where the emitters and surfaces stayed, only
   // the rays that meet the changed boxes are traced again.
-  if (reached_) measureReach(edited, bvh, emittersMoved || !sameSurfaces ? nullptr : changed);
+  if (reached_) {
+    const std::vector<scene::Bounds>* boxes = emittersMoved || !sameSurfaces ? nullptr : changed;
+    if (reflectorsOn()) {
+      measureReach(edited, bvh, boxes); // markReflectors below needs it
+    } else {
+      // Compose needs it, the passes do not: measured on threads of their own beside the GPU work
+      // of the edit, and applied when that is done (finishReach). The edit's callers keep `edited`,
+      // `bvh` and `changed` alive until then.
+      pendingReach_ = std::async(std::launch::async, [this, &edited, &bvh, boxes] { return measureReachOf(edited, bvh, boxes); });
+    }
+  }
   bool rebind = true;
   if (sameSurfaces) rebind = sceneBuffers_.updateGeometry(edited, bvh);
   else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
@@ -869,8 +913,14 @@ std::uint64_t ObscuranceRenderer::addEmitter(const scene::Scene& edited, const b
     retraceAll();
     retraced = frame_.layout().pixels();
   } else {
-    traceAddedLight(static_cast<std::uint32_t>(index));
-    retraced = retraceDirty(changed, everyPixel, static_cast<std::uint32_t>(index));
+    try {
+      traceAddedLight(static_cast<std::uint32_t>(index));
+      retraced = retraceDirty(changed, everyPixel, static_cast<std::uint32_t>(index));
+    } catch (...) {
+      if (pendingReach_.valid()) pendingReach_.wait(); // it reads the renderer
+      throw;
+    }
+    finishReach();
   }
   wallSeconds_ = wallBefore + secondsSince(start);
   return retraced;

@@ -14,6 +14,7 @@
 //   compose: C = sum_s E_s (D_s + M_s) + I_a(E) A  [SPEC §3] — a light edit reruns this alone.
 #pragma once
 #include <cstdint>
+#include <future>
 #include <map>
 #include <memory>
 #include <string>
@@ -233,9 +234,25 @@ private:
   // kept the lights, `changed` (the edited objects' old and new boxes) lets each light re-trace
   // only the rays the edit can change (ReachedSurfaces::remeasure: the same numbers).
   void measureReach(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<scene::Bounds>* changed = nullptr);
-  // Every light's reach (and Seen fit) with reached_ as it is, then I_a's weights; with `before`
-  // (the reach of the scene before an edit), re-tracing only the rays `changed` (padded) can change.
-  void measureAllReach(const ReachedSurfaces* before = nullptr, const std::vector<scene::Bounds>& changed = {});
+  // What measureReach measures, without changing the renderer (so that it can run beside an edit's
+  // GPU work), and its application.
+  struct ReachMeasurement {
+    std::vector<glm::vec3> reflectance; // per triangle
+    std::unique_ptr<ReachedSurfaces> reached;
+    std::vector<LightReach> reach;      // per light
+    ReachUpdate update;
+  };
+  ReachMeasurement measureReachOf(const scene::Scene& scene, const bvh::Bvh& bvh,
+                                  const std::vector<scene::Bounds>* changed) const;
+  void applyReach(ReachMeasurement measurement);
+  // Applies the measurement replaceScene started beside the edit's GPU work, if any.
+  void finishReach();
+  // Every light's reach (and Seen fit) with `reached`; with `before` (the reach of the scene before
+  // an edit), re-tracing only the rays `changed` (padded) can change.
+  std::vector<LightReach> reachOfEveryLight(const ReachedSurfaces& reached, const ReachedSurfaces* before,
+                                            const std::vector<scene::Bounds>& changed) const;
+  // Every light's reach with reached_ as it is, then I_a's weights.
+  void measureAllReach();
   SeenView seenView() const; // the camera and obscurance settings the Seen fit uses
   // How far beyond a changed box the rays' offset origins may start: 1e-3 of the scene's size and
   // reach (lib/ray.glsl offsets by a few hundred ulps of the coordinates).
@@ -338,6 +355,9 @@ private:
   gpu::CommandStream stream_;
   gpu::Timestamps timestamps_;
   double wallSeconds_ = 0.0;
+  // The reach of an edited scene, measured beside the edit's GPU work (replaceScene). Last: its
+  // destructor waits for the measurement, which reads the members above.
+  std::future<ReachMeasurement> pendingReach_;
 };
 
 } // namespace obscura::render

@@ -16,17 +16,22 @@ bool apart(vec2 a, vec2 b) { return a.y < b.x || b.y < a.x; }
 // of A and L (the paper's shaft, Haines & Wallace 1994), whose projection on any axis is the hull
 // of A's and L's projections; B misses the hull when its projection misses that on some axis. The
 // axes: x, y, z and three across the shaft's direction, which make a long shaft thin.
+// Written out axis by axis, without an array of axes: on lavapipe a local array indexed in a loop
+// is a per-lane gather, and dirty.comp runs this for every pixel, light and changed box.
+bool apartAcross(vec3 bc, vec3 bh, vec3 ac, vec3 ah, vec3 lc, vec3 lh, vec3 n) {
+  if (dot(n, n) == 0.0) return false;
+  vec2 a = project(ac, ah, n), l = project(lc, lh, n);
+  return apart(project(bc, bh, n), vec2(min(a.x, l.x), max(a.y, l.y)));
+}
+
 bool meetsShaft(vec3 bc, vec3 bh, vec3 ac, vec3 ah, vec3 lc, vec3 lh) {
+  // x, y, z: the hull projects as the union of A's and L's boxes.
+  vec3 lo = min(ac - ah, lc - lh), hi = max(ac + ah, lc + lh);
+  if (any(lessThan(bc + bh, lo)) || any(lessThan(hi, bc - bh))) return false;
   vec3 d = lc - ac;
-  vec3 axes[6] = vec3[6](vec3(1, 0, 0), vec3(0, 1, 0), vec3(0, 0, 1), vec3(0.0, -d.z, d.y), vec3(d.z, 0.0, -d.x),
-                         vec3(-d.y, d.x, 0.0));
-  for (uint i = 0u; i < 6u; ++i) {
-    vec3 n = axes[i];
-    if (dot(n, n) == 0.0) continue;
-    vec2 a = project(ac, ah, n), l = project(lc, lh, n);
-    if (apart(project(bc, bh, n), vec2(min(a.x, l.x), max(a.y, l.y)))) return false;
-  }
-  return true;
+  return !apartAcross(bc, bh, ac, ah, lc, lh, vec3(0.0, -d.z, d.y)) &&
+         !apartAcross(bc, bh, ac, ah, lc, lh, vec3(d.z, 0.0, -d.x)) &&
+         !apartAcross(bc, bh, ac, ah, lc, lh, vec3(-d.y, d.x, 0.0));
 }
 
 // The same for a directional light: box A swept to infinity along -direction. Across the direction
