@@ -80,10 +80,10 @@ void main() {
   const bool oneLight = shadesOneLight();
   const uint addedLight = pc.band.w;
   const bool noDirect = (pc.band.z & kShadeFlagNoDirect) != 0u;
-  // The frame keeps this sample's lobe hits (the host checks that the depth fits): the plain kernel
-  // writes them; the variants that follow the paths again (an added light, a probe) take them
-  // instead of tracing when specialised with kReplayRays (lib/kept_rays.glsl).
-  const bool keepHits = !kProbe && !kPerLight && !kReplayRays && (pc.band.z & kShadeFlagKeptRays) != 0u;
+  // The frame keeps this sample's rays (the host checks that the depth and N_s fit): the plain
+  // kernel writes the lobe hits and the vertices' shadow rays; the variants that follow the paths
+  // again (an added light, a probe) take them when specialised with kReplayRays (lib/kept_rays.glsl).
+  const bool keepRays = !kProbe && !kPerLight && !kReplayRays && (pc.band.z & kShadeFlagKeptRays) != 0u;
 
   ShadingPoint sp = shadingPointFromGBuffer(gbuffer[pixel], pc.eye.xyz);
   uint pathRng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu); // lobe samples only
@@ -116,7 +116,7 @@ void main() {
     } else {
       h = traceFollowed(budget, origin, wi, 0.0, 1.0 / 0.0); // traced even when probing
       ++rays;
-      if (keepHits) keepPathHit(hitSlot, h);
+      if (keepRays) keepPathHit(hitSlot, h);
     }
     if (gProbeMet) break; // a probe that met a changed box: the pixel is dirty, the rest is moot
     if (!rayHitValid(h) || h.primitive == kInvalidIndex) {
@@ -171,7 +171,7 @@ void main() {
         vec3 contribution;
         uint light;
         directLightSample(sp, u, lightCount, misSamples, budget, contribution, light);
-        if (keepHits) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, pixelCount, depth, k)] = gShadowRay;
+        if (keepRays) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, pixelCount, depth, k)] = gShadowRay;
         OBS_ACCUMULATE(specularBasis, light * pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
       }
     }
