@@ -4,7 +4,8 @@
 # of moving an object (dirty pixels only; the fraction retraced) and of adding an emissive quad
 # (its light everywhere, its surface's dirty pixels; the fraction retraced), from
 # `obscura relight SCENE --edits` (edits.jsonl), and the wall time of `obscura relight DIR` on a
-# saved state. Usage: tools/bench_relight.sh [build/obscura] [spp] > table.md
+# saved state. Usage: tools/bench_relight.sh [build/obscura] [spp] [WxH ...] > table.md
+# (sizes default to 400x300 and 800x600)
 set -euo pipefail
 obscura=${1:-build/obscura}
 spp=${2:-1}
@@ -48,8 +49,10 @@ PY
 
 echo "| scene | size | spp | light scale (ms) | light colour (ms) | add point light (ms) | remove it (ms) | move an object (ms) | add an emissive quad (ms) | relight DIR wall (ms) |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
-for size in "400 300" "800 600"; do
-  set -- $size
+sizes=("${@:3}")
+((${#sizes[@]})) || sizes=(400x300 800x600)
+for size in "${sizes[@]}"; do
+  set -- ${size/x/ }
   bench cornell-box "$repo/scenes/cornell-box/cornell-box.gltf" light_rectangle_1 "$1" "$2" "[0.0, 1.0, 0.3]" cube_2
   bench modern-hall "$shared/modern-hall/modern-hall.gltf" light_rectangle_6 "$1" "$2" "[0.0, 3.0, 1.0]" Mesh017
 done
