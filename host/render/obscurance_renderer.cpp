@@ -56,11 +56,11 @@ std::uint32_t keptShadowRays(const ObscuranceSettings& settings) {
 // The samples whose rays a frame keeps: as many as asked, within kKeptRayBytes and a quarter of
 // the device's memory; none where it could not keep every shadow ray.
 std::uint32_t keptRaySamples(const gpu::Context& context, const ObscuranceSettings& settings, bool specular) {
-  if (!specular || settings.keptRaySamples == 0 || keptShadowRays(settings) != settings.shadowRays ||
+  if (settings.keptRaySamples == 0 || keptShadowRays(settings) != settings.shadowRays ||
       settings.shadowSampling != ShadowSampling::Selection)
     return 0;
   const std::uint64_t perSample = std::uint64_t(settings.width) * settings.height *
-                                  ObscuranceFrame::keptRayBytesPerSample(keptShadowRays(settings));
+                                  ObscuranceFrame::keptRayBytesPerSample(keptShadowRays(settings), specular);
   const std::uint64_t budget = std::min(kKeptRayBytes, context.info().deviceLocalBytes / 3);
   return static_cast<std::uint32_t>(std::min<std::uint64_t>(settings.keptRaySamples, budget / std::max<std::uint64_t>(perSample, 1)));
 }
@@ -523,7 +523,10 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
   const bool all = everyPixel || backgroundLight(lights_) < lights_.size() || reflectorsOn();
   // Probing replays the rays the frame traced, so not after addEmitter: its new light changed how
   // lights are chosen, and the replayed rays would not be those traced.
-  const bool probing = settings_.dirtyTest == DirtyTest::Probe || (settings_.dirtyTest == DirtyTest::Auto && runSpecular_);
+  // Auto probes where the frame has specular paths (a path that left the scene bounds nothing) or
+  // keeps every sample's rays (a probe then draws no light sample: cheaper than the retrace it saves).
+  const bool keptAll = samples_ <= frame_.contents().keptRaySamples && keptRaysFlag(0, true) != 0;
+  const bool probing = settings_.dirtyTest == DirtyTest::Probe || (settings_.dirtyTest == DirtyTest::Auto && (runSpecular_ || keptAll));
   const bool probe = probing && !all && tracedLight == gpu::kInvalidIndex && samples_ > 0;
   for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
     dirty_.prepare(b, layout, camera, changed, dirtyPad, dMax_, lightCount, all, tracedLight, probe);

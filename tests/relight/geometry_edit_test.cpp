@@ -255,6 +255,17 @@ TEST_F(GeometryEdit, ProbedMoveUnderOneOfTwoLampsMatchesAFullRender) {
   EXPECT_LT(retraced, 48u * 36u);
 }
 
+TEST_F(GeometryEdit, KeptRaysLetAMatteRoomProbeAndRetraceFewerPixels) {
+  // With the frame's shadow rays kept, a probe draws no light sample, so Auto probes the matte
+  // room too (lib/kept_rays.glsl): its candidates' rays are tested, fewer pixels are retraced, and
+  // the frame is still the full render's.
+  const glm::vec3 from{-0.8f, 2.5f, 0.0f}, to{0.8f, 2.5f, 0.0f};
+  const std::uint64_t byKeptRays = moveAndCompare(from, to, 0.5f);
+  const std::uint64_t byBounds =
+      moveAndCompare(from, to, 0.5f, true, false, 0.0f, [](render::ObscuranceSettings& s) { s.keptRaySamples = 0; });
+  EXPECT_LT(byKeptRays, byBounds);
+}
+
 TEST_F(GeometryEdit, ProbingByKeptPathHitsRetracesWhatProbingByTracingDoes) {
   // The probe follows the mirror floor's paths by the hits the render kept (lib/kept_rays.glsl)
   // instead of tracing their lobe rays in the edited scene: it must find the same dirty pixels.

@@ -41,11 +41,12 @@ std::vector<FrameBufferKind> ObscuranceFrame::bufferKinds(const FrameContents& c
     kinds.push_back({"queue", 4, false});
     kinds.push_back({"specular_basis", kAccumulator, true});
     kinds.push_back({"specular_ambient", kAccumulator, false});
-    if (contents.keptRaySamples > 0) {
-      kinds.push_back({"path_hits", contents.keptRaySamples * kPathHitBytesPerSample, false});
-      kinds.push_back({"kept_shadow_rays", contents.keptRaySamples * keptShadowRayBytesPerSample(contents.keptShadowRays), false});
-    }
+    if (contents.keptRaySamples > 0)
+      kinds.push_back({"path_hits", contents.keptRaySamples * kPathHitBytesPerSample, false, false});
   }
+  if (contents.keptRaySamples > 0)
+    kinds.push_back({"kept_shadow_rays", contents.keptRaySamples * keptShadowRayBytesPerSample(contents.keptShadowRays),
+                     false, false});
   return kinds;
 }
 
@@ -63,10 +64,16 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
   const std::uint64_t limit = maxBufferBytes > 0 ? maxBufferBytes : context.info().maxStorageBufferRange;
   std::uint64_t largest = 0;
   for (const auto& k : bufferKinds(contents))
-    largest = std::max(largest, k.bytesPerPixel * (k.perLight ? maxLights_ : 1u));
+    if (k.splitsBands) largest = std::max(largest, k.bytesPerPixel * (k.perLight ? maxLights_ : 1u));
   layout_ = FrameLayout::split(width, height, largest, limit, "the per-light basis buffers");
+  // The kept rays: as many samples as fit in one buffer of the largest band.
+  std::uint64_t bandPixels = 1;
+  for (std::size_t i = 0; i < layout_.bands.size(); ++i) bandPixels = std::max<std::uint64_t>(bandPixels, layout_.bandPixels(i));
+  const std::uint64_t keptPerSample = std::max(kPathHitBytesPerSample, keptShadowRayBytesPerSample(contents.keptShadowRays));
+  contents_.keptRaySamples = static_cast<std::uint32_t>(
+      std::min<std::uint64_t>(contents.keptRaySamples, limit / (bandPixels * keptPerSample)));
 
-  const std::uint64_t need = bytesNeeded(width, height, maxLights_, contents);
+  const std::uint64_t need = bytesNeeded(width, height, maxLights_, contents_);
   if (need > context.info().deviceLocalBytes)
     throw InputError(fmt::format("{}x{} with {} light groups: the frame buffers need {:.1f} MiB, more than the device "
                                  "'{}' offers ({:.0f} MiB); merge light groups (--light-groups material) or render "
@@ -105,9 +112,9 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.dirty = gpu::Buffer(context, (2 * px + gpu::kQueueHeader + gpu::kDirtyBoxWords + 8 * slots) * 4, kStorage | Usage::eIndirectBuffer,
                           "frame.dirty" + tag);
     b.sampleCounts = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.sample_counts" + tag);
-    b.pathHits = gpu::Buffer(context, specular ? atLeastOne(px * contents.keptRaySamples * kPathHitBytesPerSample) : kVec4,
+    b.pathHits = gpu::Buffer(context, specular ? atLeastOne(px * contents_.keptRaySamples * kPathHitBytesPerSample) : kVec4,
                              kStorage, "frame.path_hits" + tag);
-    b.shadowRays = gpu::Buffer(context, specular ? atLeastOne(px * contents.keptRaySamples * keptShadowRayBytesPerSample(contents.keptShadowRays)) : kVec4,
+    b.shadowRays = gpu::Buffer(context, atLeastOne(px * contents_.keptRaySamples * keptShadowRayBytesPerSample(contents.keptShadowRays)),
                                kStorage, "frame.kept_shadow_rays" + tag);
     bands_.push_back(std::move(b));
   }

@@ -28,6 +28,9 @@ struct FrameBufferKind {
   std::string name;
   std::uint64_t bytesPerPixel = 0;
   bool perLight = false;
+  // Whether the kind's size decides the bands. The kept rays do not: they are kept for as many
+  // samples as fit in a band's buffer (ObscuranceFrame's constructor lowers keptRaySamples).
+  bool splitsBands = true;
 };
 
 // What a frame holds besides the basis buffers: only what was asked for is allocated.
@@ -41,7 +44,7 @@ struct FrameContents {
   // Samples whose rays are kept (shaders/lib/kept_rays.glsl): the specular paths' lobe hits
   // (gpu::kPathHitsPerSample per pixel and sample) and the primary hits' shadow rays
   // (keptShadowRays per pixel and sample), so that an added light's gather and a geometry edit's
-  // probes follow them without tracing or drawing them again. Only with `specular`.
+  // probes follow them without tracing or drawing them again (the lobe hits only with `specular`).
   std::uint32_t keptRaySamples = 0;
   std::uint32_t keptShadowRays = 0; // N_s, at most gpu::kMaxKeptShadowRays
 };
@@ -87,8 +90,8 @@ public:
   static std::uint64_t keptShadowRayBytesPerSample(std::uint32_t shadowRays) {
     return 16ull * shadowRays * (gpu::kPathHitsPerSample + 1);
   }
-  static std::uint64_t keptRayBytesPerSample(std::uint32_t shadowRays) {
-    return kPathHitBytesPerSample + keptShadowRayBytesPerSample(shadowRays);
+  static std::uint64_t keptRayBytesPerSample(std::uint32_t shadowRays, bool specular) {
+    return (specular ? kPathHitBytesPerSample : 0) + keptShadowRayBytesPerSample(shadowRays);
   }
   const FrameContents& contents() const { return contents_; }
 
