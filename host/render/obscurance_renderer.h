@@ -89,9 +89,10 @@ struct ObscuranceSettings {
   // Lights addLight may add (their basis buffers are reserved up front; 4 bytes x 16 per pixel
   // each). `relight --edits` reserves one per add_light edit.
   std::uint32_t spareLightSlots = 0;
-  // Samples (the first ones) whose rays the frame keeps in a glossy scene, within kKeptRayBytes:
-  // the specular paths' lobe hits (80 bytes per pixel) and the shadow rays at the primary hits and
-  // the paths' vertices (16 bytes each; N_s up to gpu::kMaxKeptShadowRays, light selection only). An added light's gather and a geometry
+  // Samples (the first ones) whose rays the frame keeps, within kKeptRayBytes and one buffer of a
+  // band: the specular paths' lobe hits (80 bytes per pixel, glossy scenes) and the shadow rays at
+  // the primary hits and the paths' vertices (16 bytes each; N_s up to gpu::kMaxKeptShadowRays,
+  // light selection only). An added light's gather and a geometry
   // edit's probes then follow those samples' rays without tracing or drawing them again
   // (shaders/lib/kept_rays.glsl). Programs that edit (relight --edits, the window) ask for them;
   // a plain render keeps none.
@@ -108,10 +109,11 @@ struct ObscuranceSettings {
   // whose rays' bounds (hit box, shafts to the lights, dMax, specular paths' boxes) may meet a
   // changed box; Probe replays those pixels' rays first and retraces only those one of whose rays
   // does (lib/probe.glsl). Both retrace every pixel that can change. Auto probes where the frame
-  // has specular paths: a path that left the scene bounds nothing, so the bounds keep most glossy
-  // pixels, while without them the pixels a probe clears are those with the cheapest rays, and
-  // on lavapipe the replay (light selection above all) costs what their retrace would
-  // (docs/BENCHMARKS.md, "Geometry edits: probing").
+  // has specular paths (a path that left the scene bounds nothing, so the bounds keep most glossy
+  // pixels) or keeps every sample's rays (keptRaySamples: the probes then draw no light sample).
+  // Otherwise the pixels a probe clears are those with the cheapest rays, and on lavapipe the
+  // replay (light selection above all) costs what their retrace would (docs/BENCHMARKS.md,
+  // "Geometry edits: probing").
   DirtyTest dirtyTest = DirtyTest::Auto;
 };
 
