@@ -317,6 +317,13 @@ OBS_CONST uint kSpecConstantReflectors = 1u;
 // selection). Like the reflectors' branch, that code slows the per-light path on lavapipe even
 // when no invocation takes it (docs/BENCHMARKS.md, adding a light).
 OBS_CONST uint kSpecConstantPerLight = 2u;
+// The specialisation constants (bools) that compile into primary.comp the AOV accumulators
+// (kSpecConstantPrimaryAovs, dispatches without kPrimaryFlagNoAovs or kPrimaryFlagGBufferOnly) and
+// the emission rays of --emission-samples K > 1 (kSpecConstantEmissionRays, a second inlined
+// traversal). PrimaryPass picks the variant from the flags; left out, the two cost the camera rays
+// 1.5x and 1.2x of their time on lavapipe even where no invocation takes them (docs/BENCHMARKS.md).
+OBS_CONST uint kSpecConstantPrimaryAovs = 3u;
+OBS_CONST uint kSpecConstantEmissionRays = 4u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 
