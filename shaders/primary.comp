@@ -129,7 +129,11 @@ void main() {
   bool emissionTruncated = false;
   uint runLight = kInvalidIndex;
   vec3 run = vec3(0.0);
-  for (uint j = 0u; j <= rays; ++j) {
+  // Without emission rays of its own (K <= 1) the loop below adds the camera ray's unit emission
+  // once, to its light: the same sum, without the loop.
+  if (!kEmissionRays && lightGroup != kInvalidIndex)
+    OBS_ACCUMULATE(emissionBasis, lightGroup * bp.count + pixel, vec4(unitSeen, 0.0))
+  for (uint j = 0u; kEmissionRays && j <= rays; ++j) {
     uint light = kInvalidIndex;
     vec3 unit = vec3(0.0);
     if (j < rays && !ownRays) {
