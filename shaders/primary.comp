@@ -24,6 +24,12 @@ layout(std430, set = 0, binding = kBindingPrimaryHitBounds) buffer HitBounds { v
 layout(std430, set = 0, binding = kBindingPrimaryDirty) readonly buffer DirtyMask { uint dirty[]; };
 layout(std430, set = 0, binding = kBindingPrimarySampleCounts) buffer SampleCounts { uint sampleCounts[]; };
 
+// Kernel variants (PrimaryPass picks one per dispatch from its flags): the code a dispatch never
+// takes is left out, because on lavapipe it still costs (registers are allocated over the whole
+// shader, and both sides of a branch run).
+layout(constant_id = kSpecConstantPrimaryAovs) const bool kAovs = false;
+layout(constant_id = kSpecConstantEmissionRays) const bool kEmissionRays = false;
+
 void accumulate(uint pixel, uint slot, vec4 value, bool first) {
   uint i = pixel * kAovSlots + slot;
   if (first) OBS_ACCUMULATE_FIRST(aov, i, value) else OBS_ACCUMULATE(aov, i, value)
@@ -46,7 +52,7 @@ void main() {
   bool first = sampleIndex == 0u;
   const uint lightCount = pc.band.z;
   const bool accumulateSums = (pc.band.w & kPrimaryFlagGBufferOnly) == 0u;
-  const bool accumulateAovs = accumulateSums && (pc.band.w & kPrimaryFlagNoAovs) == 0u;
+  const bool accumulateAovs = kAovs && accumulateSums && (pc.band.w & kPrimaryFlagNoAovs) == 0u;
   // --emission-samples K: K > 1 estimates M_s from K rays of their own (lib/emission_samples.glsl).
   const uint emissionSamples = min(pc.band.w >> kPrimaryEmissionSamplesShift, kMaxEmissionSamples);
 
@@ -117,13 +123,17 @@ void main() {
   // emission to the light each one sees; consecutive rays on the same light are summed first.
   if (first)
     for (uint s = 0u; s < lightCount; ++s) OBS_ACCUMULATE_FIRST(emissionBasis, s * bp.count + pixel, vec4(0.0))
-  const bool ownRays = emissionSamples > 1u;
+  const bool ownRays = kEmissionRays && emissionSamples > 1u;
   const uint rays = ownRays ? emissionSamples : 1u;
   const uint sky = floatBitsToUint(pc.camera.up.w);
   bool emissionTruncated = false;
   uint runLight = kInvalidIndex;
   vec3 run = vec3(0.0);
-  for (uint j = 0u; j <= rays; ++j) {
+  // Without emission rays of its own (K <= 1) the loop below adds the camera ray's unit emission
+  // once, to its light: the same sum, without the loop.
+  if (!kEmissionRays && lightGroup != kInvalidIndex)
+    OBS_ACCUMULATE(emissionBasis, lightGroup * bp.count + pixel, vec4(unitSeen, 0.0))
+  for (uint j = 0u; kEmissionRays && j <= rays; ++j) {
     uint light = kInvalidIndex;
     vec3 unit = vec3(0.0);
     if (j < rays && !ownRays) {

@@ -21,8 +21,12 @@ vec4 sampleTexture(int index, vec2 uv) {
   vec2 p = fract(uv) * vec2(size) - 0.5;
   vec2 f = fract(p);
   ivec2 i0 = ivec2(floor(p));
-  ivec2 a = (i0 % size + size) % size;
-  ivec2 b = (a + 1) % size;
+  // The texel pair with repeat: i0 lies in [-1, size - 1] (fract(uv) in [0, 1)), so the wrap is a
+  // select, not the integer modulo ((i0 % size + size) % size, (a + 1) % size) it equals there:
+  // lavapipe has no vector integer division and runs a % per lane. The clamp only keeps a NaN uv's
+  // texel inside the texture.
+  ivec2 a = clamp(mix(i0, i0 + size, lessThan(i0, ivec2(0))), ivec2(0), size - 1);
+  ivec2 b = mix(a + 1, ivec2(0), equal(a + 1, size));
   vec4 c00 = fetchTexel(tex, a.x, a.y), c10 = fetchTexel(tex, b.x, a.y);
   vec4 c01 = fetchTexel(tex, a.x, b.y), c11 = fetchTexel(tex, b.x, b.y);
   return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);

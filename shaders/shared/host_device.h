@@ -332,11 +332,18 @@ OBS_CONST uint kSpecConstantReflectors = 1u;
 // selection). Like the reflectors' branch, that code slows the per-light path on lavapipe even
 // when no invocation takes it (docs/BENCHMARKS.md, adding a light).
 OBS_CONST uint kSpecConstantPerLight = 2u;
+// The specialisation constants (bools) that compile into primary.comp the AOV accumulators
+// (kSpecConstantPrimaryAovs, dispatches without kPrimaryFlagNoAovs or kPrimaryFlagGBufferOnly) and
+// the emission rays of --emission-samples K > 1 (kSpecConstantEmissionRays, a second inlined
+// traversal). PrimaryPass picks the variant from the flags; left out, the two cost the camera rays
+// 1.5x and 1.2x of their time on lavapipe even where no invocation takes them (docs/BENCHMARKS.md).
+OBS_CONST uint kSpecConstantPrimaryAovs = 3u;
+OBS_CONST uint kSpecConstantEmissionRays = 4u;
 // The specialisation constant (a bool) that makes the specular kernel's per-light and probing
 // variants follow the paths by the frame's kept lobe hits, and the shadow kernel's probing variant
 // test the kept shadow rays (kShadeFlagKeptRays dispatches), instead of tracing or drawing them
 // (kReplayRays, lib/kept_rays.glsl).
-OBS_CONST uint kSpecConstantReplayRays = 3u;
+OBS_CONST uint kSpecConstantReplayRays = 5u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 
@@ -356,8 +363,9 @@ OBS_CONST uint kBindingHitBounds = 16;       // = primary.comp's kBindingPrimary
 OBS_CONST uint kBindingLightTree = 17;       // GpuLightNode[]: the light tree (lights.glsl)
 OBS_CONST uint kBindingPathHits = 18;        // uvec4[(sample * pixels + pixel) * kPathHitsPerSample + k]:
                                              // specular paths' lobe hits (kShadeFlagKeptRays)
-OBS_CONST uint kBindingKeptShadowRays = 19;  // vec4[(sample * pixels + pixel) * N_s + k]: direction,
-                                             // length (0: no ray) of the primary hits' shadow rays
+OBS_CONST uint kBindingKeptShadowRays = 19;  // vec4[((sample * pixels + pixel) * 6 + vertex) * N_s + k]:
+                                             // direction, length (0: no ray) of the shadow rays at the
+                                             // primary hit (vertex 0) and the paths' vertices
 OBS_CONST uint kShadingBindingCount = 20;
 
 // ---- Bindings of primary.comp after the scene's (0..5).

@@ -20,29 +20,43 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 }
 
 namespace {
-gpu::KernelDesc primaryKernelDesc(std::uint32_t bands) {
+// Variant `v`: bit 0 the AOV accumulators, bit 1 the emission rays. Compiled on first use (a render
+// dispatches one or two of the four; each is an LLVM compile of the shader on lavapipe).
+gpu::KernelDesc primaryKernelDesc(std::uint32_t bands, std::uint32_t v) {
   auto bindings = sceneBindingKinds();
   bindings.insert(bindings.end(), gpu::kPrimaryBindingCount - gpu::kSceneBindingCount,
                   gpu::BindingKind::StorageBuffer);
   return {.name = "primary", .spirv = kSpirv_primary, .bindings = bindings,
-          .pushConstantBytes = sizeof(gpu::PrimaryPush), .setCount = bands};
+          .pushConstantBytes = sizeof(gpu::PrimaryPush),
+          .specConstants = {{gpu::kSpecConstantPrimaryAovs, v & 1u}, {gpu::kSpecConstantEmissionRays, (v >> 1) & 1u}},
+          .setCount = bands, .deferCompile = true};
 }
 } // namespace
 
 PrimaryPass::PrimaryPass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, primaryKernelDesc(bands)) {}
+    : kernels_{gpu::Kernel(context, primaryKernelDesc(bands, 0u)), gpu::Kernel(context, primaryKernelDesc(bands, 1u)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 2u)), gpu::Kernel(context, primaryKernelDesc(bands, 3u))} {}
+
+const gpu::Kernel& PrimaryPass::kernelFor(std::uint32_t flags) const {
+  const bool sums = (flags & gpu::kPrimaryFlagGBufferOnly) == 0;
+  const bool aovs = sums && (flags & gpu::kPrimaryFlagNoAovs) == 0;
+  const bool emissionRays = sums && (flags >> gpu::kPrimaryEmissionSamplesShift) > 1u;
+  return kernels_[(aovs ? 1u : 0u) | (emissionRays ? 2u : 0u)];
+}
 
 void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const ObscuranceFrame& frame,
                        const gpu::Buffer& lightScales) {
-  scene.bindTo(kernel_, band, &frame.status());
   const auto& b = frame.band(band);
-  kernel_.bind(gpu::kBindingPrimaryGBuffer, b.gbuffer, band);
-  kernel_.bind(gpu::kBindingPrimaryAovs, b.aovs, band);
-  kernel_.bind(gpu::kBindingPrimaryLightScales, lightScales, band);
-  kernel_.bind(gpu::kBindingPrimaryEmissionBasis, b.emissionBasis, band);
-  kernel_.bind(gpu::kBindingPrimaryHitBounds, b.hitBounds, band);
-  kernel_.bind(gpu::kBindingPrimaryDirty, b.dirty, band);
-  kernel_.bind(gpu::kBindingPrimarySampleCounts, b.sampleCounts, band);
+  for (gpu::Kernel& kernel : kernels_) {
+    scene.bindTo(kernel, band, &frame.status());
+    kernel.bind(gpu::kBindingPrimaryGBuffer, b.gbuffer, band);
+    kernel.bind(gpu::kBindingPrimaryAovs, b.aovs, band);
+    kernel.bind(gpu::kBindingPrimaryLightScales, lightScales, band);
+    kernel.bind(gpu::kBindingPrimaryEmissionBasis, b.emissionBasis, band);
+    kernel.bind(gpu::kBindingPrimaryHitBounds, b.hitBounds, band);
+    kernel.bind(gpu::kBindingPrimaryDirty, b.dirty, band);
+    kernel.bind(gpu::kBindingPrimarySampleCounts, b.sampleCounts, band);
+  }
 }
 
 void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
@@ -52,11 +66,12 @@ void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band,
   gpu::PrimaryPush push{.camera = camera,
                         .frame = glm::uvec4(layout.width, layout.height, sampleIndex, seed),
                         .band = glm::uvec4(rows.firstRow, rows.rows, lights, flags)};
+  const gpu::Kernel& kernel = kernelFor(flags);
   if (dirtyOf != nullptr) {
-    kernel_.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &push, band);
+    kernel.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &push, band);
     return;
   }
-  kernel_.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
+  kernel.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
                    gpu::groupsFor(rows.rows, gpu::kWorkgroupSizeY), 1, &push, band);
 }
 

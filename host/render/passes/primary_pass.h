@@ -1,6 +1,7 @@
 // primary_pass.h — camera rays to the G-buffer, the AOV accumulators and the seen-emission basis
 // M_s (primary.comp) [RTO §4.1 step 1].
 #pragma once
+#include <array>
 #include <cstdint>
 
 #include "gpu/kernel.h"
@@ -34,7 +35,12 @@ public:
               std::uint32_t flags, const ObscuranceFrame* dirtyOf = nullptr) const;
 
 private:
-  gpu::Kernel kernel_;
+  // The variant for a dispatch's flags: with the AOV accumulators and/or the emission rays compiled
+  // in (kSpecConstantPrimaryAovs, kSpecConstantEmissionRays) only where the flags ask for them.
+  const gpu::Kernel& kernelFor(std::uint32_t flags) const;
+
+  // Indexed by (AOVs ? 1 : 0) | (emission rays ? 2 : 0); each compiled on its first dispatch.
+  std::array<gpu::Kernel, 4> kernels_;
 };
 
 } // namespace obscura::render
