@@ -119,7 +119,8 @@ struct ObscuranceSettings {
 
 // The most device memory the kept rays may take (ObscuranceSettings::keptRaySamples), and at
 // most a third of the device's: with 5 shadow rays per hit (560 bytes per pixel and sample), 9
-// samples at 400x300, 2 at 800x600.
+// samples at 400x300. One band's buffer holding them is the tighter bound on lavapipe (128 MiB:
+// 2 samples at 400x300).
 inline constexpr std::uint64_t kKeptRayBytes = 640ull << 20;
 
 // dMax used when the settings leave it 0: a quarter of the scene's largest extent.
