@@ -53,8 +53,9 @@ std::uint32_t keptShadowRays(const ObscuranceSettings& settings) {
   return settings.shadowRays <= gpu::kMaxKeptShadowRays ? settings.shadowRays : 0u;
 }
 
-// The samples whose rays a frame keeps: as many as asked, within kKeptRayBytes and a quarter of
-// the device's memory; none where it could not keep every shadow ray.
+// The samples whose rays a frame keeps: as many as asked, within kKeptRayBytes and a third of
+// the device's memory (the frame lowers it to what one band's buffer holds); none where it could
+// not keep every shadow ray, nor with per-light shadow sampling.
 std::uint32_t keptRaySamples(const gpu::Context& context, const ObscuranceSettings& settings, bool specular) {
   if (settings.keptRaySamples == 0 || keptShadowRays(settings) != settings.shadowRays ||
       settings.shadowSampling != ShadowSampling::Selection)
