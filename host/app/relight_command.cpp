@@ -147,7 +147,7 @@ void relightScene(RelightOptions& o) {
       edits.begin(), edits.end(), [](const relight::Edit& e) {
         return e.kind == relight::Edit::Kind::AddLight || e.kind == relight::Edit::Kind::AddQuad;
       }));
-  // An added light and a geometry edit's probe follow the frame's specular paths by their kept hits.
+  // An added light and a geometry edit's probes follow the frame's kept rays (shadow rays, lobe hits).
   settings.keptRaySamples = settings.spp;
   // Each geometry edit makes the next scene; the renderer keeps a pointer to the current one.
   std::deque<scene::Scene> scenes;

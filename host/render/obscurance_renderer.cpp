@@ -66,6 +66,18 @@ std::uint32_t keptRaySamples(const gpu::Context& context, const ObscuranceSettin
   return static_cast<std::uint32_t>(std::min<std::uint64_t>(settings.keptRaySamples, budget / std::max<std::uint64_t>(perSample, 1)));
 }
 
+// Runs an edit's GPU work while a reach measurement runs on threads of its own; on an exception,
+// waits for the measurement before passing it on (it reads the renderer).
+template <class T, class Work>
+void besideMeasurement(std::future<T>& measurement, Work&& gpuWork) {
+  try {
+    gpuWork();
+  } catch (...) {
+    if (measurement.valid()) measurement.wait();
+    throw;
+  }
+}
+
 } // namespace
 
 bool sceneHasGlossy(const scene::Scene& scene) {
@@ -449,12 +461,7 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   const double wallBefore = wallSeconds_;
   const bool emittersMoved = replaceScene(edited, bvh, &changed);
   std::uint64_t retraced = 0;
-  try {
-    retraced = retraceDirty(changed, emittersMoved);
-  } catch (...) {
-    if (pendingReach_.valid()) pendingReach_.wait(); // it reads the renderer
-    throw;
-  }
+  besideMeasurement(pendingReach_, [&] { retraced = retraceDirty(changed, emittersMoved); });
   finishReach();
   wallSeconds_ = wallBefore + secondsSince(start);
   return retraced;
@@ -821,12 +828,7 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
     retraceAll();
     return index;
   }
-  try {
-    traceAddedLight(static_cast<std::uint32_t>(index));
-  } catch (...) {
-    if (reach.valid()) reach.wait(); // it reads lights_
-    throw;
-  }
+  besideMeasurement(reach, [&] { traceAddedLight(static_cast<std::uint32_t>(index)); });
   reachIn();
   return index;
 }
@@ -917,13 +919,10 @@ std::uint64_t ObscuranceRenderer::addEmitter(const scene::Scene& edited, const b
     retraceAll();
     retraced = frame_.layout().pixels();
   } else {
-    try {
+    besideMeasurement(pendingReach_, [&] {
       traceAddedLight(static_cast<std::uint32_t>(index));
       retraced = retraceDirty(changed, everyPixel, static_cast<std::uint32_t>(index));
-    } catch (...) {
-      if (pendingReach_.valid()) pendingReach_.wait(); // it reads the renderer
-      throw;
-    }
+    });
     finishReach();
   }
   wallSeconds_ = wallBefore + secondsSince(start);

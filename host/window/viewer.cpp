@@ -83,7 +83,7 @@ Viewer::Viewer(const gpu::ContextOptions& device, scene::Scene scene, bvh::Bvh b
 
   render::ObscuranceSettings settings = config_.obscurance;
   settings.spareLightSlots = kSpareLightSlots;
-  settings.keptRaySamples = settings.spp; // within the budget: an added light follows their paths
+  settings.keptRaySamples = settings.spp; // as many as fit: added lights and moves follow them
   settings.primaryAovs = true; // picking reads the primitive AOV; the AOV list shows them
   settings.composedAovs = true;
   config_.obscurance = settings;

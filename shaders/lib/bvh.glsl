@@ -374,12 +374,16 @@ RayHit traceWithBudget(inout StepBudget budget, vec3 origin, vec3 direction, flo
 
 // A ray whose hit a path needs to go on (a specular lobe sample): traced even when probing, and
 // then its segment up to the hit tested (to infinity on a miss; a truncated one counts as met).
+// A probing kernel's test of such a ray whose hit `h` is known (traced, or kept: lib/kept_rays.glsl).
+void probeFollowedSegment(RayHit h, vec3 origin, vec3 direction, float tmin, float tmax) {
+  if (!kProbe) return;
+  if (h.primitive == kTruncatedHit) gProbeMet = true;
+  probeSegment(origin, direction, tmin, rayHitValid(h) && h.primitive != kInvalidIndex ? h.t : tmax);
+}
+
 RayHit traceFollowed(inout StepBudget budget, vec3 origin, vec3 direction, float tmin, float tmax) {
   RayHit h = traceBudgeted(budget, origin, direction, tmin, tmax, false);
-  if (kProbe) {
-    if (h.primitive == kTruncatedHit) gProbeMet = true;
-    probeSegment(origin, direction, tmin, rayHitValid(h) && h.primitive != kInvalidIndex ? h.t : tmax);
-  }
+  probeFollowedSegment(h, origin, direction, tmin, tmax);
   return h;
 }
 

@@ -58,10 +58,7 @@ RayHit keptPathHit(uint slot) {
 // tested as traceFollowed tests a traced one; a truncated ray counts as met.
 RayHit probedPathHit(uint slot, vec3 origin, vec3 direction) {
   RayHit h = keptPathHit(slot);
-  if (kProbe) {
-    if (h.primitive == kTruncatedHit) gProbeMet = true;
-    probeSegment(origin, direction, 0.0, rayHitValid(h) && h.primitive != kInvalidIndex ? h.t : 1.0 / 0.0);
-  }
+  probeFollowedSegment(h, origin, direction, 0.0, 1.0 / 0.0);
   return h;
 }
 
