@@ -1,6 +1,7 @@
 #version 460
-// trace.comp — traces a buffer of rays (closest hit or any hit), one per invocation. Used by
-// `obscura bench-rays` and by the traversal tests, so the benchmark measures the code tested.
+// trace.comp — traces a buffer of rays (closest hit or any hit), kTraceRaysPerLane per invocation
+// through one refilling traversal loop (lib/bvh_stream.glsl). Used by `obscura bench-rays` and by
+// the traversal tests, so the benchmark measures the code tested.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -9,23 +10,52 @@
 
 layout(local_size_x = kWorkgroupSize1D) in;
 layout(push_constant) uniform Push { TracePush pc; };
-layout(std430, set = 0, binding = kBindingPassFirst) readonly buffer Rays { GpuRay rays[]; };
-layout(std430, set = 0, binding = kBindingPassFirst + 1) writeonly buffer Hits { GpuHit hits[]; };
-layout(std430, set = 0, binding = kBindingPassFirst + 2) writeonly buffer Steps { uint steps[]; };
+layout(constant_id = kSpecConstantTraceSteps) const bool kRecordSteps = false;
+// Texel views (host/bench/ray_tracer.cpp), which lavapipe reads and writes a texel per lane at a
+// time: ray i = texels 2i (origin, tmin) and 2i + 1 (direction, tmax); hit i = one texel
+// (t, u, v, primitive bits); steps i = one texel.
+layout(set = 0, binding = kBindingPassFirst) uniform samplerBuffer rays;
+layout(set = 0, binding = kBindingPassFirst + 1, rgba32f) uniform writeonly imageBuffer hits;
+layout(set = 0, binding = kBindingPassFirst + 2, r32ui) uniform writeonly uimageBuffer steps;
+
+// Ray k of this invocation: 8 neighbouring invocations take 8 neighbouring rays at a time, so
+// rays that arrive in a coherent order are traced side by side.
+uint rayIndex(uint k) {
+  uint g = gl_GlobalInvocationID.x;
+  return pc.params.w + (g / 8u) * 8u * kTraceRaysPerLane + k * 8u + g % 8u;
+}
+
+GpuRay streamRay(uint k) {
+  int i = int(rayIndex(k));
+  return GpuRay(texelFetch(rays, 2 * i), texelFetch(rays, 2 * i + 1));
+}
+
+// The hits wait in shared memory (plain memory on lavapipe) until the loop is done, and only as
+// t and the triangle's texel: a texel store inside the loop costs every pass a loop over the
+// lanes (Sponza 1.2x slower), and the barycentrics are found again afterwards (hitBarycentrics),
+// which leaves their two divisions out of the loop.
+shared uvec2 sHits[kWorkgroupSize1D * kTraceRaysPerLane];
+shared uint sSteps[kWorkgroupSize1D * kTraceRaysPerLane];
+
+uint hitSlot(uint k) { return gl_LocalInvocationID.x * kTraceRaysPerLane + k; }
+
+void streamHit(uint k, RayHit h) {
+  sHits[hitSlot(k)] = uvec2(floatBitsToUint(h.t), h.primitive == kTruncatedHit ? kTruncatedHit : h.item);
+  if (kRecordSteps) sSteps[hitSlot(k)] = h.steps;
+}
+
+#include "lib/bvh_stream.glsl"
 
 void main() {
-  uint i = gl_GlobalInvocationID.x + pc.params.w;
-  if (i >= pc.params.x) return;
-  GpuRay ray = rays[i];
-  bool anyHit = pc.params.y != 0u;
-  RayHit h = traverseBvh(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, anyHit,
-                         kMaxTraversalSteps);
-  if (h.primitive == kTruncatedHit) atomicAdd(status[kStatusTruncated], 1u);
-  GpuHit out_;
-  out_.t = h.t;
-  out_.u = h.u;
-  out_.v = h.v;
-  out_.primitive = h.primitive;
-  hits[i] = out_;
-  if (pc.params.z != 0u) steps[i] = h.steps;
+  uint count = 0u;
+  while (count < kTraceRaysPerLane && rayIndex(count) < pc.params.x) ++count;
+  uint truncated = traverseStream(count, pc.params.y != 0u, kMaxTraversalSteps);
+  if (truncated != 0u) atomicAdd(status[kStatusTruncated], truncated);
+  for (uint k = 0u; k < count; ++k) {
+    uvec2 stored = sHits[hitSlot(k)];
+    GpuRay ray = streamRay(k);
+    RayHit h = storedHit(ray.origin.xyz, ray.direction.xyz, ray.origin.w, uintBitsToFloat(stored.x), stored.y);
+    imageStore(hits, int(rayIndex(k)), vec4(h.t, h.u, h.v, uintBitsToFloat(h.primitive)));
+    if (kRecordSteps) imageStore(steps, int(rayIndex(k)), uvec4(sSteps[hitSlot(k)]));
+  }
 }

@@ -7,42 +7,67 @@
 namespace obscura::render {
 
 namespace {
-gpu::KernelDesc traceKernelDesc() {
+gpu::KernelDesc traceKernelDesc(bool recordSteps) {
   auto bindings = sceneBindingKinds();
-  bindings.insert(bindings.end(), 3, gpu::BindingKind::StorageBuffer); // rays, hits, steps
+  // rays (two RGBA32F texels each), hits (one RGBA32F texel each), steps (R32UI): texel views,
+  // which lavapipe reads and writes a texel per lane at a time (an SSBO: a word per lane at a time).
+  bindings.push_back(gpu::BindingKind::UniformTexelBuffer);
+  bindings.insert(bindings.end(), 2, gpu::BindingKind::StorageTexelBuffer);
   return {.name = "trace",
           .spirv = kSpirv_trace,
           .bindings = bindings,
-          .pushConstantBytes = sizeof(gpu::TracePush)};
+          .pushConstantBytes = sizeof(gpu::TracePush),
+          .specConstants = {{gpu::kSpecConstantTraceSteps, recordSteps ? 1u : 0u}},
+          .deferCompile = recordSteps};
 }
 } // namespace
 
 RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene)
-    : context_(&context), kernel_(context, traceKernelDesc()), timestamps_(context) {
+    : context_(&context), kernel_(context, traceKernelDesc(false)), stepsKernel_(context, traceKernelDesc(true)),
+      timestamps_(context) {
   scene.bindTo(kernel_);
+  scene.bindTo(stepsKernel_);
 }
 
 TraceResult RayTracer::trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps) {
+  // Texel views hold at most maxTexelBufferElements texels (two per ray): larger sets go in parts.
+  const std::size_t maxRays = context_->info().maxTexelBufferElements / 2;
+  if (rays.size() <= maxRays) return traceFitting(rays, mode, recordSteps);
+  TraceResult all;
+  for (std::size_t first = 0; first < rays.size(); first += maxRays) {
+    TraceResult part = traceFitting(rays.subspan(first, std::min(maxRays, rays.size() - first)), mode, recordSteps);
+    all.hits.insert(all.hits.end(), part.hits.begin(), part.hits.end());
+    all.steps.insert(all.steps.end(), part.steps.begin(), part.steps.end());
+    all.gpuMs += part.gpuMs;
+  }
+  return all;
+}
+
+TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps) {
   using Usage = vk::BufferUsageFlagBits;
   const auto n = static_cast<std::uint32_t>(rays.size());
-  gpu::Buffer rayBuffer(*context_, rays.size_bytes(), Usage::eStorageBuffer, "trace.rays");
-  rayBuffer.upload(*context_, rays);
-  gpu::Buffer hitBuffer(*context_, n * sizeof(gpu::GpuHit), Usage::eStorageBuffer, "trace.hits");
-  gpu::Buffer stepBuffer(*context_, recordSteps ? n * 4ull : 4ull, Usage::eStorageBuffer, "trace.steps");
-  kernel_.bind(gpu::kBindingPassFirst, rayBuffer);
-  kernel_.bind(gpu::kBindingPassFirst + 1, hitBuffer);
-  kernel_.bind(gpu::kBindingPassFirst + 2, stepBuffer);
+  gpu::TexelBuffer rayBuffer(*context_, std::max<std::size_t>(rays.size_bytes(), sizeof(gpu::GpuRay)),
+                             vk::Format::eR32G32B32A32Sfloat, {}, "trace.rays");
+  if (n) rayBuffer.upload(*context_, rays.data(), rays.size_bytes());
+  gpu::TexelBuffer hitBuffer(*context_, std::max(n, 1u) * sizeof(gpu::GpuHit), vk::Format::eR32G32B32A32Sfloat,
+                             Usage::eStorageTexelBuffer, "trace.hits");
+  gpu::TexelBuffer stepBuffer(*context_, recordSteps ? std::max(n, 1u) * 4ull : 4ull, vk::Format::eR32Uint,
+                              Usage::eStorageTexelBuffer, "trace.steps");
+  gpu::Kernel& kernel = recordSteps ? stepsKernel_ : kernel_;
+  kernel.bind(gpu::kBindingPassFirst, rayBuffer);
+  kernel.bind(gpu::kBindingPassFirst + 1, hitBuffer);
+  kernel.bind(gpu::kBindingPassFirst + 2, stepBuffer);
 
   const std::string label = mode == TraceMode::Closest ? "trace.closest" : "trace.any";
   const std::uint32_t maxGroups = std::min(context_->info().maxComputeWorkGroupCount[0], 65535u);
-  const std::uint32_t raysPerDispatch = maxGroups * gpu::kWorkgroupSize1D;
+  const std::uint32_t raysPerDispatch = maxGroups * gpu::kWorkgroupSize1D * gpu::kTraceRaysPerLane;
   context_->submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
     timestamps_.begin(cmd, label);
     for (std::uint32_t first = 0; first < n; first += raysPerDispatch) {
       std::uint32_t count = std::min(raysPerDispatch, n - first);
       gpu::TracePush push{.params = glm::uvec4(n, static_cast<std::uint32_t>(mode), recordSteps ? 1u : 0u, first)};
-      kernel_.dispatch(cmd, gpu::groupsFor(count, gpu::kWorkgroupSize1D), 1, 1, &push);
+      kernel.dispatch(cmd, gpu::groupsFor(count, gpu::kWorkgroupSize1D * gpu::kTraceRaysPerLane), 1, 1, &push);
     }
     timestamps_.end(cmd, label);
   });
@@ -50,8 +75,9 @@ TraceResult RayTracer::trace(std::span<const gpu::GpuRay> rays, TraceMode mode, 
   timestamps_.collect();
   TraceResult result;
   result.gpuMs = timestamps_.available() ? timestamps_.totalsMs().at(label) - before : 0.0;
-  result.hits = hitBuffer.download<gpu::GpuHit>(*context_);
-  if (recordSteps) result.steps = stepBuffer.download<std::uint32_t>(*context_);
+  result.hits = hitBuffer.buffer().download<gpu::GpuHit>(*context_);
+  result.hits.resize(n);
+  if (recordSteps) result.steps = stepBuffer.buffer().download<std::uint32_t>(*context_);
   return result;
 }
 

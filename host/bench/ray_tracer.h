@@ -25,8 +25,11 @@ public:
   TraceResult trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps = false);
 
 private:
+  TraceResult traceFitting(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps);
+
   const gpu::Context* context_;
-  gpu::Kernel kernel_;
+  gpu::Kernel kernel_;      // the timed one
+  gpu::Kernel stepsKernel_; // also records each ray's loop passes (compiled on first use)
   gpu::Timestamps timestamps_;
 };
 

@@ -8,8 +8,12 @@
 namespace obscura::gpu {
 namespace {
 vk::DescriptorType descriptorType(BindingKind kind) {
-  return kind == BindingKind::StorageBuffer ? vk::DescriptorType::eStorageBuffer
-                                            : vk::DescriptorType::eUniformTexelBuffer;
+  switch (kind) {
+  case BindingKind::StorageBuffer: return vk::DescriptorType::eStorageBuffer;
+  case BindingKind::UniformTexelBuffer: return vk::DescriptorType::eUniformTexelBuffer;
+  case BindingKind::StorageTexelBuffer: return vk::DescriptorType::eStorageTexelBuffer;
+  }
+  return vk::DescriptorType::eStorageBuffer;
 }
 } // namespace
 
@@ -42,12 +46,12 @@ Kernel::Kernel(const Context& context, const KernelDesc& desc)
 
   if (!desc.deferCompile) compile();
 
-  std::uint32_t storage = 0, texel = 0;
-  for (auto kind : bindings_) (kind == BindingKind::StorageBuffer ? storage : texel)++;
   const std::uint32_t setCount = std::max(desc.setCount, 1u);
   std::vector<vk::DescriptorPoolSize> sizes;
-  if (storage) sizes.push_back({.type = vk::DescriptorType::eStorageBuffer, .descriptorCount = storage * setCount});
-  if (texel) sizes.push_back({.type = vk::DescriptorType::eUniformTexelBuffer, .descriptorCount = texel * setCount});
+  for (auto kind : {BindingKind::StorageBuffer, BindingKind::UniformTexelBuffer, BindingKind::StorageTexelBuffer}) {
+    auto count = static_cast<std::uint32_t>(std::count(bindings_.begin(), bindings_.end(), kind));
+    if (count) sizes.push_back({.type = descriptorType(kind), .descriptorCount = count * setCount});
+  }
   pool_ = device.createDescriptorPool({.flags = vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
                                        .maxSets = setCount,
                                        .poolSizeCount = static_cast<std::uint32_t>(sizes.size()),
@@ -105,14 +109,14 @@ void Kernel::bind(std::uint32_t binding, const Buffer& buffer, std::uint32_t set
 }
 
 void Kernel::bind(std::uint32_t binding, const TexelBuffer& buffer, std::uint32_t set) {
-  if (binding >= bindings_.size() || bindings_[binding] != BindingKind::UniformTexelBuffer)
+  if (binding >= bindings_.size() || bindings_[binding] == BindingKind::StorageBuffer)
     throw std::logic_error(fmt::format("{}: binding {} is not a texel buffer", name_, binding));
   vk::BufferView view = buffer.view();
   context_->device().updateDescriptorSets(
       vk::WriteDescriptorSet{.dstSet = *descriptorSet(set),
                              .dstBinding = binding,
                              .descriptorCount = 1,
-                             .descriptorType = vk::DescriptorType::eUniformTexelBuffer,
+                             .descriptorType = descriptorType(bindings_[binding]),
                              .pTexelBufferView = &view},
       nullptr);
 }

@@ -13,7 +13,7 @@
 
 namespace obscura::gpu {
 
-enum class BindingKind { StorageBuffer, UniformTexelBuffer };
+enum class BindingKind { StorageBuffer, UniformTexelBuffer, StorageTexelBuffer };
 
 struct SpecConstant {
   std::uint32_t id;

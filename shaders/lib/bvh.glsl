@@ -317,6 +317,22 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   return hit;
 }
 
+// The whole hit of a ray from what a traversal kept of it: t and the hit triangle's texel
+// (kInvalidIndex: a miss, t = tmax; kTruncatedHit: cut off). The barycentrics and the triangle's
+// index come from the same test again, which gives the same t (a loop that keeps u and v for
+// every ray pays their divisions and registers on every pass).
+RayHit storedHit(vec3 origin, vec3 direction, float tmin, float t, uint item) {
+  RayHit h = RayHit(t, 0.0, 0.0, item == kTruncatedHit ? kTruncatedHit : kInvalidIndex, item, 0u);
+  if (item >= kTruncatedHit) return h;
+  vec4 p0 = texelFetch(bvhItems, int(item));
+  vec4 p1 = texelFetch(bvhItems, int(item) + 1);
+  vec4 p2 = texelFetch(bvhItems, int(item) + 2);
+  float tAgain;
+  intersectTriangle(prepareWatertightRay(origin, direction), p0.xyz, p1.xyz, p2.xyz, tmin, t, tAgain, h.u, h.v);
+  h.primitive = floatBitsToUint(p0.w);
+  return h;
+}
+
 RayHit traceClosest(vec3 origin, vec3 direction, float tmin, float tmax) {
   return traverseBvh(origin, direction, tmin, tmax, false, kMaxTraversalSteps);
 }

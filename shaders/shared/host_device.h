@@ -237,6 +237,9 @@ OBS_CONST uint kPrimaryEmissionSamplesShift = 8u;
 OBS_CONST uint kMaxEmissionSamples = 64u;
 
 // ---- Push constants of the bench/trace kernel.
+// Rays each invocation of trace.comp traces through one refilling loop (shaders/lib/bvh_stream.glsl):
+// 16 measured best on Sponza's random rays (8: 0.38 of Embree, 16: 0.45, 32: worse; docs/BENCHMARKS.md).
+OBS_CONST uint kTraceRaysPerLane = 16;
 struct TracePush {
   uvec4 params; // 0: ray count, mode (0 closest, 1 any), record steps (0/1), first ray index
 };              // 16 bytes
@@ -344,6 +347,9 @@ OBS_CONST uint kSpecConstantEmissionRays = 4u;
 // test the kept shadow rays (kShadeFlagKeptRays dispatches), instead of tracing or drawing them
 // (kReplayRays, lib/kept_rays.glsl).
 OBS_CONST uint kSpecConstantReplayRays = 5u;
+// The specialisation constant (a bool) that makes trace.comp record each ray's loop passes (the
+// traversal tests and bench-rays' statistics); the timed variant leaves the stores out.
+OBS_CONST uint kSpecConstantTraceSteps = 6u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

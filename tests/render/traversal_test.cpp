@@ -31,6 +31,7 @@ struct Comparison {
   std::size_t hitMissDisagreements = 0;
   std::size_t tDisagreements = 0;        // |t_gpu - t_cpu| > 1e-5 relative
   std::size_t primitiveTies = 0;         // same t, other triangle (a shared edge or vertex)
+  std::size_t barycentricDisagreements = 0; // same triangle, |u or v difference| > 1e-5
 };
 
 Comparison compare(const std::vector<gpu::GpuHit>& gpuHits, const std::vector<bvh::Hit>& cpuHits) {
@@ -48,6 +49,7 @@ Comparison compare(const std::vector<gpu::GpuHit>& gpuHits, const std::vector<bv
     if (!gpuHit) continue;
     if (std::abs(g.t - b.t) > 1e-5f * std::max(1.0f, std::abs(b.t))) ++c.tDisagreements;
     else if (g.primitive != b.primitive) ++c.primitiveTies;
+    else if (std::abs(g.u - b.u) > 1e-5f || std::abs(g.v - b.v) > 1e-5f) ++c.barycentricDisagreements;
   }
   return c;
 }
@@ -59,6 +61,8 @@ void expectAgreement(const Comparison& c, const char* what) {
   // Two triangles at the same t differ only for rays through a shared edge or vertex, where the
   // CPU and GPU may round the edge test differently (fused multiply-adds): at most 1 in 10^4.
   EXPECT_LE(c.primitiveTies, c.rays / 10000) << what;
+  // The barycentrics are found again after the traversal loop (storedHit in shaders/lib/bvh.glsl).
+  EXPECT_EQ(c.barycentricDisagreements, 0u) << what;
   EXPECT_GT(c.hits, 0u) << what;
 }
 

@@ -1,0 +1,160 @@
+// bvh_stream.glsl — several rays per invocation through ONE traversal loop, each lane taking its
+// next ray as soon as its current one is done ("refill"; Aila & Laine, "Understanding the
+// Efficiency of Ray Traversal on GPUs", HPG 2009, §4). Needs bvh.glsl, and the including shader
+// defines, before including this file:
+//   GpuRay streamRay(uint k);          // ray k (< count) of this invocation
+//   void streamHit(uint k, RayHit h);  // its result
+//
+// Why: lavapipe runs 8 lanes in lock-step, so a loop costs its slowest lane's passes. Tracing
+// the rays one after the other costs the sum over rays of the slowest lane's passes; here it is
+// the slowest lane's sum over its rays, which for incoherent rays is much closer to the mean.
+// The price: the ray set-up below runs (masked) on every pass, as lavapipe runs both sides of
+// every branch.
+//
+// The pass is traverseBvh's (bvh.glsl), with its register stack. A ray whose stack would grow
+// deeper than kBvhRegisterStack is put aside and traced again afterwards by traverseBvh, whose
+// second loop has the array stack (rare: exact either way).
+#ifndef OBSCURA_BVH_STREAM_GLSL
+#define OBSCURA_BVH_STREAM_GLSL
+
+// Returns how many of this invocation's rays ran out of passes (reported as kTruncatedHit).
+uint traverseStream(uint count, bool anyHit, uint maxSteps) {
+  WatertightRay wr;
+  vec3 origin = vec3(0.0), invDir = vec3(0.0);
+  bvec3 negative = bvec3(false);
+  uint octant = 0u;
+  float tmin = 0.0, tmax = 0.0;
+  RayHit hit;
+  uvec2 group = uvec2(0u);
+  uint triangleBase = 0u, triangleBits = 0u;
+  uint queuedBase = 0u, queuedBits = 0u;
+  uvec4 s0 = uvec4(0u), s1 = uvec4(0u), s2 = uvec4(0u), s3 = uvec4(0u);
+  uint stackSize = 0u;
+  uint laneSteps = 0u;    // passes this lane has used, all its rays together
+  uint overflowed = 0u;   // bit k: ray k is traced again by traverseBvh
+  uint truncated = 0u;
+  uint k = 0u;
+  bool needRay = true;
+  for (;;) {
+    if (needRay) { // the one set-up site
+      if (k >= count) break;
+      GpuRay ray = streamRay(k);
+      origin = ray.origin.xyz;
+      tmin = ray.origin.w;
+      tmax = ray.direction.w;
+      wr = prepareWatertightRay(origin, ray.direction.xyz);
+      invDir = safeReciprocal(ray.direction.xyz);
+      negative = lessThan(ray.direction.xyz, vec3(0.0));
+      octant = (negative.x ? 1u : 0u) | (negative.y ? 2u : 0u) | (negative.z ? 4u : 0u);
+      hit = RayHit(tmax, 0.0, 0.0, kInvalidIndex, kInvalidIndex, 0u);
+      group = uvec2(0u, (1u << octant) | (1u << 8));
+      triangleBits = 0u;
+      queuedBits = 0u;
+      stackSize = 0u;
+      needRay = false;
+    }
+    if (laneSteps >= maxSteps) {
+      hit.primitive = kTruncatedHit;
+      streamHit(k, hit);
+      ++truncated;
+      ++k;
+      needRay = true;
+      continue;
+    }
+    laneSteps++;
+    hit.steps++;
+    bool onTriangle = triangleBits != 0u;
+    uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
+    triangleBits &= triangleBits - 1u;
+    if (triangleBits == 0u) { // the queued triangle group moves up
+      triangleBase = queuedBase;
+      triangleBits = queuedBits;
+      queuedBits = 0u;
+    }
+    bool onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
+    uint bit;
+    uint node = groupChild(group, octant, bit);
+    int tb = onTriangle ? int(triangle) : 0;
+    vec4 p0 = texelFetch(bvhItems, tb);
+    vec4 p1 = texelFetch(bvhItems, tb + 1);
+    vec4 p2 = texelFetch(bvhItems, tb + 2);
+    int nb = onNode ? int(node * kTexelsPerNode) : 0;
+    vec4 n0 = texelFetch(bvhItems, nb);
+    vec4 n1 = texelFetch(bvhItems, nb + 1);
+    vec4 n2 = texelFetch(bvhItems, nb + 2);
+    vec4 n3 = texelFetch(bvhItems, nb + 3);
+    vec4 n4 = texelFetch(bvhItems, nb + 4);
+    bool done = false;
+    if (onTriangle) {
+      float t, u, v;
+      if (intersectTriangle(wr, p0.xyz, p1.xyz, p2.xyz, tmin, hit.t, t, u, v)) {
+        uint primitive = floatBitsToUint(p0.w);
+        if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
+          hit.t = t;
+          hit.u = u;
+          hit.v = v;
+          hit.primitive = primitive;
+          hit.item = triangle;
+          done = anyHit;
+        }
+      }
+    }
+    bool overflow = false;
+    if (onNode && !done) {
+      group.y &= ~bit;
+      NodeVisit visit = visitNode(n0, n1, n2, n3, n4, origin, invDir, negative, octant, tmin, hit.t);
+      if (triangleBits == 0u) {
+        triangleBase = visit.triangleBase;
+        triangleBits = visit.triangleBits;
+      } else {
+        queuedBase = visit.triangleBase;
+        queuedBits = visit.triangleBits;
+      }
+      if ((visit.group.y & 0xFFu) != 0u) {
+        if ((group.y & 0xFFu) != 0u) { // the push site
+          overflow = stackSize == kBvhRegisterStack;
+          s3 = uvec4(s2.zw, s3.xy);
+          s2 = uvec4(s1.zw, s2.xy);
+          s1 = uvec4(s0.zw, s1.xy);
+          s0 = uvec4(group, s0.xy);
+          stackSize++;
+        }
+        group = visit.group;
+      }
+    }
+    if ((group.y & 0xFFu) == 0u) {
+      if (stackSize == 0u) {
+        done = done || triangleBits == 0u;
+      } else { // the pop site
+        group = s0.xy;
+        s0 = uvec4(s0.zw, s1.xy);
+        s1 = uvec4(s1.zw, s2.xy);
+        s2 = uvec4(s2.zw, s3.xy);
+        s3 = uvec4(s3.zw, 0u, 0u);
+        stackSize--;
+      }
+    }
+    if (done || overflow) {
+      if (overflow) overflowed |= 1u << k;
+      else streamHit(k, hit);
+      ++k;
+      needRay = true;
+    }
+  }
+  // The rays put aside, each by the single-ray traversal (its array stack takes any depth),
+  // within what is left of the group's passes (lavapipe's limiter counts the group's loops).
+  uint used = subgroupMax(laneSteps);
+  while (overflowed != 0u) {
+    uint j = uint(findLSB(overflowed));
+    overflowed &= overflowed - 1u;
+    GpuRay ray = streamRay(j);
+    RayHit h = traverseBvh(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, anyHit,
+                           used < maxSteps ? maxSteps - used : 0u);
+    used += subgroupMax(h.steps);
+    if (h.primitive == kTruncatedHit) ++truncated;
+    streamHit(j, h);
+  }
+  return truncated;
+}
+
+#endif
