@@ -6,7 +6,8 @@
 // loop passes per ray / mean of the group maxima. The frame's rays (sample 0 of
 // bench/frame_rays.h: camera rays, then N_obs obscurance rays at each hit, around the geometric
 // normal) are traced by trace.comp with its step counts, in each order below; a group is 8
-// consecutive rays, as a pass's 8 consecutive invocations are.
+// consecutive rays, as a pass's 8 consecutive invocations are (one ray per lane: the figures
+// model the passes; trace.comp itself refills its lanes, so its gpuMs is that loop's time).
 #pragma once
 #include <string>
 #include <vector>
@@ -22,7 +23,7 @@ struct LaneOrderFigures {
   std::size_t rays = 0;   // real rays (lanes without one are left out of the figures)
   double meanSteps = 0.0; // loop passes per ray
   double groupSteps = 0.0; // loop passes per 8-lane group (its longest ray)
-  double gpuMs = 0.0;     // trace.comp on them in this order (best of `repeats`)
+  double gpuMs = 0.0;     // trace.comp (refilling) on them in this order (best of `repeats`)
   double utilisation() const { return groupSteps > 0.0 ? meanSteps / groupSteps : 0.0; }
 };
 
