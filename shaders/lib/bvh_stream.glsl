@@ -53,15 +53,17 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       stackSize = 0u;
       needRay = false;
     }
-    if (laneSteps >= maxSteps) {
+    // Out of passes: this ray ends as truncated, and so will the lane's next ones, without a pass.
+    const bool outOfPasses = laneSteps >= maxSteps;
+    if (outOfPasses) {
       hit.primitive = kTruncatedHit;
-      streamHit(k, hit);
-      ++truncated;
-      ++k;
-      needRay = true;
-      continue;
+      triangleBits = 0u;
+      queuedBits = 0u;
+      group.y = 0u;
+      stackSize = 0u;
+    } else {
+      laneSteps++;
     }
-    laneSteps++;
     hit.steps++;
     bool onTriangle = triangleBits != 0u;
     uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
@@ -135,8 +137,9 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       }
     }
     if (done || overflow) {
+      if (outOfPasses) ++truncated;
       if (overflow) overflowed |= 1u << k;
-      else streamHit(k, hit);
+      else streamHit(k, hit); // the one store site
       ++k;
       needRay = true;
     }
