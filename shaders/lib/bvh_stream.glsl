@@ -63,8 +63,8 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       stackSize = 0u;
     } else {
       laneSteps++;
+      hit.steps++;
     }
-    hit.steps++;
     bool onTriangle = triangleBits != 0u;
     uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
     triangleBits &= triangleBits - 1u;
