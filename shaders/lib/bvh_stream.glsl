@@ -17,7 +17,8 @@
 #ifndef OBSCURA_BVH_STREAM_GLSL
 #define OBSCURA_BVH_STREAM_GLSL
 
-// Returns how many of this invocation's rays ran out of passes (reported as kTruncatedHit).
+// Traces rays 0 .. count - 1 of this invocation (count <= 32: the rays put aside are a bit mask).
+// Returns how many of them ran out of passes (reported as kTruncatedHit).
 uint traverseStream(uint count, bool anyHit, uint maxSteps) {
   WatertightRay wr;
   vec3 origin = vec3(0.0), invDir = vec3(0.0);
