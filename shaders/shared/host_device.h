@@ -238,8 +238,12 @@ OBS_CONST uint kMaxEmissionSamples = 64u;
 
 // ---- Push constants of the bench/trace kernel.
 // Rays each invocation of trace.comp traces through one refilling loop (shaders/lib/bvh_stream.glsl):
-// 16 measured best on Sponza's random rays (8: 0.38 of Embree, 16: 0.45, 32: worse; docs/BENCHMARKS.md).
-OBS_CONST uint kTraceRaysPerLane = 16;
+// on Sponza's random rays 8 gave 0.37 of Embree, 16 0.42, 32 0.46 (docs/BENCHMARKS.md); 32 is the
+// most traverseStream takes (it marks the rays it puts aside in a 32-bit mask).
+OBS_CONST uint kTraceRaysPerLane = 32;
+#ifdef __cplusplus
+static_assert(kTraceRaysPerLane <= 32, "traverseStream marks the rays it puts aside in a 32-bit mask");
+#endif
 struct TracePush {
   uvec4 params; // 0: ray count, mode (0 closest, 1 any), record steps (0/1), first ray index
 };              // 16 bytes
