@@ -32,7 +32,7 @@ GpuRay streamRay(uint k) {
 
 // The hits wait in shared memory (plain memory on lavapipe) until the loop is done, and only as
 // t and the triangle's texel: a texel store inside the loop costs every pass a loop over the
-// lanes (Sponza 1.2x slower), and the barycentrics are found again afterwards (hitBarycentrics),
+// lanes (Sponza 1.2x slower), and the barycentrics are found again afterwards (storedHit),
 // which leaves their two divisions out of the loop.
 shared uvec2 sHits[kWorkgroupSize1D * kTraceRaysPerLane];
 shared uint sSteps[kWorkgroupSize1D * kTraceRaysPerLane];
