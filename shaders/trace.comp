@@ -8,7 +8,7 @@
 #include "lib/intersect.glsl"
 #include "lib/bvh.glsl"
 
-layout(local_size_x = kWorkgroupSize1D) in;
+layout(local_size_x = kTraceWorkgroupSize) in;
 layout(push_constant) uniform Push { TracePush pc; };
 layout(constant_id = kSpecConstantTraceSteps) const bool kRecordSteps = false;
 // Texel views (host/bench/ray_tracer.cpp), which lavapipe reads and writes a texel per lane at a
@@ -34,8 +34,8 @@ GpuRay streamRay(uint k) {
 // t and the triangle's texel: a texel store inside the loop costs every pass a loop over the
 // lanes (Sponza 1.2x slower), and the barycentrics are found again afterwards (storedHit),
 // which leaves their two divisions out of the loop.
-shared uvec2 sHits[kWorkgroupSize1D * kTraceRaysPerLane];
-shared uint sSteps[kWorkgroupSize1D * kTraceRaysPerLane];
+shared uvec2 sHits[kTraceWorkgroupSize * kTraceRaysPerLane];
+shared uint sSteps[kTraceWorkgroupSize * kTraceRaysPerLane];
 
 uint hitSlot(uint k) { return gl_LocalInvocationID.x * kTraceRaysPerLane + k; }
 

@@ -60,14 +60,14 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
 
   const std::string label = mode == TraceMode::Closest ? "trace.closest" : "trace.any";
   const std::uint32_t maxGroups = std::min(context_->info().maxComputeWorkGroupCount[0], 65535u);
-  const std::uint32_t raysPerDispatch = maxGroups * gpu::kWorkgroupSize1D * gpu::kTraceRaysPerLane;
+  const std::uint32_t raysPerDispatch = maxGroups * gpu::kTraceWorkgroupSize * gpu::kTraceRaysPerLane;
   context_->submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
     timestamps_.begin(cmd, label);
     for (std::uint32_t first = 0; first < n; first += raysPerDispatch) {
       std::uint32_t count = std::min(raysPerDispatch, n - first);
       gpu::TracePush push{.params = glm::uvec4(n, static_cast<std::uint32_t>(mode), recordSteps ? 1u : 0u, first)};
-      kernel.dispatch(cmd, gpu::groupsFor(count, gpu::kWorkgroupSize1D * gpu::kTraceRaysPerLane), 1, 1, &push);
+      kernel.dispatch(cmd, gpu::groupsFor(count, gpu::kTraceWorkgroupSize * gpu::kTraceRaysPerLane), 1, 1, &push);
     }
     timestamps_.end(cmd, label);
   });

@@ -17,7 +17,7 @@
 #ifndef OBSCURA_BVH_STREAM_GLSL
 #define OBSCURA_BVH_STREAM_GLSL
 
-// Traces rays 0 .. count - 1 of this invocation (count <= 32: the rays put aside are a bit mask).
+// Traces rays 0 .. count - 1 of this invocation (count <= 64: the rays put aside are a bit mask).
 // Returns how many of them ran out of passes (reported as kTruncatedHit).
 uint traverseStream(uint count, bool anyHit, uint maxSteps) {
   WatertightRay wr;
@@ -32,7 +32,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
   uvec4 s0 = uvec4(0u), s1 = uvec4(0u), s2 = uvec4(0u), s3 = uvec4(0u);
   uint stackSize = 0u;
   uint laneSteps = 0u;    // passes this lane has used, all its rays together
-  uint overflowed = 0u;   // bit k: ray k is traced again by traverseBvh
+  uvec2 overflowed = uvec2(0u);   // bit k: ray k is traced again by traverseBvh
   uint truncated = 0u;
   uint k = 0u;
   bool needRay = true;
@@ -139,7 +139,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
     }
     if (done || overflow) {
       if (outOfPasses) ++truncated;
-      if (overflow) overflowed |= 1u << k;
+      if (overflow) overflowed[k >> 5] |= 1u << (k & 31u);
       else streamHit(k, hit); // the one store site
       ++k;
       needRay = true;
@@ -148,9 +148,10 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
   // The rays put aside, each by the single-ray traversal (its array stack takes any depth),
   // within what is left of the group's passes (lavapipe's limiter counts the group's loops).
   uint used = subgroupMax(laneSteps);
-  while (overflowed != 0u) {
-    uint j = uint(findLSB(overflowed));
-    overflowed &= overflowed - 1u;
+  while (any(notEqual(overflowed, uvec2(0u)))) {
+    uint j = overflowed.x != 0u ? uint(findLSB(overflowed.x)) : 32u + uint(findLSB(overflowed.y));
+    if (overflowed.x != 0u) overflowed.x &= overflowed.x - 1u;
+    else overflowed.y &= overflowed.y - 1u;
     GpuRay ray = streamRay(j);
     RayHit h = traverseBvh(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, anyHit,
                            used < maxSteps ? maxSteps - used : 0u);

@@ -238,11 +238,17 @@ OBS_CONST uint kMaxEmissionSamples = 64u;
 
 // ---- Push constants of the bench/trace kernel.
 // Rays each invocation of trace.comp traces through one refilling loop (shaders/lib/bvh_stream.glsl):
-// on Sponza's random rays 8 gave 0.37 of Embree, 16 0.42, 32 0.46 (docs/BENCHMARKS.md); 32 is the
-// most traverseStream takes (it marks the rays it puts aside in a 32-bit mask).
-OBS_CONST uint kTraceRaysPerLane = 32;
+// on Sponza's random rays 8 gave 0.37 of Embree, 16 0.42, 32 0.46, 64 0.49 (docs/BENCHMARKS.md).
+// 64 is the most traverseStream takes (it marks the rays it puts aside in a 64-bit mask). The hits
+// wait in shared memory, 8 bytes a ray (12 in the variant that records steps): trace.comp's
+// workgroups are smaller than the passes' so that they fit 32 KiB (lavapipe's limit; NVIDIA's is
+// 48 KiB).
+OBS_CONST uint kTraceRaysPerLane = 64;
+OBS_CONST uint kTraceWorkgroupSize = 32;
 #ifdef __cplusplus
-static_assert(kTraceRaysPerLane <= 32, "traverseStream marks the rays it puts aside in a 32-bit mask");
+static_assert(kTraceRaysPerLane <= 64, "traverseStream marks the rays it puts aside in a 64-bit mask");
+static_assert(kTraceWorkgroupSize * kTraceRaysPerLane * 12 <= 32768, "trace.comp's hits must fit shared memory");
+static_assert(kTraceWorkgroupSize % 8 == 0, "lavapipe runs 8 invocations per SIMD group");
 #endif
 struct TracePush {
   uvec4 params; // 0: ray count, mode (0 closest, 1 any), record steps (0/1), first ray index
