@@ -118,6 +118,63 @@ uint groupChild(uvec2 group, uint octant, out uint bit) {
   return group.x + bitCount8((group.y >> 8) & ((1u << slot) - 1u));
 }
 
+// What one traversal pass works on: the next triangle of the triangle group (which moves on, the
+// queued group taking its place when it empties) and the next child of the node group, both
+// fetched. A lane with no triangle or no node fetches texel 0 (lavapipe runs both halves anyway).
+// Shared by every traversal loop (here and in bvh_stream.glsl), so they cannot drift apart.
+struct PassItems {
+  bool onTriangle;
+  uint triangle; // texel of the triangle's v0
+  vec4 p0, p1, p2;
+  bool onNode;
+  uint bit;      // the node's pending bit in group.y
+  vec4 n0, n1, n2, n3, n4;
+};
+
+PassItems fetchPassItems(inout uint triangleBase, inout uint triangleBits, inout uint queuedBase,
+                         inout uint queuedBits, uvec2 group, uint octant) {
+  PassItems it;
+  it.onTriangle = triangleBits != 0u;
+  it.triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
+  triangleBits &= triangleBits - 1u;
+  if (triangleBits == 0u) { // the queued triangle group moves up
+    triangleBase = queuedBase;
+    triangleBits = queuedBits;
+    queuedBits = 0u;
+  }
+  it.onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
+  uint node = groupChild(group, octant, it.bit);
+  int tb = it.onTriangle ? int(it.triangle) : 0;
+  it.p0 = texelFetch(bvhItems, tb);
+  it.p1 = texelFetch(bvhItems, tb + 1);
+  it.p2 = texelFetch(bvhItems, tb + 2);
+  int nb = it.onNode ? int(node * kTexelsPerNode) : 0;
+  it.n0 = texelFetch(bvhItems, nb);
+  it.n1 = texelFetch(bvhItems, nb + 1);
+  it.n2 = texelFetch(bvhItems, nb + 2);
+  it.n3 = texelFetch(bvhItems, nb + 3);
+  it.n4 = texelFetch(bvhItems, nb + 4);
+  return it;
+}
+
+// The register stack: entries e0 (top) .. e7 as (s0.xy, s0.zw, s1.xy, ..., s3.zw); a push or a pop
+// shifts them all (vector selects; an indexed array would be a per-lane gather on lavapipe).
+void pushRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uvec4 s3, uvec2 entry) {
+  s3 = uvec4(s2.zw, s3.xy);
+  s2 = uvec4(s1.zw, s2.xy);
+  s1 = uvec4(s0.zw, s1.xy);
+  s0 = uvec4(entry, s0.xy);
+}
+
+uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uvec4 s3) {
+  uvec2 top = s0.xy;
+  s0 = uvec4(s0.zw, s1.xy);
+  s1 = uvec4(s1.zw, s2.xy);
+  s2 = uvec4(s2.zw, s3.xy);
+  s3 = uvec4(s3.zw, 0u, 0u);
+  return top;
+}
+
 // Closest hit when anyHit is false (ties in t go to the lower primitive id), else the first hit
 // found with t < tmax (occlusion). Stops after `maxSteps` passes and reports kTruncatedHit:
 // lavapipe's loop limiter (65,535 passes for ALL loops of an invocation) would otherwise cut the
@@ -154,7 +211,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   uvec2 group = kRootGroup;
   uint triangleBase = 0u, triangleBits = 0u; // the triangle group being tested
   uint queuedBase = 0u, queuedBits = 0u;      // the next one (empty while the first is)
-  // Register stack: entries e0 (top) .. e7 as (s0.xy, s0.zw, s1.xy, ..., s3.zw).
+  // Register stack (pushRegisterStack): e0 (top) .. e7.
   uvec4 s0 = uvec4(0u), s1 = uvec4(0u), s2 = uvec4(0u), s3 = uvec4(0u);
   uint stackSize = 0u;
   bool overflow = false;
@@ -164,44 +221,24 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
       break;
     }
     hit.steps++;
-    bool onTriangle = triangleBits != 0u;
-    uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
-    triangleBits &= triangleBits - 1u;
-    if (triangleBits == 0u) { // the queued triangle group moves up
-      triangleBase = queuedBase;
-      triangleBits = queuedBits;
-      queuedBits = 0u;
-    }
-    bool onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
-    uint bit;
-    uint node = groupChild(group, octant, bit);
-    int tb = onTriangle ? int(triangle) : 0;
-    vec4 p0 = texelFetch(bvhItems, tb);
-    vec4 p1 = texelFetch(bvhItems, tb + 1);
-    vec4 p2 = texelFetch(bvhItems, tb + 2);
-    int nb = onNode ? int(node * kTexelsPerNode) : 0;
-    vec4 n0 = texelFetch(bvhItems, nb);
-    vec4 n1 = texelFetch(bvhItems, nb + 1);
-    vec4 n2 = texelFetch(bvhItems, nb + 2);
-    vec4 n3 = texelFetch(bvhItems, nb + 3);
-    vec4 n4 = texelFetch(bvhItems, nb + 4);
-    if (onTriangle) {
+    PassItems it = fetchPassItems(triangleBase, triangleBits, queuedBase, queuedBits, group, octant);
+    if (it.onTriangle) {
       float t, u, v;
-      if (intersectTriangle(wr, p0.xyz, p1.xyz, p2.xyz, tmin, hit.t, t, u, v)) {
-        uint primitive = floatBitsToUint(p0.w);
+      if (intersectTriangle(wr, it.p0.xyz, it.p1.xyz, it.p2.xyz, tmin, hit.t, t, u, v)) {
+        uint primitive = floatBitsToUint(it.p0.w);
         if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
           hit.t = t;
           hit.u = u;
           hit.v = v;
           hit.primitive = primitive;
-          hit.item = triangle;
+          hit.item = it.triangle;
           if (anyHit) break;
         }
       }
     }
-    if (onNode) {
-      group.y &= ~bit;
-      NodeVisit visit = visitNode(n0, n1, n2, n3, n4, origin, invDir, negative, octant, tmin, hit.t);
+    if (it.onNode) {
+      group.y &= ~it.bit;
+      NodeVisit visit = visitNode(it.n0, it.n1, it.n2, it.n3, it.n4, origin, invDir, negative, octant, tmin, hit.t);
       if (triangleBits == 0u) {
         triangleBase = visit.triangleBase;
         triangleBits = visit.triangleBits;
@@ -215,10 +252,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
             overflow = true; // finished by the second loop
             break;
           }
-          s3 = uvec4(s2.zw, s3.xy);
-          s2 = uvec4(s1.zw, s2.xy);
-          s1 = uvec4(s0.zw, s1.xy);
-          s0 = uvec4(group, s0.xy);
+          pushRegisterStack(s0, s1, s2, s3, group);
           stackSize++;
         }
         group = visit.group;
@@ -228,11 +262,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
       if (stackSize == 0u) {
         if (triangleBits == 0u) break;
       } else { // the pop site
-        group = s0.xy;
-        s0 = uvec4(s0.zw, s1.xy);
-        s1 = uvec4(s1.zw, s2.xy);
-        s2 = uvec4(s2.zw, s3.xy);
-        s3 = uvec4(s3.zw, 0u, 0u);
+        group = popRegisterStack(s0, s1, s2, s3);
         stackSize--;
       }
     }
@@ -256,44 +286,24 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
       break;
     }
     hit.steps++;
-    bool onTriangle = triangleBits != 0u;
-    uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
-    triangleBits &= triangleBits - 1u;
-    if (triangleBits == 0u) { // the queued triangle group moves up
-      triangleBase = queuedBase;
-      triangleBits = queuedBits;
-      queuedBits = 0u;
-    }
-    bool onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
-    uint bit;
-    uint node = groupChild(group, octant, bit);
-    int tb = onTriangle ? int(triangle) : 0;
-    vec4 p0 = texelFetch(bvhItems, tb);
-    vec4 p1 = texelFetch(bvhItems, tb + 1);
-    vec4 p2 = texelFetch(bvhItems, tb + 2);
-    int nb = onNode ? int(node * kTexelsPerNode) : 0;
-    vec4 n0 = texelFetch(bvhItems, nb);
-    vec4 n1 = texelFetch(bvhItems, nb + 1);
-    vec4 n2 = texelFetch(bvhItems, nb + 2);
-    vec4 n3 = texelFetch(bvhItems, nb + 3);
-    vec4 n4 = texelFetch(bvhItems, nb + 4);
-    if (onTriangle) {
+    PassItems it = fetchPassItems(triangleBase, triangleBits, queuedBase, queuedBits, group, octant);
+    if (it.onTriangle) {
       float t, u, v;
-      if (intersectTriangle(wr, p0.xyz, p1.xyz, p2.xyz, tmin, hit.t, t, u, v)) {
-        uint primitive = floatBitsToUint(p0.w);
+      if (intersectTriangle(wr, it.p0.xyz, it.p1.xyz, it.p2.xyz, tmin, hit.t, t, u, v)) {
+        uint primitive = floatBitsToUint(it.p0.w);
         if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
           hit.t = t;
           hit.u = u;
           hit.v = v;
           hit.primitive = primitive;
-          hit.item = triangle;
+          hit.item = it.triangle;
           if (anyHit) break;
         }
       }
     }
-    if (onNode) {
-      group.y &= ~bit;
-      NodeVisit visit = visitNode(n0, n1, n2, n3, n4, origin, invDir, negative, octant, tmin, hit.t);
+    if (it.onNode) {
+      group.y &= ~it.bit;
+      NodeVisit visit = visitNode(it.n0, it.n1, it.n2, it.n3, it.n4, origin, invDir, negative, octant, tmin, hit.t);
       if (triangleBits == 0u) {
         triangleBase = visit.triangleBase;
         triangleBits = visit.triangleBits;

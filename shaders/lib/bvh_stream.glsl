@@ -66,46 +66,26 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       laneSteps++;
       hit.steps++;
     }
-    bool onTriangle = triangleBits != 0u;
-    uint triangle = triangleBase + kTexelsPerTriangle * uint(findLSB(triangleBits));
-    triangleBits &= triangleBits - 1u;
-    if (triangleBits == 0u) { // the queued triangle group moves up
-      triangleBase = queuedBase;
-      triangleBits = queuedBits;
-      queuedBits = 0u;
-    }
-    bool onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
-    uint bit;
-    uint node = groupChild(group, octant, bit);
-    int tb = onTriangle ? int(triangle) : 0;
-    vec4 p0 = texelFetch(bvhItems, tb);
-    vec4 p1 = texelFetch(bvhItems, tb + 1);
-    vec4 p2 = texelFetch(bvhItems, tb + 2);
-    int nb = onNode ? int(node * kTexelsPerNode) : 0;
-    vec4 n0 = texelFetch(bvhItems, nb);
-    vec4 n1 = texelFetch(bvhItems, nb + 1);
-    vec4 n2 = texelFetch(bvhItems, nb + 2);
-    vec4 n3 = texelFetch(bvhItems, nb + 3);
-    vec4 n4 = texelFetch(bvhItems, nb + 4);
+    PassItems it = fetchPassItems(triangleBase, triangleBits, queuedBase, queuedBits, group, octant);
     bool done = false;
-    if (onTriangle) {
+    if (it.onTriangle) {
       float t, u, v;
-      if (intersectTriangle(wr, p0.xyz, p1.xyz, p2.xyz, tmin, hit.t, t, u, v)) {
-        uint primitive = floatBitsToUint(p0.w);
+      if (intersectTriangle(wr, it.p0.xyz, it.p1.xyz, it.p2.xyz, tmin, hit.t, t, u, v)) {
+        uint primitive = floatBitsToUint(it.p0.w);
         if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
           hit.t = t;
           hit.u = u;
           hit.v = v;
           hit.primitive = primitive;
-          hit.item = triangle;
+          hit.item = it.triangle;
           done = anyHit;
         }
       }
     }
     bool overflow = false;
-    if (onNode && !done) {
-      group.y &= ~bit;
-      NodeVisit visit = visitNode(n0, n1, n2, n3, n4, origin, invDir, negative, octant, tmin, hit.t);
+    if (it.onNode && !done) {
+      group.y &= ~it.bit;
+      NodeVisit visit = visitNode(it.n0, it.n1, it.n2, it.n3, it.n4, origin, invDir, negative, octant, tmin, hit.t);
       if (triangleBits == 0u) {
         triangleBase = visit.triangleBase;
         triangleBits = visit.triangleBits;
@@ -116,10 +96,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       if ((visit.group.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
           overflow = stackSize == kBvhRegisterStack;
-          s3 = uvec4(s2.zw, s3.xy);
-          s2 = uvec4(s1.zw, s2.xy);
-          s1 = uvec4(s0.zw, s1.xy);
-          s0 = uvec4(group, s0.xy);
+          pushRegisterStack(s0, s1, s2, s3, group);
           stackSize++;
         }
         group = visit.group;
@@ -129,11 +106,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       if (stackSize == 0u) {
         done = done || triangleBits == 0u;
       } else { // the pop site
-        group = s0.xy;
-        s0 = uvec4(s0.zw, s1.xy);
-        s1 = uvec4(s1.zw, s2.xy);
-        s2 = uvec4(s2.zw, s3.xy);
-        s3 = uvec4(s3.zw, 0u, 0u);
+        group = popRegisterStack(s0, s1, s2, s3);
         stackSize--;
       }
     }
