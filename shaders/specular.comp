@@ -4,6 +4,10 @@
 // gather direct light and obscurance as at P, weighted by the path throughput, into the
 // specular basis buffers (still linear in every E_s [SPEC §3]).
 //
+// A dispatch runs ONE vertex of every path in its depth's queue; the paths that go on are stored
+// (storePath) and queued for the next depth, one dispatch each (specular_pass.cpp). A path keeps
+// its own generators, so its value does not depend on where or when its vertices run.
+//
 // The primary hit's own direct light (full BSDF) and obscurance (diffuse part) come from
 // shadow.comp and obscurance.comp; this pass adds what arrives through the specular lobe.
 // Emitters seen through the lobe: after a mirror (delta) bounce they count whole (no light sample
@@ -43,6 +47,7 @@
 #include "lib/obscurance.glsl"
 #include "lib/band.glsl"
 #include "lib/kept_rays.glsl"
+#include "lib/queue_append.glsl"
 
 layout(local_size_x = kWorkgroupSize1D) in;
 
@@ -62,130 +67,230 @@ bool sampleSpecularLobe(ShadingPoint sp, vec3 wo, vec2 u, out vec3 wi, out vec3 
   return true;
 }
 
-void main() {
-  gSceneScale = pc.eye.w;
-  gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
-  const bool glossyMis = (pc.counts.w & kFlagGlossyMis) != 0u;
-  uint entry = gl_GlobalInvocationID.x;
-  if (entry >= queue[kQueueCount]) return;
-  uint pixel = queue[kQueueHeader + entry];
-  uvec2 size = pc.frame.xy;
-  BandPixel bp = bandPixelFromIndex(pixel, size, pc.band.xy);
-  uvec2 p = bp.frame;
-  uint pixelCount = bp.count;
-  beginProbe(); // the queue holds only the candidates not yet found dirty (skipClean)
-  const uint lightCount = pc.counts.x;
-  const uint shadowRays = lightCount > 0u ? pc.counts.y : 0u;
-  const uint maxDepth = uint(pc.params.w);
-  const bool oneLight = shadesOneLight();
-  const uint addedLight = pc.band.w;
-  const bool noDirect = (pc.band.z & kShadeFlagNoDirect) != 0u;
+// What a path carries from one vertex to the next. The pass runs one vertex per dispatch, and
+// the paths that go on are queued for the next (a wavefront; Laine, Karras & Aila 2013): with a
+// whole path per invocation, lavapipe ran every 8-lane group until its longest path ended, and a
+// quarter of the lane-iterations were idle.
+struct PathState {
+  ShadingPoint sp;
+  vec3 throughput;
+  uint pathRng;   // lobe samples only
+  uint rng;       // what is gathered
+  vec3 pathLo;    // the box of the path's vertices (dirty.comp)
+  vec3 pathHi;
+  bool escaped;   // a ray of the path left the scene
+  bool truncated; // a traversal of the path ran out of loop passes
+  uint pixel;     // band-local
+};
+
+// The pass's constants, from the push constants.
+struct SpecularPass {
+  uint pixelCount;
+  uint lightCount;
+  uint shadowRays;
+  uint maxDepth;
+  bool oneLight;
+  uint addedLight;
+  bool noDirect;
+  bool glossyMis;
   // The frame keeps this sample's rays (the host checks that the depth and N_s fit): the plain
   // kernel writes the lobe hits and the vertices' shadow rays; the variants that follow the paths
   // again (an added light, a probe) take them when specialised with kReplayRays (lib/kept_rays.glsl).
-  const bool keepRays = !kProbe && !kPerLight && !kReplayRays && (pc.band.z & kShadeFlagKeptRays) != 0u;
+  bool keepRays;
+};
 
-  ShadingPoint sp = shadingPointFromGBuffer(gbuffer[pixel], pc.eye.xyz);
-  uint pathRng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu); // lobe samples only
-  uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x6c8e9cf5u);     // what is gathered
-  StepBudget budget = newStepBudget();
-  vec3 throughput = vec3(1.0);
-  uint rays = 0u;
-  // The box of this path's vertices, and whether a ray of it left the scene (dirty.comp).
-  vec3 pathLo = sp.position, pathHi = sp.position;
-  bool escaped = false;
-  for (uint depth = 1u; depth < maxDepth && sp.glossy; ++depth) {
-    vec3 t, b;
-    orthonormalBasis(sp.ns, t, b);
-    vec3 wo = vec3(dot(sp.wo, t), dot(sp.wo, b), dot(sp.wo, sp.ns));
-    vec3 wiLocal, weight;
-    bool delta;
-    if (wo.z <= 0.0 || !sampleSpecularLobe(sp, wo, vec2(rngNext(pathRng), rngNext(pathRng)), wiLocal, weight, delta)) break;
-    vec3 wi = toWorld(wiLocal, t, b, sp.ns);
-    if (dot(wi, sp.ng) <= 0.0) break; // below the geometric surface: no leaks
-    // What MIS needs of the vertex the lobe sample leaves (its light samples' density).
-    float lobePdf = delta ? 0.0 : ggxReflectionPdf(wo, wiLocal, ggxAlpha(sp.roughness));
-    vec3 previous = sp.position, previousNormal = sp.ng;
-    throughput *= weight;
-    if (all(equal(throughput, vec3(0.0)))) break;
-    vec3 origin = offsetRayOrigin(sp.position, sp.ng);
-    const uint hitSlot = pathHitSlot(pc.frame.z, pixel, pixelCount, depth);
-    RayHit h;
-    if (kReplayRays) {
-      h = probedPathHit(hitSlot, origin, wi);
-    } else {
-      h = traceFollowed(budget, origin, wi, 0.0, 1.0 / 0.0); // traced even when probing
-      ++rays;
-      if (keepRays) keepPathHit(hitSlot, h);
-    }
-    if (gProbeMet) break; // a probe that met a changed box: the pixel is dirty, the rest is moot
-    if (!rayHitValid(h) || h.primitive == kInvalidIndex) {
-      escaped = true;
-      // The sky along the lobe: whole after a mirror, MIS-weighted after a glossy bounce.
-      uint sky = findBackgroundLight(lightCount);
-      if ((oneLight && sky != addedLight) || noDirect) sky = kInvalidIndex;
-      if (!kProbe && h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || (glossyMis && !oneLight))) { // a miss, not a truncation
-        float w = delta ? 1.0 : powerHeuristic(lobePdf, float(shadowRays) * backgroundLightPdf(sky, previous, previousNormal, lightCount, wi));
-        OBS_ACCUMULATE(specularBasis, sky * pixelCount + pixel, vec4(w * throughput, 0.0))
-      }
-      break;
-    }
-    Surface s = surfaceAt(h, origin, wi);
-    pathLo = min(pathLo, s.position);
-    pathHi = max(pathHi, s.position);
-    GpuMaterial m = materials[s.material];
-    vec3 baseColor = materialBaseColor(m, s.uv).rgb;
-    const bool counted = oneLight ? delta && s.lightGroup == addedLight : !noDirect && (delta || glossyMis);
-    if (!kProbe && counted && s.lightGroup != kInvalidIndex && s.lightGroup < lightCount) {
-      float w = 1.0;
-      if (!delta) {
-        float lightPdf = emitterHitLightPdf(s.lightGroup, previous, previousNormal, lightCount, h, s.position, wi);
-        w = powerHeuristic(lobePdf, float(shadowRays) * lightPdf);
-      }
-      // Seen emission in unit-emission terms: divided by the group's E_s (1 where E_s is 0).
-      vec3 unit = unitEmission(materialEmission(m, s.uv, s.frontFacing), lightScales[s.lightGroup].rgb);
-      OBS_ACCUMULATE(specularBasis, s.lightGroup * pixelCount + pixel, vec4(w * throughput * unit, 0.0))
-    }
-    sp = shadingPoint(s.position, s.geometricNormal, s.shadingNormal, -wi, baseColor, s.material);
-    // Gather as at P [RTO §4.1 step 4]: direct light, then obscurance.
-    // MIS only where a lobe sample follows from this vertex (the loop goes on past it).
-    float misSamples = glossyMis && depth + 1u < maxDepth ? float(shadowRays) : 0.0;
-    const vec4 lightShift = rngNext4(rng); // this vertex's light samples: one shifted low-discrepancy set
-    if (kProbe && kReplayRays) {
-      // The vertex's kept shadow rays (never kept for one light alone, nor without direct light:
-      // the host keeps no rays with per-light shadow sampling).
-      probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.frame.z, pixel, pixelCount, depth, shadowRays);
-    } else {
-      // A probe whose shafts from the vertex to the lights all miss the boxes draws no light sample.
-      const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, lightCount);
-      if (oneLight) {
-        uint taken = 0u;
-        vec3 direct = vec3(0.0);
-        if (drawn) direct = directLightFromOne(sp, addedLight, lightShift, budget, taken);
-        OBS_ACCUMULATE(specularBasis, addedLight * pixelCount + pixel, vec4(throughput * direct, 0.0))
-        rays += taken;
-        continue;
-      }
-      for (uint k = 0u; k < (noDirect || !drawn ? 0u : shadowRays); ++k) {
-        vec4 u = kroneckerPoint4(k, lightShift);
-        vec3 contribution;
-        uint light;
-        directLightSample(sp, u, lightCount, misSamples, budget, contribution, light);
-        if (keepRays) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, pixelCount, depth, k)] = gShadowRay;
-        OBS_ACCUMULATE(specularBasis, light * pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
-      }
-    }
-    // Secondary reflectors only at primary hits: here the ambient keeps its whole I_a.
-    vec4 aw = gatherObscurance(sp, rng, budget, kInvalidIndex, pixelCount);
-    OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
-    rays += (noDirect ? 0u : shadowRays) + pc.counts.z;
+SpecularPass specularPass() {
+  SpecularPass c;
+  c.pixelCount = pc.frame.x * pc.band.y;
+  c.lightCount = pc.counts.x;
+  c.shadowRays = c.lightCount > 0u ? pc.counts.y : 0u;
+  c.maxDepth = uint(pc.params.w);
+  c.oneLight = shadesOneLight();
+  c.addedLight = pc.band.w;
+  c.noDirect = (pc.band.z & kShadeFlagNoDirect) != 0u;
+  c.glossyMis = (pc.counts.w & kFlagGlossyMis) != 0u;
+  c.keepRays = !kProbe && !kPerLight && !kReplayRays && (pc.band.z & kShadeFlagKeptRays) != 0u;
+  return c;
+}
+
+PathState startPath(uint pixel) {
+  BandPixel bp = bandPixelFromIndex(pixel, pc.frame.xy, pc.band.xy);
+  PathState path;
+  path.sp = shadingPointFromGBuffer(gbuffer[pixel], pc.eye.xyz);
+  path.throughput = vec3(1.0);
+  path.pathRng = rngSeed(bp.frame, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu);
+  path.rng = rngSeed(bp.frame, pc.frame.z, pc.frame.w ^ 0x6c8e9cf5u);
+  path.pathLo = path.sp.position;
+  path.pathHi = path.sp.position;
+  path.escaped = false;
+  path.truncated = false;
+  path.pixel = pixel;
+  return path;
+}
+
+// The path's vertex at `depth`: its lobe ray from the previous vertex, the emitter it may see,
+// then direct light and obscurance gathered there. False when the path ends (no lobe sample, a
+// miss, a probe that met a box); `rays` counts the rays traced.
+bool followVertex(SpecularPass c, inout PathState path, uint depth, inout StepBudget budget, inout uint rays) {
+  const uint pixel = path.pixel;
+  ShadingPoint sp = path.sp;
+  vec3 t, b;
+  orthonormalBasis(sp.ns, t, b);
+  vec3 wo = vec3(dot(sp.wo, t), dot(sp.wo, b), dot(sp.wo, sp.ns));
+  vec3 wiLocal, weight;
+  bool delta;
+  if (wo.z <= 0.0 || !sampleSpecularLobe(sp, wo, vec2(rngNext(path.pathRng), rngNext(path.pathRng)), wiLocal, weight, delta)) return false;
+  vec3 wi = toWorld(wiLocal, t, b, sp.ns);
+  if (dot(wi, sp.ng) <= 0.0) return false; // below the geometric surface: no leaks
+  // What MIS needs of the vertex the lobe sample leaves (its light samples' density).
+  float lobePdf = delta ? 0.0 : ggxReflectionPdf(wo, wiLocal, ggxAlpha(sp.roughness));
+  vec3 previous = sp.position, previousNormal = sp.ng;
+  path.throughput *= weight;
+  const vec3 throughput = path.throughput;
+  if (all(equal(throughput, vec3(0.0)))) return false;
+  vec3 origin = offsetRayOrigin(sp.position, sp.ng);
+  const uint hitSlot = pathHitSlot(pc.frame.z, pixel, c.pixelCount, depth);
+  RayHit h;
+  if (kReplayRays) {
+    h = probedPathHit(hitSlot, origin, wi);
+  } else {
+    h = traceFollowed(budget, origin, wi, 0.0, 1.0 / 0.0); // traced even when probing
+    ++rays;
+    if (c.keepRays) keepPathHit(hitSlot, h);
   }
-  if (!oneLight && !kProbe) {
+  if (gProbeMet) return false; // a probe that met a changed box: the pixel is dirty, the rest is moot
+  if (!rayHitValid(h) || h.primitive == kInvalidIndex) {
+    path.escaped = true;
+    // The sky along the lobe: whole after a mirror, MIS-weighted after a glossy bounce.
+    uint sky = findBackgroundLight(c.lightCount);
+    if ((c.oneLight && sky != c.addedLight) || c.noDirect) sky = kInvalidIndex;
+    if (!kProbe && h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || (c.glossyMis && !c.oneLight))) { // a miss, not a truncation
+      float w = delta ? 1.0 : powerHeuristic(lobePdf, float(c.shadowRays) * backgroundLightPdf(sky, previous, previousNormal, c.lightCount, wi));
+      OBS_ACCUMULATE(specularBasis, sky * c.pixelCount + pixel, vec4(w * throughput, 0.0))
+    }
+    return false;
+  }
+  Surface s = surfaceAt(h, origin, wi);
+  path.pathLo = min(path.pathLo, s.position);
+  path.pathHi = max(path.pathHi, s.position);
+  GpuMaterial m = materials[s.material];
+  vec3 baseColor = materialBaseColor(m, s.uv).rgb;
+  const bool counted = c.oneLight ? delta && s.lightGroup == c.addedLight : !c.noDirect && (delta || c.glossyMis);
+  if (!kProbe && counted && s.lightGroup != kInvalidIndex && s.lightGroup < c.lightCount) {
+    float w = 1.0;
+    if (!delta) {
+      float lightPdf = emitterHitLightPdf(s.lightGroup, previous, previousNormal, c.lightCount, h, s.position, wi);
+      w = powerHeuristic(lobePdf, float(c.shadowRays) * lightPdf);
+    }
+    // Seen emission in unit-emission terms: divided by the group's E_s (1 where E_s is 0).
+    vec3 unit = unitEmission(materialEmission(m, s.uv, s.frontFacing), lightScales[s.lightGroup].rgb);
+    OBS_ACCUMULATE(specularBasis, s.lightGroup * c.pixelCount + pixel, vec4(w * throughput * unit, 0.0))
+  }
+  sp = shadingPoint(s.position, s.geometricNormal, s.shadingNormal, -wi, baseColor, s.material);
+  path.sp = sp;
+  // Gather as at P [RTO §4.1 step 4]: direct light, then obscurance.
+  // MIS only where a lobe sample follows from this vertex (the path goes on past it).
+  float misSamples = c.glossyMis && depth + 1u < c.maxDepth ? float(c.shadowRays) : 0.0;
+  const vec4 lightShift = rngNext4(path.rng); // this vertex's light samples: one shifted low-discrepancy set
+  if (kProbe && kReplayRays) {
+    // The vertex's kept shadow rays (never kept for one light alone, nor without direct light:
+    // the host keeps no rays with per-light shadow sampling).
+    probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.frame.z, pixel, c.pixelCount, depth, c.shadowRays);
+  } else {
+    // A probe whose shafts from the vertex to the lights all miss the boxes draws no light sample.
+    const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, c.lightCount);
+    if (c.oneLight) {
+      uint taken = 0u;
+      vec3 direct = vec3(0.0);
+      if (drawn) direct = directLightFromOne(sp, c.addedLight, lightShift, budget, taken);
+      OBS_ACCUMULATE(specularBasis, c.addedLight * c.pixelCount + pixel, vec4(throughput * direct, 0.0))
+      rays += taken;
+      return true; // one light's rays alone: no obscurance
+    }
+    for (uint k = 0u; k < (c.noDirect || !drawn ? 0u : c.shadowRays); ++k) {
+      vec4 u = kroneckerPoint4(k, lightShift);
+      vec3 contribution;
+      uint light;
+      directLightSample(sp, u, c.lightCount, misSamples, budget, contribution, light);
+      if (c.keepRays) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, c.pixelCount, depth, k)] = gShadowRay;
+      OBS_ACCUMULATE(specularBasis, light * c.pixelCount + pixel, vec4(throughput * contribution / float(c.shadowRays), 0.0))
+    }
+  }
+  // Secondary reflectors only at primary hits: here the ambient keeps its whole I_a.
+  vec4 aw = gatherObscurance(sp, path.rng, budget, kInvalidIndex, c.pixelCount);
+  OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
+  rays += (c.noDirect ? 0u : c.shadowRays) + pc.counts.z;
+  return true;
+}
+
+// A path that has ended: the box of its vertices for dirty.comp, a probe's verdict, a truncation.
+void finishPath(SpecularPass c, PathState path) {
+  const uint pixel = path.pixel;
+  if (!c.oneLight && !kProbe) {
     vec4 lo = hitBounds[2u * pixel], hi = hitBounds[2u * pixel + 1u];
-    hitBounds[2u * pixel] = vec4(min(lo.xyz, pathLo), max(lo.w, escaped ? 1.0 : 0.0));
-    hitBounds[2u * pixel + 1u] = vec4(max(hi.xyz, pathHi), hi.w);
+    hitBounds[2u * pixel] = vec4(min(lo.xyz, path.pathLo), max(lo.w, path.escaped ? 1.0 : 0.0));
+    hitBounds[2u * pixel + 1u] = vec4(max(hi.xyz, path.pathHi), hi.w);
   }
-  if (kProbe) endProbe(pixel);
-  else atomicAdd(status[kStatusSpecularRays], rays);
-  if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
+  endProbe(pixel); // a path goes on only while its probe has met no box (gProbeMet)
+  if (path.truncated) atomicAdd(status[kStatusTruncated], 1u);
+}
+
+// A path's state in specularPaths[kSpecularPathTexels * pixel ...] (the pixel is its index; the
+// shading point's material parameters are read again, as shadingPoint reads them).
+void storePath(PathState path) {
+  const uint at = kSpecularPathTexels * path.pixel;
+  const uint flags = (path.escaped ? 1u : 0u) | (path.truncated ? 2u : 0u);
+  specularPaths[at] = vec4(path.sp.position, path.throughput.x);
+  specularPaths[at + 1u] = vec4(path.sp.ng, path.throughput.y);
+  specularPaths[at + 2u] = vec4(path.sp.ns, path.throughput.z);
+  specularPaths[at + 3u] = vec4(path.sp.wo, uintBitsToFloat(path.sp.material));
+  specularPaths[at + 4u] = vec4(path.sp.baseColor, uintBitsToFloat(flags));
+  specularPaths[at + 5u] = vec4(path.pathLo, uintBitsToFloat(path.pathRng));
+  specularPaths[at + 6u] = vec4(path.pathHi, uintBitsToFloat(path.rng));
+}
+
+PathState loadPath(uint pixel) {
+  const uint at = kSpecularPathTexels * pixel;
+  vec4 t0 = specularPaths[at], t1 = specularPaths[at + 1u], t2 = specularPaths[at + 2u], t3 = specularPaths[at + 3u];
+  vec4 t4 = specularPaths[at + 4u], t5 = specularPaths[at + 5u], t6 = specularPaths[at + 6u];
+  const uint flags = floatBitsToUint(t4.w);
+  PathState path;
+  path.sp = shadingPoint(t0.xyz, t1.xyz, t2.xyz, t3.xyz, t4.xyz, floatBitsToUint(t3.w));
+  path.throughput = vec3(t0.w, t1.w, t2.w);
+  path.pathRng = floatBitsToUint(t5.w);
+  path.rng = floatBitsToUint(t6.w);
+  path.pathLo = t5.xyz;
+  path.pathHi = t6.xyz;
+  path.escaped = (flags & 1u) != 0u;
+  path.truncated = (flags & 2u) != 0u;
+  path.pixel = pixel;
+  return path;
+}
+
+// One vertex (depth pc.rAve.w) of each path in this depth's queue.
+void main() {
+  gSceneScale = pc.eye.w;
+  gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
+  const SpecularPass c = specularPass();
+  const uint depth = uint(pc.rAve.w);
+  const uint queued = specularQueueBase(depth, c.pixelCount);
+  const uint entry = gl_GlobalInvocationID.x;
+  if (entry >= queue[queued + kQueueCount]) return;
+  const uint pixel = queue[queued + kQueueHeader + entry];
+  beginProbe(); // the queue holds only the candidates not yet found dirty (skipClean)
+  StepBudget budget = newStepBudget();
+  PathState path = depth == 1u ? startPath(pixel) : loadPath(pixel);
+  uint rays = 0u;
+  bool goesOn = false;
+  if (depth < c.maxDepth && path.sp.glossy) {
+    goesOn = followVertex(c, path, depth, budget, rays);
+    path.truncated = path.truncated || budget.truncated;
+  }
+  if (goesOn && depth + 1u < c.maxDepth && path.sp.glossy) {
+    storePath(path);
+    OBS_QUEUE_APPEND(queue, specularQueueBase(depth + 1u, c.pixelCount), pixel)
+  } else {
+    finishPath(c, path);
+  }
+  if (!kProbe && rays > 0u) atomicAdd(status[kStatusSpecularRays], rays);
 }

@@ -20,7 +20,10 @@ layout(std430, set = 0, binding = kBindingAmbient) buffer AmbientBuffer { vec4 a
 layout(std430, set = 0, binding = kBindingSpecularBasis) buffer SpecularBasisBuffer { vec4 specularBasis[]; };
 layout(std430, set = 0, binding = kBindingSpecularAmbient) buffer SpecularAmbientBuffer { vec4 specularAmbient[]; };
 // queue[0..3] = indirect dispatch groups (x, y, z) and the entry count; pixel indices follow.
+// Two such queues take turns, one per path depth (specularQueueBase).
 layout(std430, set = 0, binding = kBindingSpecularQueue) buffer SpecularQueue { uint queue[]; };
+// The specular paths' state between vertices, kSpecularPathTexels per pixel (specular.comp).
+layout(std430, set = 0, binding = kBindingSpecularPaths) buffer SpecularPaths { vec4 specularPaths[]; };
 layout(std430, set = 0, binding = kBindingLightScales) readonly buffer LightScales { vec4 lightScales[]; };
 layout(std430, set = 0, binding = kBindingDirty) buffer DirtyMask { uint dirty[]; }; // probes mark it
 // Per pixel, the box of its hits and specular path vertices (primary.comp starts it; specular.comp

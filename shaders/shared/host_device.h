@@ -293,7 +293,8 @@ struct ShadePush {
   uvec4 frame;  // 0:  width, height, sample index, seed
   uvec4 counts; // 16: light count, shadow rays per hit, obscurance rays per hit, flags
   vec4 params;  // 32: dMax, tau, rho kind (as float), maximum path depth (as float)
-  vec4 rAve;    // 48: R_ave rgb (the reflectance of a miss within dmax, SPEC §1.2), w = unused
+  vec4 rAve;    // 48: R_ave rgb (the reflectance of a miss within dmax, SPEC §1.2), w = the path
+                //     depth of a specular.comp dispatch (as float)
   vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = scene size
                 //     (largest bounding-box extent: scales the ray-origin offset, ray.glsl)
   uvec4 band;   // 80: first row, rows, flags (kShadeFlag*), the light of a per-light dispatch
@@ -382,7 +383,9 @@ OBS_CONST uint kBindingPathHits = 18;        // uvec4[(sample * pixels + pixel) 
 OBS_CONST uint kBindingKeptShadowRays = 19;  // vec4[((sample * pixels + pixel) * 6 + vertex) * N_s + k]:
                                              // direction, length (0: no ray) of the shadow rays at the
                                              // primary hit (vertex 0) and the paths' vertices
-OBS_CONST uint kShadingBindingCount = 20;
+OBS_CONST uint kBindingSpecularPaths = 20;    // vec4[pixels * kSpecularPathTexels]: the state of each
+                                             // specular path between its vertices (specular.comp)
+OBS_CONST uint kShadingBindingCount = 21;
 
 // ---- Bindings of primary.comp after the scene's (0..5).
 OBS_CONST uint kBindingPrimaryGBuffer = 6;       // GBufferTexel[pixel]
@@ -404,6 +407,12 @@ OBS_CONST uint kPrimaryBindingCount = 13;
 OBS_CONST uint kQueueGroupsX = 0;
 OBS_CONST uint kQueueCount = 3;
 OBS_CONST uint kQueueHeader = 4;
+// The specular pass runs one vertex of its paths per dispatch (a wavefront): the paths that go on
+// past depth d are queued for depth d + 1. Two queues of a band's `pixels` entries take turns in
+// the queue buffer: depth 1 (filled by specular_queue.comp) at word 0, depth 2 after it, ...
+OBS_FN uint specularQueueBase(uint depth, uint pixels) { return (depth & 1u) != 0u ? 0u : kQueueHeader + pixels; }
+// A path's state between vertices: 7 vec4 (specular.comp, storePath).
+OBS_CONST uint kSpecularPathTexels = 7;
 
 // ---- pathtrace.comp: push constants and its own bindings after the scene's (0..5).
 struct PathPush {

@@ -38,7 +38,8 @@ std::vector<FrameBufferKind> ObscuranceFrame::bufferKinds(const FrameContents& c
   };
   if (contents.primaryAovs) kinds.push_back({"aovs", gpu::kAovSlots * kAccumulator, false});
   if (contents.specular) {
-    kinds.push_back({"queue", 4, false});
+    kinds.push_back({"queue", 2 * 4, false}); // two queues: one path depth reads one, fills the other
+    kinds.push_back({"specular_paths", gpu::kSpecularPathTexels * kVec4, false});
     kinds.push_back({"specular_basis", kAccumulator, true});
     kinds.push_back({"specular_ambient", kAccumulator, false});
     if (contents.keptRaySamples > 0)
@@ -92,8 +93,10 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.ambient = gpu::Buffer(context, px * kAccumulator, kStorage, "frame.ambient" + tag);
     b.specularAmbient = gpu::Buffer(context, specular ? px * kAccumulator : kVec4, kStorage,
                                     "frame.specular_ambient" + tag);
-    b.queue = gpu::Buffer(context, (gpu::kQueueHeader + (specular ? px : 1)) * 4,
+    b.queue = gpu::Buffer(context, 2 * (gpu::kQueueHeader + (specular ? px : 1)) * 4,
                           kStorage | Usage::eIndirectBuffer, "frame.specular_queue" + tag);
+    b.specularPaths = gpu::Buffer(context, specular ? px * gpu::kSpecularPathTexels * kVec4 : kVec4, kStorage,
+                                  "frame.specular_paths" + tag);
     b.composed = gpu::Buffer(context, px * contents.composedSlots * kVec4, kStorage, "frame.composed" + tag);
     b.display = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.display" + tag);
     const std::uint64_t slots = maxLights_;
@@ -125,7 +128,7 @@ std::uint64_t ObscuranceFrame::bytes() const {
   std::uint64_t total = status_.buffer().size();
   for (const auto& b : bands_)
     for (const gpu::Buffer* buffer : {&b.gbuffer, &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
-                                      &b.specularAmbient, &b.queue, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty,
+                                      &b.specularAmbient, &b.queue, &b.specularPaths, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty,
                                       &b.sampleCounts, &b.pathHits, &b.shadowRays})
       total += buffer->size();
   return total;

@@ -54,7 +54,7 @@ class ObscuranceFrame {
 public:
   struct Band {
     FrameBand rows;
-    gpu::Buffer gbuffer, aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, composed,
+    gpu::Buffer gbuffer, aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, specularPaths, composed,
         display;
     gpu::TexelBuffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits:
                                // lightmix.comp reads four pixels at a time as RGBA32UI texels

@@ -51,6 +51,7 @@ void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInp
   kernel.bind(gpu::kBindingSpecularBasis, b.specularBasis, band);
   kernel.bind(gpu::kBindingSpecularAmbient, b.specularAmbient, band);
   kernel.bind(gpu::kBindingSpecularQueue, b.queue, band);
+  kernel.bind(gpu::kBindingSpecularPaths, b.specularPaths, band);
   kernel.bind(gpu::kBindingLightScales, in.lights.scales, band);
   kernel.bind(gpu::kBindingDirty, b.dirty, band);
   kernel.bind(gpu::kBindingHitBounds, b.hitBounds, band);

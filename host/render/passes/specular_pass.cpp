@@ -1,5 +1,6 @@
 #include "render/passes/specular_pass.h"
 
+#include <algorithm>
 #include <array>
 
 #include "specular.spv.h"
@@ -26,11 +27,16 @@ void SpecularPass::bind(std::uint32_t band, const ShadingInputs& in) {
 
 void SpecularPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
                           const ObscuranceFrame& frame, const gpu::ShadePush& push) const {
-  // An empty queue dispatches (0, 1, 1) groups; specular_queue.comp raises x as it appends.
+  // An empty queue dispatches (0, 1, 1) groups; specular_queue.comp and specular.comp raise x as
+  // they append.
   static constexpr std::array<std::uint32_t, gpu::kQueueHeader> kEmptyQueue = {0u, 1u, 1u, 0u};
-  const gpu::ShadePush p = forBand(push, layout, band);
+  gpu::ShadePush p = forBand(push, layout, band);
   const gpu::Buffer& queue = frame.band(band).queue;
-  cmd.updateBuffer<std::uint32_t>(queue.handle(), 0, kEmptyQueue);
+  const auto pixels = static_cast<std::uint32_t>(layout.bandPixels(band));
+  auto clearQueue = [&](std::uint32_t depth) {
+    cmd.updateBuffer<std::uint32_t>(queue.handle(), vk::DeviceSize(gpu::specularQueueBase(depth, pixels)) * 4, kEmptyQueue);
+  };
+  clearQueue(1);
   gpu::computeBarrier(cmd);
   queue_.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
                   gpu::groupsFor(layout.bands[band].rows, gpu::kWorkgroupSizeY), 1, &p, band);
@@ -39,7 +45,18 @@ void SpecularPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band
   const gpu::Kernel& paths = (push.band.z & gpu::kShadeFlagProbe) != 0 ? (replay ? probeReplay_ : probe_)
                              : takesPerLightVariant(p)                ? (replay ? perLightReplay_ : perLight_)
                                                                       : paths_;
-  paths.dispatchIndirect(cmd, queue, 0, &p, band);
+  // One dispatch per vertex depth; each fills the queue of the next (specular.comp). A path
+  // depth of 1 still runs depth 1, which only finishes the paths.
+  const std::uint32_t lastDepth = std::max(static_cast<std::uint32_t>(push.params.w), 2u) - 1u;
+  for (std::uint32_t depth = 1; depth <= lastDepth; ++depth) {
+    if (depth < lastDepth) {
+      clearQueue(depth + 1);
+      gpu::computeBarrier(cmd);
+    }
+    p.rAve.w = static_cast<float>(depth);
+    paths.dispatchIndirect(cmd, queue, vk::DeviceSize(gpu::specularQueueBase(depth, pixels)) * 4, &p, band);
+    if (depth < lastDepth) gpu::computeBarrier(cmd);
+  }
 }
 
 } // namespace obscura::render
