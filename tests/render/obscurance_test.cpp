@@ -195,6 +195,35 @@ TEST_F(Obscurance, MirrorReflectsAnEmitterExactly) {
   EXPECT_NEAR(mean(r.image, "indirect.R"), 0.0, 1e-6);
 }
 
+TEST_F(Obscurance, FacingMirrorsReflectAnEmittingMirrorOncePerRoundTripUpToTheMaximumDepth) {
+  // A white mirror floor (F = 1) under an emitting mirror ceiling of reflectance c = 0.5 (metallic,
+  // base colour c: F = c at the near-normal incidence of a 0.2 rad field of view, the Schlick term
+  // (1 - cos)^5 < 1e-11) and radiance 1. A path from the floor meets the ceiling at depths 1, 3,
+  // 5, ... with throughputs 1, c, c^2, ... and sees its emission each time (whole: delta bounces),
+  // so with paths of maxDepth scattering vertices the image is sum_{k < maxDepth / 2} c^k. Neither
+  // mirror has a diffuse part, so no shadow ray or obscurance adds anything. The specular pass
+  // runs one dispatch per depth: a depth that is not run, or a path not carried to the next,
+  // changes the sum.
+  const float c = 0.5f;
+  SceneBuilder b;
+  auto floorMirror = b.glossy(glm::vec3(1.0f), 1.0f, 0.0f);
+  auto ceiling = b.glossy(glm::vec3(c), 1.0f, 0.0f, glm::vec3(1.0f));
+  b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, floorMirror);
+  b.quad({-kHalfSize, 2, -kHalfSize}, {2 * kHalfSize, 0, 0}, {0, 0, 2 * kHalfSize}, ceiling, "ceiling"); // faces -y
+  scene::Scene s = b.build();
+  for (std::uint32_t maxDepth : {1u, 2u, 3u, 4u, 6u}) {
+    auto settings = lookDown(1.0f, 0.2f, 8, 1);
+    settings.maxDepth = maxDepth;
+    auto r = render(s, settings);
+    double expected = 0.0;
+    for (std::uint32_t depth = 1; depth < maxDepth; depth += 2) expected += std::pow(c, (depth - 1) / 2);
+    const int channel = r.image.channelIndex("combined.R");
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x)
+        ASSERT_NEAR(r.image.at(x, y, channel), expected, 1e-4) << "maxDepth " << maxDepth << " at " << x << "," << y;
+  }
+}
+
 TEST_F(Obscurance, SameSeedSameImageNoNaNAndOnlyNeededPasses) {
   scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
   render::ObscuranceSettings settings;

@@ -19,12 +19,13 @@ std::uint32_t SceneBuilder::lambertian(glm::vec3 albedo, glm::vec3 emission, boo
   return static_cast<std::uint32_t>(scene_.materials.size() - 1);
 }
 
-std::uint32_t SceneBuilder::glossy(glm::vec3 baseColor, float metallic, float roughness) {
+std::uint32_t SceneBuilder::glossy(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 emission) {
   scene::Material m;
   m.name = "glossy" + std::to_string(scene_.materials.size());
   m.baseColor = glm::vec4(baseColor, 1.0f);
   m.metallic = metallic;
   m.roughness = roughness;
+  m.emission = emission;
   scene_.materials.push_back(m);
   return static_cast<std::uint32_t>(scene_.materials.size() - 1);
 }

@@ -16,7 +16,7 @@ class SceneBuilder {
 public:
   // A Lambertian material (metallic 0, roughness 1: no specular lobe [SPEC §5]).
   std::uint32_t lambertian(glm::vec3 albedo, glm::vec3 emission = glm::vec3(0.0f), bool doubleSided = false);
-  std::uint32_t glossy(glm::vec3 baseColor, float metallic, float roughness);
+  std::uint32_t glossy(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 emission = glm::vec3(0.0f));
   // Quad corner, edge u, edge v: two triangles, front face = the side cross(u, v) points to.
   void quad(glm::vec3 corner, glm::vec3 u, glm::vec3 v, std::uint32_t material, const std::string& group = "");
   void pointLight(glm::vec3 position, glm::vec3 color, float intensity, const std::string& name = "point");
