@@ -10,6 +10,9 @@
 // compiled in at all; lavapipe's register allocation over the whole shader made the obscurance
 // rays' traversal loop 1.7x slower with it present but never taken.
 layout(constant_id = kSpecConstantReflectors) const bool kReflectors = false;
+// The variant for grey obscurance (kSpecConstantGreyObscurance): no colour bleeding, so neither the
+// surface nor the texture at an obscurance ray's hit is looked up.
+layout(constant_id = kSpecConstantGreyObscurance) const bool kGreyObscurance = false;
 
 // rho(d) for d < dMax; rho = 1 from dMax on (a miss within dMax).
 float rho(float d, float dMax, uint kind, float tau) {
@@ -60,7 +63,7 @@ vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, 
   orthonormalBasis(sp.ns, t, b);
   const uint n = pc.counts.z;
   const bool systematic = (pc.counts.w & kFlagSystematic) != 0u;
-  const bool bleed = (pc.counts.w & kFlagBleed) != 0u;
+  const bool bleed = !kGreyObscurance && (pc.counts.w & kFlagBleed) != 0u;
   const bool reflectors = kReflectors && reflectorPixel != kInvalidIndex && (pc.counts.w & kFlagSecondaryReflectors) != 0u;
   const float dMax = pc.params.x;
   const uint rhoKind = uint(pc.params.z);

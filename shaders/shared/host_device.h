@@ -361,6 +361,11 @@ OBS_CONST uint kSpecConstantReplayRays = 5u;
 // The specialisation constant (a bool) that makes trace.comp record each ray's loop passes (the
 // traversal tests and bench-rays' statistics); the timed variant leaves the stores out.
 OBS_CONST uint kSpecConstantTraceSteps = 6u;
+// The specialisation constant (a bool) that leaves the colour bleeding out of gatherObscurance
+// (kGreyObscurance, lib/obscurance.glsl): the obscurance pass's dispatches without kFlagBleed (and
+// without reflectors) go to that variant. Left in, the hit's surface and texture lookup, which
+// lavapipe runs for every ray whether or not a lane takes the branch, cost the grey pass 13 %.
+OBS_CONST uint kSpecConstantGreyObscurance = 7u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

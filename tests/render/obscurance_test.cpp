@@ -129,6 +129,32 @@ TEST_F(Obscurance, FloorUnderParallelCeilingMatchesTheClosedForm) {
   }
 }
 
+TEST_F(Obscurance, GreyObscuranceTracesTheSameRaysAndLeavesTheColourOut) {
+  // Without colour bleeding the pass runs its grey variant (kSpecConstantGreyObscurance), which
+  // never looks up the surface an obscurance ray hits. Same seed, same rays: W is the same, pixel
+  // for pixel, as with bleeding, and the indirect AOV is I_a R(P) W in every channel (R(P) = 0.5,
+  // the floor), whatever the ceiling's colour.
+  const float h = 1.0f, dMax = 2.0f;
+  scene::Scene s = slabScene(h, glm::vec3(0.2f, 0.5f, 0.8f));
+  auto settings = lookDown(0.5f * h, 0.3f, 16, 2);
+  settings.obscuranceRays = 8;
+  settings.dMax = dMax;
+  auto bleeding = render(s, settings);
+  settings.colourBleeding = false;
+  auto grey = render(s, settings);
+  const int w = grey.image.channelIndex("obscurance.Y");
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      ASSERT_EQ(grey.image.at(x, y, w), bleeding.image.at(x, y, w)) << x << "," << y;
+      for (int ch = 0; ch < 3; ++ch) {
+        const float expected = grey.ambientIntensity[ch] * 0.5f * grey.image.at(x, y, w);
+        ASSERT_NEAR(grey.image.at(x, y, grey.image.channelIndex(std::string("indirect.") + "RGB"[ch])), expected,
+                    1e-5f * expected + 1e-7f)
+            << x << "," << y << " channel " << ch;
+      }
+    }
+}
+
 TEST_F(Obscurance, PointLightOverAPlaneIsExact) {
   SceneBuilder b;
   auto floor = b.lambertian(glm::vec3(0.5f));

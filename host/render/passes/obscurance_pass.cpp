@@ -5,6 +5,6 @@
 namespace obscura::render {
 
 ObscurancePass::ObscurancePass(const gpu::Context& context, std::uint32_t bands)
-    : PixelShadingPass(context, "obscurance", kSpirv_obscurance, bands, {.reflectors = true}) {}
+    : PixelShadingPass(context, "obscurance", kSpirv_obscurance, bands, {.reflectors = true, .grey = true}) {}
 
 } // namespace obscura::render

@@ -15,6 +15,10 @@ struct ShadingVariants {
   // (kSpecConstantReflectors, lib/obscurance.glsl): that kernel takes the dispatches with
   // kFlagSecondaryReflectors, and the others leave that code out.
   bool reflectors = false;
+  // The shader has a variant without colour bleeding (kSpecConstantGreyObscurance,
+  // lib/obscurance.glsl): it takes the dispatches without kFlagBleed that neither probe nor
+  // gather reflectors.
+  bool grey = false;
   // The shader shades one light alone when specialised for it (kSpecConstantPerLight): that kernel
   // takes the kShadeFlagPerLight dispatches that do not probe.
   bool perLight = false;
@@ -31,6 +35,8 @@ public:
       : kernel_(context, shadingKernelDesc(name, spirv, bands)), probe_(context, probingKernelDesc(name, spirv, bands)),
         reflectors_(variants.reflectors ? std::make_unique<gpu::Kernel>(context, reflectorKernelDesc(name, spirv, bands))
                                         : nullptr),
+        grey_(variants.grey ? std::make_unique<gpu::Kernel>(context, greyObscuranceKernelDesc(name, spirv, bands))
+                            : nullptr),
         perLight_(variants.perLight ? std::make_unique<gpu::Kernel>(context, perLightKernelDesc(name, spirv, bands))
                                     : nullptr),
         probeReplay_(variants.replayKeptRays
@@ -41,6 +47,7 @@ public:
     bindShadingInputs(kernel_, band, in);
     bindShadingInputs(probe_, band, in);
     if (reflectors_) bindShadingInputs(*reflectors_, band, in);
+    if (grey_) bindShadingInputs(*grey_, band, in);
     if (perLight_) bindShadingInputs(*perLight_, band, in);
     if (probeReplay_) bindShadingInputs(*probeReplay_, band, in);
   }
@@ -69,7 +76,9 @@ public:
     if (perLight && (!perLight_ || reflectors)) throw std::logic_error("PixelShadingPass: no per-light variant");
     const bool replay = probeReplay_ && probe && (push.band.z & gpu::kShadeFlagKeptRays) != 0 &&
                         (push.band.z & gpu::kShadeFlagPerLight) == 0;
-    const gpu::Kernel& kernel = replay ? *probeReplay_ : probe ? probe_ : reflectors ? *reflectors_ : perLight ? *perLight_ : kernel_;
+    const bool grey = grey_ && !probe && !reflectors && !perLight && (push.counts.w & gpu::kFlagBleed) == 0;
+    const gpu::Kernel& kernel = replay ? *probeReplay_ : probe ? probe_ : reflectors ? *reflectors_ : perLight ? *perLight_
+                              : grey ? *grey_ : kernel_;
     if (dirtyOf != nullptr) {
       kernel.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &p, band);
       return;
@@ -82,6 +91,7 @@ private:
   gpu::Kernel kernel_;
   gpu::Kernel probe_;
   std::unique_ptr<gpu::Kernel> reflectors_;
+  std::unique_ptr<gpu::Kernel> grey_;
   std::unique_ptr<gpu::Kernel> perLight_;
   std::unique_ptr<gpu::Kernel> probeReplay_;
 };

@@ -24,6 +24,14 @@ gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint3
   return desc;
 }
 
+gpu::KernelDesc greyObscuranceKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
+  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
+  desc.name += ".grey";
+  desc.deferCompile = true; // renders without colour bleeding only
+  desc.specConstants.push_back({.id = gpu::kSpecConstantGreyObscurance, .value = 1u});
+  return desc;
+}
+
 gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
   gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
   desc.name += ".perlight";

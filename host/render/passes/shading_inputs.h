@@ -29,6 +29,8 @@ gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_
 gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
 // The variant with the secondary reflectors' code (kSpecConstantReflectors): "<name>.reflectors".
 gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+// The obscurance variant without colour bleeding (kSpecConstantGreyObscurance): "<name>.grey".
+gpu::KernelDesc greyObscuranceKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
 // The variant for one light alone (kSpecConstantPerLight): "<name>.perlight".
 gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
 // The same shader's variant (of the per-light or probing one) that follows the frame's kept rays
