@@ -1,6 +1,7 @@
 // specular_pass.h — specular paths from glossy primary hits (specular_queue.comp compacts the
 // glossy pixels of a band into a queue and sizes an indirect dispatch of specular.comp), gathering
-// direct light and obscurance at their vertices [RTO §4.1 step 4].
+// direct light and obscurance at their vertices [RTO §4.1 step 4]. specular.comp runs one vertex
+// depth per dispatch and queues the paths that go on for the next (a wavefront).
 #pragma once
 #include "render/passes/shading_inputs.h"
 
@@ -17,7 +18,8 @@ public:
     (keptHits ? probeReplay_ : probe_).compile();
     (keptHits ? perLightReplay_ : perLight_).compile();
   }
-  // Clears band `band`'s queue, fills it and dispatches the paths (barriers included). A per-light
+  // Clears band `band`'s queue, fills it and dispatches the paths, one dispatch per depth
+  // (barriers included). A per-light
   // or probing dispatch with kShadeFlagKeptRays follows the kept hits (the .replay kernels).
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
               const ObscuranceFrame& frame, const gpu::ShadePush& push) const;
