@@ -232,6 +232,12 @@ public:
   std::uint64_t deviceBytes() const;
 
 private:
+  // What the shading passes' kernels are specialised for: the frame's bands, and the flat light
+  // selection where this render can take no other (settings_ and frame_ are made first).
+  ShadingSpecialisation shadingKernels() const {
+    return shadingSpecialisation(frame_.layout().bandCount(), settings_.lightSampling == LightSampling::Spatial,
+                                 frame_.lightCapacity());
+  }
   void uploadLights();
   // The Reached ambient model: what every light reaches in `scene`. After a geometry edit that
   // kept the lights, `changed` (the edited objects' old and new boxes) lets each light re-trace

@@ -129,11 +129,14 @@ bool isUnbounded(uint type) { return type == kLightDirectional || type == kLight
 
 // Up to kMaxSpatialLights lights, the spatial selection weighs every light at the point (exact);
 // beyond, it descends the light tree (approximate weights, a bounded number of nodes).
+// A kernel specialised with kFlatLightSelection uses only the flat selection (the host makes
+// sure that the dispatch samples spatially and that count <= kMaxSpatialLights).
+layout(constant_id = kSpecConstantFlatLightSelection) const bool kFlatLightSelection = false;
 bool useSpatialSelection(uint count) {
-  return gLightSampling == kLightSamplingSpatial && count <= kMaxSpatialLights;
+  return kFlatLightSelection || (gLightSampling == kLightSamplingSpatial && count <= kMaxSpatialLights);
 }
 bool useLightTree(uint count) {
-  return gLightSampling == kLightSamplingSpatial && count > kMaxSpatialLights;
+  return !kFlatLightSelection && gLightSampling == kLightSamplingSpatial && count > kMaxSpatialLights;
 }
 
 // ---- The light tree (more than kMaxSpatialLights lights; layout: GpuLightNode in host_device.h)

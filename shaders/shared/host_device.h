@@ -366,6 +366,12 @@ OBS_CONST uint kSpecConstantTraceSteps = 6u;
 // without reflectors) go to that variant. Left in, the hit's surface and texture lookup, which
 // lavapipe runs for every ray whether or not a lane takes the branch, cost the grey pass 13 %.
 OBS_CONST uint kSpecConstantGreyObscurance = 7u;
+// The specialisation constant (a bool) that leaves the light tree and the selection by power out
+// of a shading kernel (kFlatLightSelection, lib/lights.glsl): every light is chosen by the flat
+// spatial selection. The host sets it where the render samples lights spatially and its frame
+// holds no more than kMaxSpatialLights lights (spares included); lavapipe otherwise runs the
+// unused selections masked for every light sample (5 % of the shadow pass).
+OBS_CONST uint kSpecConstantFlatLightSelection = 8u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

@@ -16,6 +16,7 @@
 #include "gpu_test.h"
 #include "render/obscurance_renderer.h"
 #include "render/one_shot.h"
+#include "render/passes/shading_inputs.h"
 #include "render/scene/scene_buffers.h"
 #include "render/test_scenes.h"
 
@@ -197,6 +198,39 @@ TEST_F(DirectLight, SkyOverAnOpenFloorIsExactInBothMethods) {
   pt.camera = atTheOrigin(render::LightSampling::Spatial, 1).camera;
   for (int c = 0; c < 3; ++c)
     EXPECT_NEAR(estimate(pathTrace(s, pt).image, {std::string("combined.") + "RGB"[c]}).mean, 0.5 * sky[c], 1e-4 * sky[c]) << c;
+}
+
+TEST_F(DirectLight, FlatLightSelectionKernelsRenderTheGeneralKernelsImage) {
+  // The shading kernels leave the light tree and the selection by power out
+  // (kSpecConstantFlatLightSelection) exactly where a render can take no other selection: spatial
+  // sampling and at most kMaxSpatialLights lights, the frame's spare light slots included.
+  EXPECT_TRUE(render::shadingSpecialisation(1, true, gpu::kMaxSpatialLights).flatLightSelection);
+  EXPECT_FALSE(render::shadingSpecialisation(1, true, gpu::kMaxSpatialLights + 1).flatLightSelection);
+  EXPECT_FALSE(render::shadingSpecialisation(1, false, 3).flatLightSelection);
+  // Three lamps over a glossy floor (shadow rays with MIS, specular paths, obscurance): spare
+  // light slots past kMaxSpatialLights make the same render use the general kernels, whose
+  // dispatches still select among the three lamps spatially. Same estimator, same image.
+  SceneBuilder b;
+  auto floor = b.glossy(glm::vec3(0.6f, 0.5f, 0.4f), 0.0f, 0.3f);
+  auto wall = b.lambertian(glm::vec3(0.3f, 0.6f, 0.3f));
+  b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, floor);
+  b.quad({-1, 0, -0.5f}, {0, 1, 0}, {2, 0, 0}, wall); // faces +z
+  for (int i = 0; i < 3; ++i) {
+    auto lamp = b.lambertian(glm::vec3(0.0f), glm::vec3(1.0f + i, 2.0f, 3.0f - i));
+    b.quad({-0.9f + 0.6f * i, 0.8f, 0.1f}, {0.3f, 0, 0}, {0, 0, 0.3f}, lamp, "lamp" + std::to_string(i)); // faces -y
+  }
+  scene::Scene s = b.build();
+  render::ObscuranceSettings settings;
+  settings.width = settings.height = 24;
+  settings.spp = 2;
+  settings.camera = lookCamera({0, 0.6f, 1.5f}, {0, -0.3f, -1}, {0, 1, 0}, 1.0f);
+  auto flat = render(s, settings);
+  settings.spareLightSlots = gpu::kMaxSpatialLights;
+  auto general = render(s, settings);
+  ASSERT_TRUE(flat.stats.passes.contains("specular"));
+  ASSERT_EQ(flat.image.pixels.size(), general.image.pixels.size());
+  for (std::size_t i = 0; i < flat.image.pixels.size(); ++i) ASSERT_EQ(flat.image.pixels[i], general.image.pixels[i]) << i;
+  EXPECT_GT(estimate(flat.image, {"direct.G"}).mean, 0.0);
 }
 
 } // namespace

@@ -4,7 +4,7 @@
 
 namespace obscura::render {
 
-ObscurancePass::ObscurancePass(const gpu::Context& context, std::uint32_t bands)
-    : PixelShadingPass(context, "obscurance", kSpirv_obscurance, bands, {.reflectors = true, .grey = true}) {}
+ObscurancePass::ObscurancePass(const gpu::Context& context, const ShadingSpecialisation& s)
+    : PixelShadingPass(context, "obscurance", kSpirv_obscurance, s, {.reflectors = true, .grey = true}) {}
 
 } // namespace obscura::render

@@ -7,7 +7,7 @@ namespace obscura::render {
 
 class ObscurancePass : public PixelShadingPass {
 public:
-  ObscurancePass(const gpu::Context& context, std::uint32_t bands);
+  ObscurancePass(const gpu::Context& context, const ShadingSpecialisation& s);
 };
 
 } // namespace obscura::render

@@ -31,16 +31,16 @@ struct ShadingVariants {
 class PixelShadingPass {
 public:
   PixelShadingPass(const gpu::Context& context, const char* name, std::span<const std::uint32_t> spirv,
-                   std::uint32_t bands, ShadingVariants variants = {})
-      : kernel_(context, shadingKernelDesc(name, spirv, bands)), probe_(context, probingKernelDesc(name, spirv, bands)),
-        reflectors_(variants.reflectors ? std::make_unique<gpu::Kernel>(context, reflectorKernelDesc(name, spirv, bands))
+                   const ShadingSpecialisation& s, ShadingVariants variants = {})
+      : kernel_(context, shadingKernelDesc(name, spirv, s)), probe_(context, probingKernelDesc(name, spirv, s)),
+        reflectors_(variants.reflectors ? std::make_unique<gpu::Kernel>(context, reflectorKernelDesc(name, spirv, s))
                                         : nullptr),
-        grey_(variants.grey ? std::make_unique<gpu::Kernel>(context, greyObscuranceKernelDesc(name, spirv, bands))
+        grey_(variants.grey ? std::make_unique<gpu::Kernel>(context, greyObscuranceKernelDesc(name, spirv, s))
                             : nullptr),
-        perLight_(variants.perLight ? std::make_unique<gpu::Kernel>(context, perLightKernelDesc(name, spirv, bands))
+        perLight_(variants.perLight ? std::make_unique<gpu::Kernel>(context, perLightKernelDesc(name, spirv, s))
                                     : nullptr),
         probeReplay_(variants.replayKeptRays
-                         ? std::make_unique<gpu::Kernel>(context, replayingKeptRaysKernelDesc(probingKernelDesc(name, spirv, bands)))
+                         ? std::make_unique<gpu::Kernel>(context, replayingKeptRaysKernelDesc(probingKernelDesc(name, spirv, s)))
                          : nullptr) {}
 
   void bind(std::uint32_t band, const ShadingInputs& in) {

@@ -2,38 +2,44 @@
 
 namespace obscura::render {
 
-gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
-  auto bindings = sceneBindingKinds();
-  bindings.insert(bindings.end(), gpu::kShadingBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
-  return {.name = name, .spirv = spirv, .bindings = bindings, .pushConstantBytes = sizeof(gpu::ShadePush),
-          .setCount = bands};
+ShadingSpecialisation shadingSpecialisation(std::uint32_t bands, bool spatialSampling, std::uint32_t lightCapacity) {
+  return {.bands = bands, .flatLightSelection = spatialSampling && lightCapacity <= gpu::kMaxSpatialLights};
 }
 
-gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
-  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
+gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
+  auto bindings = sceneBindingKinds();
+  bindings.insert(bindings.end(), gpu::kShadingBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
+  gpu::KernelDesc desc{.name = name, .spirv = spirv, .bindings = bindings, .pushConstantBytes = sizeof(gpu::ShadePush),
+                       .setCount = s.bands};
+  if (s.flatLightSelection) desc.specConstants.push_back({.id = gpu::kSpecConstantFlatLightSelection, .value = 1u});
+  return desc;
+}
+
+gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
+  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, s);
   desc.name += ".probe";
   desc.deferCompile = true; // edits only
   desc.specConstants.push_back({.id = gpu::kSpecConstantProbe, .value = 1u});
   return desc;
 }
 
-gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
-  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
+gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
+  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, s);
   desc.name += ".reflectors";
   desc.specConstants.push_back({.id = gpu::kSpecConstantReflectors, .value = 1u});
   return desc;
 }
 
-gpu::KernelDesc greyObscuranceKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
-  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
+gpu::KernelDesc greyObscuranceKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
+  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, s);
   desc.name += ".grey";
   desc.deferCompile = true; // renders without colour bleeding only
   desc.specConstants.push_back({.id = gpu::kSpecConstantGreyObscurance, .value = 1u});
   return desc;
 }
 
-gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands) {
-  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, bands);
+gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
+  gpu::KernelDesc desc = shadingKernelDesc(name, spirv, s);
   desc.name += ".perlight";
   desc.deferCompile = true; // added lights only (and per-light shadow sampling)
   desc.specConstants.push_back({.id = gpu::kSpecConstantPerLight, .value = 1u});

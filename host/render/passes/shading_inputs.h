@@ -22,17 +22,29 @@ struct ShadingInputs {
   const ObscuranceFrame& frame;
 };
 
+// What every shading kernel of a renderer is specialised for, whatever its variant.
+struct ShadingSpecialisation {
+  std::uint32_t bands = 1; // one descriptor set per band of the frame
+  // Lights chosen by the flat spatial selection alone (kSpecConstantFlatLightSelection): the
+  // render samples lights spatially and its frame holds at most kMaxSpatialLights lights.
+  bool flatLightSelection = false;
+};
+
+// The shading specialisation of a render: flat selection where it is the only one its dispatches
+// can take (spatial sampling, no more lights than kMaxSpatialLights, spare slots included).
+ShadingSpecialisation shadingSpecialisation(std::uint32_t bands, bool spatialSampling, std::uint32_t lightCapacity);
+
 // The kernel description every shading pass shares: scene bindings, then the shading bindings,
 // ShadePush, one descriptor set per band.
-gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s);
 // The same shader's probing variant (kSpecConstantProbe, lib/probe.glsl): "<name>.probe".
-gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s);
 // The variant with the secondary reflectors' code (kSpecConstantReflectors): "<name>.reflectors".
-gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s);
 // The obscurance variant without colour bleeding (kSpecConstantGreyObscurance): "<name>.grey".
-gpu::KernelDesc greyObscuranceKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+gpu::KernelDesc greyObscuranceKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s);
 // The variant for one light alone (kSpecConstantPerLight): "<name>.perlight".
-gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, std::uint32_t bands);
+gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s);
 // The same shader's variant (of the per-light or probing one) that follows the frame's kept rays
 // instead of tracing or drawing them (kSpecConstantReplayRays): "<desc.name>.replay".
 gpu::KernelDesc replayingKeptRaysKernelDesc(gpu::KernelDesc desc);

@@ -4,7 +4,7 @@
 
 namespace obscura::render {
 
-ShadowPass::ShadowPass(const gpu::Context& context, std::uint32_t bands)
-    : PixelShadingPass(context, "shadow", kSpirv_shadow, bands, {.perLight = true, .replayKeptRays = true}) {}
+ShadowPass::ShadowPass(const gpu::Context& context, const ShadingSpecialisation& s)
+    : PixelShadingPass(context, "shadow", kSpirv_shadow, s, {.perLight = true, .replayKeptRays = true}) {}
 
 } // namespace obscura::render

@@ -7,7 +7,7 @@ namespace obscura::render {
 
 class ShadowPass : public PixelShadingPass {
 public:
-  ShadowPass(const gpu::Context& context, std::uint32_t bands);
+  ShadowPass(const gpu::Context& context, const ShadingSpecialisation& s);
 };
 
 } // namespace obscura::render

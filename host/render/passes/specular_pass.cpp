@@ -8,13 +8,13 @@
 
 namespace obscura::render {
 
-SpecularPass::SpecularPass(const gpu::Context& context, std::uint32_t bands)
-    : queue_(context, shadingKernelDesc("specular.queue", kSpirv_specular_queue, bands)),
-      paths_(context, shadingKernelDesc("specular", kSpirv_specular, bands)),
-      probe_(context, probingKernelDesc("specular", kSpirv_specular, bands)),
-      perLight_(context, perLightKernelDesc("specular", kSpirv_specular, bands)),
-      probeReplay_(context, replayingKeptRaysKernelDesc(probingKernelDesc("specular", kSpirv_specular, bands))),
-      perLightReplay_(context, replayingKeptRaysKernelDesc(perLightKernelDesc("specular", kSpirv_specular, bands))) {}
+SpecularPass::SpecularPass(const gpu::Context& context, const ShadingSpecialisation& s)
+    : queue_(context, shadingKernelDesc("specular.queue", kSpirv_specular_queue, s)),
+      paths_(context, shadingKernelDesc("specular", kSpirv_specular, s)),
+      probe_(context, probingKernelDesc("specular", kSpirv_specular, s)),
+      perLight_(context, perLightKernelDesc("specular", kSpirv_specular, s)),
+      probeReplay_(context, replayingKeptRaysKernelDesc(probingKernelDesc("specular", kSpirv_specular, s))),
+      perLightReplay_(context, replayingKeptRaysKernelDesc(perLightKernelDesc("specular", kSpirv_specular, s))) {}
 
 void SpecularPass::bind(std::uint32_t band, const ShadingInputs& in) {
   bindShadingInputs(queue_, band, in);

@@ -9,7 +9,7 @@ namespace obscura::render {
 
 class SpecularPass {
 public:
-  SpecularPass(const gpu::Context& context, std::uint32_t bands);
+  SpecularPass(const gpu::Context& context, const ShadingSpecialisation& s);
 
   void bind(std::uint32_t band, const ShadingInputs& in);
   // Compiles now the kernels only edits dispatch (deferred: KernelDesc::deferCompile): those
