@@ -157,6 +157,39 @@ PassItems fetchPassItems(inout uint triangleBase, inout uint triangleBits, inout
   return it;
 }
 
+// The pass's triangle test: true when it found a nearer hit (closest) or any hit within tmax
+// (anyHit), which `hit` then holds; an any-hit ray is done there.
+bool testPassTriangle(PassItems it, WatertightRay wr, float tmin, float tmax, bool anyHit, inout RayHit hit) {
+  float t, u, v;
+  if (!intersectTriangle(wr, it.p0.xyz, it.p1.xyz, it.p2.xyz, tmin, hit.t, t, u, v)) return false;
+  uint primitive = floatBitsToUint(it.p0.w);
+  if (!(anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive))) return false;
+  hit.t = t;
+  hit.u = u;
+  hit.v = v;
+  hit.primitive = primitive;
+  hit.item = it.triangle;
+  return true;
+}
+
+// The pass's node visit: the node leaves the node group, and its leaf triangles hit become the
+// triangle group (or the queued one behind it). Returns the node group of its interior children
+// hit (none where y & 0xFF is 0); pushing what is left of `group` is the caller's (its stack).
+uvec2 visitPassNode(PassItems it, inout uvec2 group, inout uint triangleBase, inout uint triangleBits,
+                    inout uint queuedBase, inout uint queuedBits, vec3 origin, vec3 invDir, bvec3 negative,
+                    uint octant, float tmin, float tmax) {
+  group.y &= ~it.bit;
+  NodeVisit visit = visitNode(it.n0, it.n1, it.n2, it.n3, it.n4, origin, invDir, negative, octant, tmin, tmax);
+  if (triangleBits == 0u) {
+    triangleBase = visit.triangleBase;
+    triangleBits = visit.triangleBits;
+  } else {
+    queuedBase = visit.triangleBase;
+    queuedBits = visit.triangleBits;
+  }
+  return visit.group;
+}
+
 // The register stack: entries e0 (top) .. e7 as (s0.xy, s0.zw, s1.xy, ..., s3.zw); a push or a pop
 // shifts them all (vector selects; an indexed array would be a per-lane gather on lavapipe).
 void pushRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uvec4 s3, uvec2 entry) {
@@ -222,31 +255,11 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     }
     hit.steps++;
     PassItems it = fetchPassItems(triangleBase, triangleBits, queuedBase, queuedBits, group, octant);
-    if (it.onTriangle) {
-      float t, u, v;
-      if (intersectTriangle(wr, it.p0.xyz, it.p1.xyz, it.p2.xyz, tmin, hit.t, t, u, v)) {
-        uint primitive = floatBitsToUint(it.p0.w);
-        if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
-          hit.t = t;
-          hit.u = u;
-          hit.v = v;
-          hit.primitive = primitive;
-          hit.item = it.triangle;
-          if (anyHit) break;
-        }
-      }
-    }
+    if (it.onTriangle && testPassTriangle(it, wr, tmin, tmax, anyHit, hit) && anyHit) break;
     if (it.onNode) {
-      group.y &= ~it.bit;
-      NodeVisit visit = visitNode(it.n0, it.n1, it.n2, it.n3, it.n4, origin, invDir, negative, octant, tmin, hit.t);
-      if (triangleBits == 0u) {
-        triangleBase = visit.triangleBase;
-        triangleBits = visit.triangleBits;
-      } else {
-        queuedBase = visit.triangleBase;
-        queuedBits = visit.triangleBits;
-      }
-      if ((visit.group.y & 0xFFu) != 0u) {
+      uvec2 children = visitPassNode(it, group, triangleBase, triangleBits, queuedBase, queuedBits, origin, invDir,
+                                     negative, octant, tmin, hit.t);
+      if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
           if (stackSize == kBvhRegisterStack) {
             overflow = true; // finished by the second loop
@@ -255,7 +268,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
           pushRegisterStack(s0, s1, s2, s3, group);
           stackSize++;
         }
-        group = visit.group;
+        group = children;
       }
     }
     if ((group.y & 0xFFu) == 0u) {
@@ -268,11 +281,11 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     }
   }
 
-  // The second loop repeats the first one's pass with an array stack (the body is written twice
-  // on purpose: a function for the common pass measured 15 % slower on lavapipe with the binary
-  // BVH). lavapipe's loop limiter counts the passes of both loops of the 8-lane group, which
-  // ran the first loop for as many passes as its longest ray: an overflowed ray continues
-  // counting from there, so the group stays within kMaxTraversalSteps passes in total.
+  // The second loop repeats the first one's pass (the same fetchPassItems, testPassTriangle and
+  // visitPassNode) with an array stack; only the push and pop sites differ. lavapipe's loop
+  // limiter counts the passes of both loops of the 8-lane group, which ran the first loop for as
+  // many passes as its longest ray: an overflowed ray continues counting from there, so the
+  // group stays within kMaxTraversalSteps passes in total.
   uint groupSteps = subgroupMax(hit.steps);
   if (overflow) hit.steps = groupSteps;
   uvec2 stack[kBvhStackSize];
@@ -287,33 +300,13 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     }
     hit.steps++;
     PassItems it = fetchPassItems(triangleBase, triangleBits, queuedBase, queuedBits, group, octant);
-    if (it.onTriangle) {
-      float t, u, v;
-      if (intersectTriangle(wr, it.p0.xyz, it.p1.xyz, it.p2.xyz, tmin, hit.t, t, u, v)) {
-        uint primitive = floatBitsToUint(it.p0.w);
-        if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
-          hit.t = t;
-          hit.u = u;
-          hit.v = v;
-          hit.primitive = primitive;
-          hit.item = it.triangle;
-          if (anyHit) break;
-        }
-      }
-    }
+    if (it.onTriangle && testPassTriangle(it, wr, tmin, tmax, anyHit, hit) && anyHit) break;
     if (it.onNode) {
-      group.y &= ~it.bit;
-      NodeVisit visit = visitNode(it.n0, it.n1, it.n2, it.n3, it.n4, origin, invDir, negative, octant, tmin, hit.t);
-      if (triangleBits == 0u) {
-        triangleBase = visit.triangleBase;
-        triangleBits = visit.triangleBits;
-      } else {
-        queuedBase = visit.triangleBase;
-        queuedBits = visit.triangleBits;
-      }
-      if ((visit.group.y & 0xFFu) != 0u) {
+      uvec2 children = visitPassNode(it, group, triangleBase, triangleBits, queuedBase, queuedBits, origin, invDir,
+                                     negative, octant, tmin, hit.t);
+      if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) stack[stackSize++] = group; // the push site
-        group = visit.group;
+        group = children;
       }
     }
     if ((group.y & 0xFFu) == 0u) {

@@ -67,39 +67,18 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       hit.steps++;
     }
     PassItems it = fetchPassItems(triangleBase, triangleBits, queuedBase, queuedBits, group, octant);
-    bool done = false;
-    if (it.onTriangle) {
-      float t, u, v;
-      if (intersectTriangle(wr, it.p0.xyz, it.p1.xyz, it.p2.xyz, tmin, hit.t, t, u, v)) {
-        uint primitive = floatBitsToUint(it.p0.w);
-        if (anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive)) {
-          hit.t = t;
-          hit.u = u;
-          hit.v = v;
-          hit.primitive = primitive;
-          hit.item = it.triangle;
-          done = anyHit;
-        }
-      }
-    }
+    bool done = it.onTriangle && testPassTriangle(it, wr, tmin, tmax, anyHit, hit) && anyHit;
     bool overflow = false;
     if (it.onNode && !done) {
-      group.y &= ~it.bit;
-      NodeVisit visit = visitNode(it.n0, it.n1, it.n2, it.n3, it.n4, origin, invDir, negative, octant, tmin, hit.t);
-      if (triangleBits == 0u) {
-        triangleBase = visit.triangleBase;
-        triangleBits = visit.triangleBits;
-      } else {
-        queuedBase = visit.triangleBase;
-        queuedBits = visit.triangleBits;
-      }
-      if ((visit.group.y & 0xFFu) != 0u) {
+      uvec2 children = visitPassNode(it, group, triangleBase, triangleBits, queuedBase, queuedBits, origin, invDir,
+                                     negative, octant, tmin, hit.t);
+      if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
           overflow = stackSize == kBvhRegisterStack;
           pushRegisterStack(s0, s1, s2, s3, group);
           stackSize++;
         }
-        group = visit.group;
+        group = children;
       }
     }
     if ((group.y & 0xFFu) == 0u) {
