@@ -66,7 +66,7 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
     timestamps_.begin(cmd, label);
     for (std::uint32_t first = 0; first < n; first += raysPerDispatch) {
       std::uint32_t count = std::min(raysPerDispatch, n - first);
-      gpu::TracePush push{.params = glm::uvec4(n, static_cast<std::uint32_t>(mode), recordSteps ? 1u : 0u, first)};
+      gpu::TracePush push{.params = glm::uvec4(n, static_cast<std::uint32_t>(mode), 0u, first)};
       kernel.dispatch(cmd, gpu::groupsFor(count, gpu::kTraceWorkgroupSize * gpu::kTraceRaysPerLane), 1, 1, &push);
     }
     timestamps_.end(cmd, label);

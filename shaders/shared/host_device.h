@@ -251,7 +251,7 @@ static_assert(kTraceWorkgroupSize * kTraceRaysPerLane * 12 <= 32768, "trace.comp
 static_assert(kTraceWorkgroupSize % 8 == 0, "lavapipe runs 8 invocations per SIMD group");
 #endif
 struct TracePush {
-  uvec4 params; // 0: ray count, mode (0 closest, 1 any), record steps (0/1), first ray index
+  uvec4 params; // 0: ray count, mode (0 closest, 1 any), unused (steps: kSpecConstantTraceSteps), first ray index
 };              // 16 bytes
 
 // ---- Descriptor bindings (set 0) shared by every pass that traces rays.
