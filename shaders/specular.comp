@@ -84,7 +84,7 @@ struct PathState {
 };
 
 // The pass's constants, from the push constants.
-struct SpecularPass {
+struct SpecularConstants {
   uint pixelCount;
   uint lightCount;
   uint shadowRays;
@@ -99,8 +99,8 @@ struct SpecularPass {
   bool keepRays;
 };
 
-SpecularPass specularPass() {
-  SpecularPass c;
+SpecularConstants specularConstants() {
+  SpecularConstants c;
   c.pixelCount = pc.frame.x * pc.band.y;
   c.lightCount = pc.counts.x;
   c.shadowRays = c.lightCount > 0u ? pc.counts.y : 0u;
@@ -131,7 +131,7 @@ PathState startPath(uint pixel) {
 // The path's vertex at `depth`: its lobe ray from the previous vertex, the emitter it may see,
 // then direct light and obscurance gathered there. False when the path ends (no lobe sample, a
 // miss, a probe that met a box); `rays` counts the rays traced.
-bool followVertex(SpecularPass c, inout PathState path, uint depth, inout StepBudget budget, inout uint rays) {
+bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout StepBudget budget, inout uint rays) {
   const uint pixel = path.pixel;
   ShadingPoint sp = path.sp;
   vec3 t, b;
@@ -224,7 +224,7 @@ bool followVertex(SpecularPass c, inout PathState path, uint depth, inout StepBu
 }
 
 // A path that has ended: the box of its vertices for dirty.comp, a probe's verdict, a truncation.
-void finishPath(SpecularPass c, PathState path) {
+void finishPath(SpecularConstants c, PathState path) {
   const uint pixel = path.pixel;
   if (!c.oneLight && !kProbe) {
     vec4 lo = hitBounds[2u * pixel], hi = hitBounds[2u * pixel + 1u];
@@ -271,7 +271,7 @@ PathState loadPath(uint pixel) {
 void main() {
   gSceneScale = pc.eye.w;
   gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
-  const SpecularPass c = specularPass();
+  const SpecularConstants c = specularConstants();
   const uint depth = uint(pc.rAve.w);
   const uint queued = specularQueueBase(depth, c.pixelCount);
   const uint entry = gl_GlobalInvocationID.x;
