@@ -178,7 +178,9 @@ struct PassesRun {
 
 const char* benchKindOf(const std::string& pass) { return pass == "shadow" ? "shadow" : "closest"; }
 
-// --frame: one size of the obscurance-only frame, by Obscura and by Embree.
+#ifdef OBSCURA_HAVE_EMBREE
+// --frame: one size of the obscurance-only frame, by Obscura and by Embree (a build without
+// Embree refuses --frame before it gets here).
 struct FrameRun {
   glm::uvec2 size{0};
   render::ObscuraFrameResult ours;
@@ -201,9 +203,7 @@ FrameRun runFrame(const BenchOptions& o, const gpu::Context& context, const Load
   work.camera = render::gpuCamera(camera, size.x, size.y);
   work.sceneScale = render::sceneScale(loaded.scene.bounds);
   run.ours = render::runObscuraFrame(context, loaded.scene, loaded.bvh, camera, work, o.repeats);
-#ifdef OBSCURA_HAVE_EMBREE
   run.embree = render::runEmbreeFrame(loaded.scene, work, o.repeats);
-#endif
   // The same work on both sides: every camera ray, and N_obs rays per hit (the hits may differ at
   // a few silhouette pixels: Embree's triangle test is not watertight, ours is).
   if (run.ours.primaryRays != run.embree.primaryRays)
@@ -215,6 +215,7 @@ FrameRun runFrame(const BenchOptions& o, const gpu::Context& context, const Load
                                   size.x, size.y, run.ours.obscuranceRays, run.embree.obscuranceRays));
   return run;
 }
+#endif
 
 nlohmann::json passesJson(const PassesRun& p, double closestMrays, double shadowMrays) {
   nlohmann::json passes = nlohmann::json::object();
@@ -233,6 +234,7 @@ nlohmann::json passesJson(const PassesRun& p, double closestMrays, double shadow
           {"gpu_ms", render::totalGpuMs(p.stats)}, {"per_pass", passes}};
 }
 
+#ifdef OBSCURA_HAVE_EMBREE
 nlohmann::json frameJson(const BenchOptions& o, const FrameRun& f) {
   return {{"width", f.size.x}, {"height", f.size.y}, {"spp", o.frameWork.spp},
           {"obscurance_rays_per_hit", o.frameWork.obscuranceRays}, {"dmax", o.frameWork.dMax},
@@ -249,6 +251,7 @@ nlohmann::json frameJson(const BenchOptions& o, const FrameRun& f) {
           {"ratio_vs_embree", f.embree.bestMs / f.ours.bestMs},
           {"cpu_ratio_vs_embree", f.embree.bestCpuMs / f.ours.bestCpuMs}};
 }
+#endif
 
 void printPasses(const PassesRun& p, double closestMrays, double shadowMrays) {
   const render::ObscuranceSettings budget; // the paper's budget is the defaults
@@ -271,6 +274,7 @@ void printPasses(const PassesRun& p, double closestMrays, double shadowMrays) {
   }
 }
 
+#ifdef OBSCURA_HAVE_EMBREE
 void printFrame(const BenchOptions& o, const FrameRun& f) {
   fmt::print("frame {}x{}: obscurance only, {} spp x {} rays, dmax {} (best of {})\n", f.size.x, f.size.y,
              o.frameWork.spp, o.frameWork.obscuranceRays, o.frameWork.dMax, o.repeats);
@@ -285,6 +289,7 @@ void printFrame(const BenchOptions& o, const FrameRun& f) {
   fmt::print("  ours / embree = {:.3f} (by CPU time {:.3f})\n", f.embree.bestMs / f.ours.bestMs,
              f.embree.bestCpuMs / f.ours.bestCpuMs);
 }
+#endif
 
 void runBench(const BenchOptions& o) {
   if (o.rays == 0) throw InputError("--rays must be at least 1");
@@ -324,8 +329,10 @@ void runBench(const BenchOptions& o) {
   if (passesSize)
     passes = PassesRun{*passesSize, render::renderPaperBudget(context, loaded.scene, loaded.bvh, camera, passesSize->x,
                                                               passesSize->y, o.repeats)};
+#ifdef OBSCURA_HAVE_EMBREE
   std::vector<FrameRun> frames;
   for (glm::uvec2 size : frameSizes) frames.push_back(runFrame(o, context, loaded, camera, size));
+#endif
   std::vector<render::LaneOrderFigures> lanes;
   if (lanesSize) {
     render::ObscuranceFrameWork work = o.frameWork;
@@ -383,7 +390,9 @@ void runBench(const BenchOptions& o) {
       j["shadow_cpu_ratio_vs_embree"] = base->shadowCpuMs / shadow.bestCpuMs;
     }
     if (passes) j["passes"] = passesJson(*passes, closestMrays, shadowMrays);
+#ifdef OBSCURA_HAVE_EMBREE
     for (const FrameRun& f : frames) j["frames"].push_back(frameJson(o, f));
+#endif
     for (const auto& l : lanes)
       j["lanes"].push_back({{"order", l.name}, {"rays", l.rays}, {"mean_steps", l.meanSteps},
                             {"group_steps", l.groupSteps}, {"utilisation", l.utilisation()}, {"gpu_ms", l.gpuMs}});
@@ -412,7 +421,9 @@ void runBench(const BenchOptions& o) {
                  base->shadowCpuMs / shadow.bestCpuMs);
     }
     if (passes) printPasses(*passes, closestMrays, shadowMrays);
+#ifdef OBSCURA_HAVE_EMBREE
     for (const FrameRun& f : frames) printFrame(o, f);
+#endif
     if (lanesSize)
       fmt::print("lanes: sample 0 of the obscurance-only frame at {}x{}, traced by trace.comp in each order\n",
                  lanesSize->x, lanesSize->y);

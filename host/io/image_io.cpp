@@ -6,10 +6,14 @@
 #include <system_error>
 #include <unistd.h>
 
+#ifdef OBSCURA_HAVE_OPENIMAGEIO
 #include <OpenImageIO/imageio.h>
+#endif
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "io/exr_writer.h"
+#include "io/stb_codec.h"
 
 namespace obscura::io {
 namespace fs = std::filesystem;
@@ -51,6 +55,7 @@ void writeAtomically(const std::string& path, WriteFn&& write) {
   }
 }
 
+#ifdef OBSCURA_HAVE_OPENIMAGEIO
 void writeWithOiio(const std::string& path, const std::string& shownPath, const OIIO::ImageSpec& spec,
                    OIIO::TypeDesc type, const void* data) {
   auto out = OIIO::ImageOutput::create(path);
@@ -58,6 +63,7 @@ void writeWithOiio(const std::string& path, const std::string& shownPath, const 
   if (!out->open(path, spec) || !out->write_image(type, data) || !out->close())
     throw InputError(fmt::format("{}: cannot write: {}", shownPath, out->geterror()));
 }
+#endif
 
 } // namespace
 
@@ -84,19 +90,20 @@ void writePngRgba8(const std::string& path, int width, int height, const std::ve
   std::vector<unsigned char> rgb(std::size_t(width) * height * 3);
   for (std::size_t i = 0; i < rgb.size() / 3; ++i)
     for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = static_cast<unsigned char>((rgba[i] >> (8 * c)) & 0xFFu);
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  writeAtomically(path, [&](const std::string& temp) {
-    writeWithOiio(temp, path, spec, OIIO::TypeDesc::UINT8, rgb.data());
-  });
+  writeAtomically(path, [&](const std::string& temp) { writePngWithStb(temp, path, width, height, 3, rgb.data()); });
 }
 
 void writeExr(const std::string& path, const Image& image) {
+#ifndef OBSCURA_HAVE_OPENIMAGEIO
+  writeAtomically(path, [&](const std::string& temp) { writeUncompressedExr(temp, path, image); });
+#else
   OIIO::ImageSpec spec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT);
   spec.channelnames = image.channels;
   spec.attribute("compression", "zip");
   writeAtomically(path, [&](const std::string& temp) {
     writeWithOiio(temp, path, spec, OIIO::TypeDesc::FLOAT, image.pixels.data());
   });
+#endif
 }
 
 std::vector<std::uint32_t> encodeRgba8(const Image& image, int firstChannel, float exposure, int count) {
@@ -119,6 +126,11 @@ void writePng(const std::string& path, const Image& image, int firstChannel, flo
 }
 
 Image readImage(const std::string& path) {
+#ifndef OBSCURA_HAVE_OPENIMAGEIO
+  if (extensionOf(path) == "exr")
+    throw InputError(fmt::format("{}: cannot read EXR: this build has no OpenImageIO", path));
+  return readImageWithStb(path);
+#else
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw InputError(fmt::format("{}: cannot read image: {}", path, OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
@@ -131,6 +143,7 @@ Image readImage(const std::string& path) {
     throw InputError(fmt::format("{}: cannot read image: {}", path, in->geterror()));
   in->close();
   return image;
+#endif
 }
 
 } // namespace obscura::io

@@ -1,4 +1,6 @@
-// image_io.h — images in and out through OpenImageIO.
+// image_io.h — images in and out: EXR and reading through OpenImageIO, PNG written through stb
+// (io/stb_codec.h). A build without OpenImageIO (-DOBSCURA_WITH_OPENIMAGEIO=OFF) reads through
+// stb (no EXR) and writes uncompressed EXR (io/exr_writer.h).
 //
 // EXR holds linear radiance and every AOV as channel layers ("albedo.R", "depth.Z", …). PNG is
 // for viewing only: exposure, then the sRGB curve, 8 bits [SPEC §5]. Files are written to a
@@ -29,7 +31,7 @@ void writePng(const std::string& path, const Image& image, int firstChannel = 0,
               int count = 3);
 // The pixels writePng writes, packed RGBA8 (R in the low byte, alpha 255), as the window shows them.
 std::vector<std::uint32_t> encodeRgba8(const Image& image, int firstChannel = 0, float exposure = 0.0f, int count = 3);
-// Reads any image OpenImageIO reads (linear floats as stored; PNG values / 255, no decoding).
+// Reads any image OpenImageIO reads (without it: what stb reads) (linear floats as stored; PNG values / 255, no decoding).
 Image readImage(const std::string& path);
 
 // Appends `from`'s channels to `to` (same size; InputError otherwise).

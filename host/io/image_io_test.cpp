@@ -1,0 +1,92 @@
+// PNG goes out through stb in every build and comes back through OpenImageIO where the build has
+// it, through stb where it does not: both readers must see the same file the same way.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include <fmt/core.h>
+#include <vector>
+
+#include "core/error.h"
+#include "io/image_io.h"
+#include "io/exr_writer.h"
+#include "io/stb_codec.h"
+
+namespace obscura::io {
+namespace {
+namespace fs = std::filesystem;
+
+TEST(ImageIo, PngWrittenThroughStbReadsBackTheSameThroughBothReaders) {
+  const int width = 7, height = 5; // odd sizes: no row padding hides an off-by-one
+  std::vector<std::uint32_t> rgba(std::size_t(width) * height);
+  for (std::size_t i = 0; i < rgba.size(); ++i)
+    rgba[i] = 0xFF000000u | std::uint32_t((i * 37) & 0xFF) | std::uint32_t((i * 11 + 3) & 0xFF) << 8 |
+              std::uint32_t(255 - (i * 5 & 0xFF)) << 16;
+  const fs::path path = fs::temp_directory_path() / fmt::format("obscura-image-io-{}.png", ::getpid());
+  writePngRgba8(path.string(), width, height, rgba);
+
+  const Image viaStb = readImageWithStb(path.string());
+  const Image viaReader = readImage(path.string()); // OpenImageIO in the default build
+  fs::remove(path);
+  for (const Image* image : {&viaStb, &viaReader}) {
+    ASSERT_EQ(image->width, width);
+    ASSERT_EQ(image->height, height);
+    ASSERT_EQ(image->channels, (std::vector<std::string>{"R", "G", "B"}));
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        for (int c = 0; c < 3; ++c)
+          // 1e-6: OpenImageIO scales by 1/255 rather than dividing; one 8-bit step is 3.9e-3.
+          ASSERT_NEAR(image->at(x, y, c), float((rgba[std::size_t(y) * width + x] >> (8 * c)) & 0xFFu) / 255.0f, 1e-6f)
+              << "pixel " << x << "," << y << " channel " << c;
+  }
+}
+
+TEST(ImageIo, UnreadableImageNamesTheFileThroughStb) {
+  const fs::path path = fs::temp_directory_path() / fmt::format("obscura-image-io-{}-bad.png", ::getpid());
+  { std::ofstream(path) << "not a png"; }
+  try {
+    readImageWithStb(path.string());
+    fs::remove(path);
+    FAIL() << "a text file read as an image";
+  } catch (const InputError& e) {
+    fs::remove(path);
+    EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+  }
+}
+
+// The writer of builds without OpenImageIO, read back by OpenImageIO (the default build's reader):
+// every channel by name, every value bit for bit, names out of order and one longer than 31
+// bytes (the long-names flag).
+TEST(ImageIo, UncompressedExrReadsBackBitForBitThroughOpenImageIo) {
+#ifndef OBSCURA_HAVE_OPENIMAGEIO
+  GTEST_SKIP() << "this build has no OpenImageIO to read the file back";
+#endif
+  Image image;
+  image.width = 5;
+  image.height = 3;
+  image.channels = {"R", "G", "B", "albedo.R", "depth.Z", "a.channel.name.longer.than.31.bytes"};
+  image.pixels.resize(std::size_t(image.width) * image.height * image.channels.size());
+  for (std::size_t i = 0; i < image.pixels.size(); ++i)
+    image.pixels[i] = (i % 3 == 0 ? -1.0f : 1.0f) * std::ldexp(float(i) + 0.1f, int(i % 7) - 3);
+  const fs::path path = fs::temp_directory_path() / fmt::format("obscura-image-io-{}.exr", ::getpid());
+  writeUncompressedExr(path.string(), path.string(), image);
+  const Image back = readImage(path.string());
+  fs::remove(path);
+  ASSERT_EQ(back.width, image.width);
+  ASSERT_EQ(back.height, image.height);
+  ASSERT_EQ(back.channelCount(), image.channelCount());
+  for (int c = 0; c < image.channelCount(); ++c) {
+    const int b = back.channelIndex(image.channels[c]);
+    ASSERT_GE(b, 0) << image.channels[c] << " is missing";
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        ASSERT_EQ(back.at(x, y, b), image.at(x, y, c)) << image.channels[c] << " at " << x << "," << y;
+  }
+}
+
+} // namespace
+} // namespace obscura::io

@@ -1,0 +1,73 @@
+#include "io/stb_codec.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+
+#include <fmt/core.h>
+
+#include "core/error.h"
+
+// stb's implementations, static so that they cannot clash with the copy of stb_image that the
+// glTF loader compiles for textures.
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STB_IMAGE_WRITE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wsign-conversion"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#pragma GCC diagnostic ignored "-Wtype-limits"
+#pragma GCC diagnostic ignored "-Wdouble-promotion"
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+#pragma GCC diagnostic pop
+
+namespace obscura::io {
+
+void writePngWithStb(const std::string& path, const std::string& shownPath, int width, int height, int channels,
+                     const unsigned char* pixels) {
+  if (width <= 0 || height <= 0 || channels < 1 || channels > 4)
+    throw InputError(fmt::format("{}: cannot write a {}x{} PNG of {} channels", shownPath, width, height, channels));
+  if (!stbi_write_png(path.c_str(), width, height, channels, pixels, width * channels))
+    throw InputError(fmt::format("{}: cannot write the PNG", shownPath));
+}
+
+Image readImageWithStb(const std::string& path) {
+  int width = 0, height = 0, channels = 0;
+  if (!stbi_info(path.c_str(), &width, &height, &channels))
+    throw InputError(fmt::format("{}: cannot read image: {}", path, stbi_failure_reason()));
+  Image image;
+  image.width = width;
+  image.height = height;
+  static const char* const kNames[4][4] = {{"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
+  image.channels.assign(kNames[channels - 1], kNames[channels - 1] + channels);
+  const std::size_t values = std::size_t(width) * height * channels;
+  image.pixels.resize(values);
+  int w = 0, h = 0, n = 0;
+  auto fail = [&] { return InputError(fmt::format("{}: cannot read image: {}", path, stbi_failure_reason())); };
+  if (stbi_is_hdr(path.c_str())) {
+    std::unique_ptr<float, void (*)(void*)> data(stbi_loadf(path.c_str(), &w, &h, &n, channels), stbi_image_free);
+    if (!data) throw fail();
+    std::copy_n(data.get(), values, image.pixels.begin());
+  } else if (stbi_is_16_bit(path.c_str())) {
+    std::unique_ptr<std::uint16_t, void (*)(void*)> data(stbi_load_16(path.c_str(), &w, &h, &n, channels),
+                                                         stbi_image_free);
+    if (!data) throw fail();
+    for (std::size_t i = 0; i < values; ++i) image.pixels[i] = float(data.get()[i]) / 65535.0f;
+  } else {
+    std::unique_ptr<unsigned char, void (*)(void*)> data(stbi_load(path.c_str(), &w, &h, &n, channels),
+                                                         stbi_image_free);
+    if (!data) throw fail();
+    for (std::size_t i = 0; i < values; ++i) image.pixels[i] = float(data.get()[i]) / 255.0f;
+  }
+  return image;
+}
+
+} // namespace obscura::io

@@ -1,0 +1,24 @@
+// stb_codec.h — images through stb (stb_image_write, stb_image), which every build has.
+//
+// PNG is always written through here. OpenImageIO stays the reader and the EXR writer where the
+// build has it (OBSCURA_WITH_OPENIMAGEIO, the default); a build without it (a machine lent for
+// GPU benchmarks, where OpenImageIO's ~400 MB of dependencies cannot travel) reads through here.
+#pragma once
+#include <string>
+
+#include "io/image_io.h"
+
+namespace obscura::io {
+
+// Writes `channels` (1-4) interleaved 8-bit values per pixel, rows top to bottom, as a PNG at
+// `path`. Throws InputError naming `shownPath` (the name the user gave; `path` may be a
+// temporary file beside it).
+void writePngWithStb(const std::string& path, const std::string& shownPath, int width, int height, int channels,
+                     const unsigned char* pixels);
+
+// Reads a PNG, JPEG, BMP, TGA or Radiance HDR as OpenImageIO does: values as stored (8- and 16-bit
+// formats divided by their maximum, no transfer curve undone), channels named as OpenImageIO names
+// them (Y, Y A, R G B, R G B A). Throws InputError naming the path.
+Image readImageWithStb(const std::string& path);
+
+} // namespace obscura::io

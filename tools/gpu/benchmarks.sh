@@ -1,0 +1,66 @@
+#!/bin/bash
+# benchmarks.sh BUNDLE_DIR OUT_DIR [quick] — the traversal and frame figures (issue: traversal and
+# frame speed) on whatever Vulkan device the bundle finds first by rank (a discrete GPU before a
+# CPU), in one run that fits a 15-minute device lease. BUNDLE_DIR comes from make_bundle.sh.
+# OUT_DIR gets log.txt (everything printed) and a few images and JSON files, at most 8 files.
+# "quick" shrinks every size so that the script itself can be tried on lavapipe first.
+#
+#   bench-rays, both scenes: closest-hit and shadow rays per second (16M random rays, the best of
+#     5 timed repeats, the first 100k checked against the CPU traversal), and on modern-hall the
+#     paper's budget at 800x600 per pass (--passes)
+#   render: the paper's budget (8 spp), modern-hall 800x600 and Sponza 1920x1080 under a uniform sky
+#     (Sponza has no lights), --metrics
+#   relight: modern-hall 800x600, 1 spp: a light's scale and colour, add and remove a point light,
+#     move an object, add an emissive quad (edits.jsonl: GPU and wall ms per edit)
+set -u
+bundle=$(cd "${1:?usage: benchmarks.sh BUNDLE_DIR OUT_DIR [quick]}" && pwd)
+out=${2:?usage: benchmarks.sh BUNDLE_DIR OUT_DIR [quick]}
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+quick=${3:-}
+obscura=$bundle/obscura
+scenes=$bundle/scenes
+export LD_LIBRARY_PATH=$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+rays=16777216 passes=800x600 hall=(800 600) sponza=(1920 1080) limit=150
+if [ "$quick" = quick ]; then rays=65536 passes=80x60 hall=(80 60) sponza=(96 54) limit=300; fi
+
+step() { # name command...: runs it under a time limit, everything into log.txt
+  local name=$1 start rc
+  shift
+  echo "==== $name: $*"
+  start=$(date +%s%N)
+  timeout "$limit" "$@" 2>&1
+  rc=$?
+  echo "==== $name: exit $rc after $((($(date +%s%N) - start) / 1000000)) ms"
+}
+
+{
+  echo "date $(date -u +%FT%TZ), $(uname -m), $(nproc) cores"
+  command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
+  ldd "$obscura" | grep 'not found' && echo "LIBRARIES MISSING"
+  step info "$obscura" info
+  step bench-hall "$obscura" bench-rays "$scenes/modern-hall/modern-hall.gltf" --rays "$rays" --repeats 5 \
+    --verify 100000 --passes "$passes"
+  step bench-sponza "$obscura" bench-rays "$scenes/sponza/sponza.gltf" --rays "$rays" --repeats 5 --verify 100000
+  step render-hall "$obscura" render "$scenes/modern-hall/modern-hall.gltf" --width "${hall[0]}" \
+    --height "${hall[1]}" --spp 8 -o "$out/modern-hall.png" --metrics "$out/modern-hall.metrics.json"
+  step render-sponza "$obscura" render "$scenes/sponza/sponza.gltf" --width "${sponza[0]}" --height "${sponza[1]}" \
+    --spp 8 --background 2,2,2 -o "$out/sponza.png" --metrics "$out/sponza.metrics.json"
+  cat > "$work/edits.json" <<'JSON'
+[{"light": "light_rectangle_6", "scale": 0.3},
+ {"light": "light_rectangle_6", "color": [1.0, 0.6, 0.3]},
+ {"add_light": {"type": "point", "name": "bench_bulb", "position": [0.0, 3.0, 1.0], "color": [1, 1, 1], "intensity": 5}},
+ {"remove_light": "bench_bulb"},
+ {"move": "Mesh017", "translate": [0.1, 0.0, 0.1]},
+ {"add_light": {"type": "quad", "name": "bench_panel", "corner": [0.0, 3.0, 1.0], "edge1": [0.5, 0, 0],
+                "edge2": [0, 0, 0.5], "emission": [4, 4, 4]}}]
+JSON
+  step relight-hall "$obscura" relight "$scenes/modern-hall/modern-hall.gltf" --edits "$work/edits.json" \
+    -o "$work/relight" --width "${hall[0]}" --height "${hall[1]}" --spp 1 --png
+  cat "$work/relight/edits.jsonl"
+  cp "$work/relight/frame-006.png" "$out/relight-last-frame.png"
+} > "$out/log.txt" 2>&1
+cat "$out/log.txt"
