@@ -12,6 +12,7 @@
 #     (Sponza has no lights), --metrics
 #   relight: modern-hall 800x600, 1 spp: a light's scale and colour, add and remove a point light,
 #     move an object, add an emissive quad (edits.jsonl: GPU and wall ms per edit)
+# STEP_LIMIT (seconds, default 150) bounds each step, so that a hang cannot eat the lease.
 set -u
 bundle=$(cd "${1:?usage: benchmarks.sh BUNDLE_DIR OUT_DIR [quick]}" && pwd)
 out=${2:?usage: benchmarks.sh BUNDLE_DIR OUT_DIR [quick]}
@@ -24,7 +25,7 @@ export LD_LIBRARY_PATH=$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-rays=16777216 passes=800x600 hall=(800 600) sponza=(1920 1080) limit=150
+rays=16777216 passes=800x600 hall=(800 600) sponza=(1920 1080) limit=${STEP_LIMIT:-150}
 if [ "$quick" = quick ]; then rays=65536 passes=80x60 hall=(80 60) sponza=(96 54) limit=300; fi
 
 step() { # name command...: runs it under a time limit, everything into log.txt
