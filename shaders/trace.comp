@@ -1,6 +1,7 @@
 #version 460
-// trace.comp — traces a buffer of rays (closest hit or any hit), kTraceRaysPerLane per invocation
-// through one refilling traversal loop (lib/bvh_stream.glsl). Used by `obscura bench-rays` and by
+// trace.comp — traces a buffer of rays (closest hit or any hit). On lavapipe kTraceRaysPerLane per
+// invocation through one refilling traversal loop (lib/bvh_stream.glsl); on a GPU one per
+// invocation (kRaysPerLane = 1, a specialisation constant). Used by `obscura bench-rays` and by
 // the traversal tests, so the benchmark measures the code tested.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
@@ -8,9 +9,10 @@
 #include "lib/intersect.glsl"
 #include "lib/bvh.glsl"
 
-layout(local_size_x = kTraceWorkgroupSize) in;
+layout(local_size_x = kTraceWorkgroupSize, local_size_x_id = kSpecConstantTraceWorkgroupSize) in;
 layout(push_constant) uniform Push { TracePush pc; };
 layout(constant_id = kSpecConstantTraceSteps) const bool kRecordSteps = false;
+layout(constant_id = kSpecConstantTraceRaysPerLane) const uint kRaysPerLane = kTraceRaysPerLane;
 // Texel views (host/bench/ray_tracer.cpp), which lavapipe reads and writes a texel per lane at a
 // time: ray i = texels 2i (origin, tmin) and 2i + 1 (direction, tmax); hit i = one texel
 // (t, u, v, primitive bits); steps i = one texel.
@@ -22,7 +24,7 @@ layout(set = 0, binding = kBindingPassFirst + 2, r32ui) uniform writeonly uimage
 // rays that arrive in a coherent order are traced side by side.
 uint rayIndex(uint k) {
   uint g = gl_GlobalInvocationID.x;
-  return pc.params.w + (g / 8u) * 8u * kTraceRaysPerLane + k * 8u + g % 8u;
+  return pc.params.w + (g / 8u) * 8u * kRaysPerLane + k * 8u + g % 8u;
 }
 
 GpuRay streamRay(uint k) {
@@ -34,10 +36,10 @@ GpuRay streamRay(uint k) {
 // t and the triangle's texel: a texel store inside the loop costs every pass a loop over the
 // lanes (Sponza 1.2x slower), and the barycentrics are found again afterwards (storedHit),
 // which leaves their two divisions out of the loop.
-shared uvec2 sHits[kTraceWorkgroupSize * kTraceRaysPerLane];
-shared uint sSteps[kTraceWorkgroupSize * kTraceRaysPerLane];
+shared uvec2 sHits[gl_WorkGroupSize.x * kRaysPerLane];
+shared uint sSteps[gl_WorkGroupSize.x * kRaysPerLane];
 
-uint hitSlot(uint k) { return gl_LocalInvocationID.x * kTraceRaysPerLane + k; }
+uint hitSlot(uint k) { return gl_LocalInvocationID.x * kRaysPerLane + k; }
 
 void streamHit(uint k, RayHit h) {
   sHits[hitSlot(k)] = uvec2(floatBitsToUint(h.t), h.primitive == kTruncatedHit ? kTruncatedHit : h.item);
@@ -47,8 +49,19 @@ void streamHit(uint k, RayHit h) {
 #include "lib/bvh_stream.glsl"
 
 void main() {
+  if (kRaysPerLane == 1u) { // a GPU's shape: the ray straight through traverseBvh
+    const uint i = rayIndex(0u);
+    if (i >= pc.params.x) return;
+    GpuRay ray = streamRay(0u);
+    RayHit h = traverseBvh(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, pc.params.y != 0u,
+                           kMaxTraversalSteps);
+    if (h.primitive == kTruncatedHit) atomicAdd(status[kStatusTruncated], 1u);
+    imageStore(hits, int(i), vec4(h.t, h.u, h.v, uintBitsToFloat(h.primitive)));
+    if (kRecordSteps) imageStore(steps, int(i), uvec4(h.steps));
+    return;
+  }
   uint count = 0u;
-  while (count < kTraceRaysPerLane && rayIndex(count) < pc.params.x) ++count;
+  while (count < kRaysPerLane && rayIndex(count) < pc.params.x) ++count;
   uint truncated = traverseStream(count, pc.params.y != 0u, kMaxTraversalSteps);
   if (truncated != 0u) atomicAdd(status[kStatusTruncated], truncated);
   for (uint k = 0u; k < count; ++k) {

@@ -27,6 +27,7 @@
 #include "bench/embree_frame.h"
 #endif
 #include "bench/cpu_time.h"
+#include "bench/hit_agreement.h"
 #include "bench/lane_order.h"
 #include "bench/pass_bench.h"
 #include "bench/ray_tracer.h"
@@ -85,7 +86,9 @@ struct SetResult {
   // (in trace.comp a lane's kTraceRaysPerLane rays together). Passes per ray as the groups run
   // them; meanSteps / it = lane utilisation.
   double meanGroupMaxSteps = 0.0;
-  std::size_t mismatches = 0;
+  std::size_t mismatches = 0;           // traversal errors (bench/hit_agreement.h)
+  std::size_t precisionDifferences = 0; // the other correct answer of a float-rounding-sensitive ray
+  std::vector<std::string> mismatchExamples; // the first few traversal errors, for the report
 };
 
 SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std::vector<gpu::GpuRay>& rays,
@@ -101,9 +104,10 @@ SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std
   }
   r.hitFraction = rays.empty() ? 0.0 : static_cast<double>(hits) / static_cast<double>(rays.size());
   r.meanSteps = rays.empty() ? 0.0 : steps / static_cast<double>(rays.size());
-  // What the 8-lane groups run: each lane traces kTraceRaysPerLane rays in one refilling loop
-  // (trace.comp), so a group runs as many passes as its busiest lane's rays take together.
-  constexpr std::size_t kLanes = 8, kBlock = kLanes * gpu::kTraceRaysPerLane;
+  // What lavapipe's 8-lane groups run: each lane traces its rays (the tracer's raysPerLane) in one
+  // refilling loop (trace.comp), so a group runs as many passes as its busiest lane's rays take.
+  constexpr std::size_t kLanes = 8;
+  const std::size_t kBlock = kLanes * tracer.shape().raysPerLane;
   double groupPasses = 0.0;
   for (std::size_t b = 0; b < rays.size(); b += kBlock) {
     std::array<std::uint64_t, kLanes> lane{};
@@ -125,13 +129,23 @@ SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std
   // Optional check of the first `verify` rays against the CPU reference traversal.
   for (std::size_t i = 0; i < std::min(o.verify, rays.size()); ++i) {
     bvh::Ray ray{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
-    bool gpuHit = first.hits[i].primitive != gpu::kInvalidIndex;
-    if (mode == render::TraceMode::Closest) {
-      bvh::Hit cpu = bvh::closestHit(loaded.bvh, ray);
-      if (cpu.primitive != first.hits[i].primitive) ++r.mismatches;
-    } else if (bvh::anyHit(loaded.bvh, ray) != gpuHit) {
-      ++r.mismatches;
+    render::HitAgreement agreement =
+        mode == render::TraceMode::Closest
+            ? render::closestHitAgreement(ray, bvh::closestHit(loaded.bvh, ray), first.hits[i])
+            : render::anyHitAgreement(ray, bvh::anyHit(loaded.bvh, ray), bvh::closestHit(loaded.bvh, ray),
+                                      first.hits[i]);
+    if (agreement == render::HitAgreement::Different && ++r.mismatches <= 5) {
+      const bvh::Hit cpu = bvh::closestHit(loaded.bvh, ray);
+      const gpu::GpuHit& g = first.hits[i];
+      r.mismatchExamples.push_back(fmt::format(
+          "{} ray {}: origin ({}, {}, {}) direction ({}, {}, {}) t in ({}, {}); CPU closest t {} u {} v {} "
+          "triangle {}{}; GPU t {} u {} v {} triangle {}",
+          mode == render::TraceMode::Closest ? "closest" : "shadow", i, ray.origin.x, ray.origin.y, ray.origin.z,
+          ray.direction.x, ray.direction.y, ray.direction.z, ray.tmin, ray.tmax, cpu.t, cpu.u, cpu.v, cpu.primitive,
+          mode == render::TraceMode::Any ? fmt::format(" (occluded: {})", bvh::anyHit(loaded.bvh, ray)) : "", g.t,
+          g.u, g.v, g.primitive));
     }
+    if (agreement == render::HitAgreement::WithinPrecision) ++r.precisionDifferences;
   }
   return r;
 }
@@ -372,7 +386,8 @@ void runBench(const BenchOptions& o) {
                         {"shadow_mean_steps", shadow.meanSteps},
                         {"shadow_mean_group_max_steps", shadow.meanGroupMaxSteps},
                         {"verified", o.verify},
-                        {"mismatches", closest.mismatches + shadow.mismatches}};
+                        {"mismatches", closest.mismatches + shadow.mismatches},
+                        {"float_precision_differences", closest.precisionDifferences + shadow.precisionDifferences}};
     if (base) {
       j["baseline"] = o.baseline;
       j["embree_threads"] = base->threads;
@@ -407,8 +422,12 @@ void runBench(const BenchOptions& o) {
                shadowMrays, o.repeats, n / (shadow.medianMs * 1e3), shadow.hitFraction, shadow.meanSteps,
                shadow.meanGroupMaxSteps);
     if (o.verify)
-      fmt::print("verified the first {} rays of each set against the CPU: {} mismatches\n", o.verify,
-                 closest.mismatches + shadow.mismatches);
+      fmt::print("verified the first {} rays of each set against the CPU: {} mismatches ({} more differ only as float "
+                 "rounding may: a grazed edge, a tie in t, a hit at the ray's end)\n",
+                 o.verify, closest.mismatches + shadow.mismatches,
+                 closest.precisionDifferences + shadow.precisionDifferences);
+    for (const SetResult* set : {&closest, &shadow})
+      for (const std::string& example : set->mismatchExamples) fmt::print("  mismatch: {}\n", example);
     if (base) {
       fmt::print("embree {} threads: build {:.3f} s\n", base->threads, base->buildSeconds);
       fmt::print("  closest hit (a): {:8.2f} Mrays/s, hit fraction {:.3f}; ours / embree = {:.3f} "

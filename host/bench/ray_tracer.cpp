@@ -7,7 +7,7 @@
 namespace obscura::render {
 
 namespace {
-gpu::KernelDesc traceKernelDesc(bool recordSteps) {
+gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps) {
   auto bindings = sceneBindingKinds();
   // rays (two RGBA32F texels each), hits (one RGBA32F texel each), steps (R32UI): texel views,
   // which lavapipe reads and writes a texel per lane at a time (an SSBO: a word per lane at a time).
@@ -17,13 +17,20 @@ gpu::KernelDesc traceKernelDesc(bool recordSteps) {
           .spirv = kSpirv_trace,
           .bindings = bindings,
           .pushConstantBytes = sizeof(gpu::TracePush),
-          .specConstants = {{gpu::kSpecConstantTraceSteps, recordSteps ? 1u : 0u}},
+          .specConstants = {{gpu::kSpecConstantTraceSteps, recordSteps ? 1u : 0u},
+                            {gpu::kSpecConstantTraceRaysPerLane, shape.raysPerLane},
+                            {gpu::kSpecConstantTraceWorkgroupSize, shape.workgroupSize}},
           .deferCompile = recordSteps};
 }
 } // namespace
 
-RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene)
-    : context_(&context), kernel_(context, traceKernelDesc(false)), stepsKernel_(context, traceKernelDesc(true)),
+TraceShape TraceShape::forDevice(const gpu::Context& context) {
+  return context.info().type == "cpu" ? cpu() : gpu();
+}
+
+RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape)
+    : context_(&context), shape_(shape.value_or(TraceShape::forDevice(context))),
+      kernel_(context, traceKernelDesc(shape_, false)), stepsKernel_(context, traceKernelDesc(shape_, true)),
       timestamps_(context) {
   scene.bindTo(kernel_);
   scene.bindTo(stepsKernel_);
@@ -60,14 +67,15 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
 
   const std::string label = mode == TraceMode::Closest ? "trace.closest" : "trace.any";
   const std::uint32_t maxGroups = std::min(context_->info().maxComputeWorkGroupCount[0], 65535u);
-  const std::uint32_t raysPerDispatch = maxGroups * gpu::kTraceWorkgroupSize * gpu::kTraceRaysPerLane;
+  const std::uint32_t raysPerGroup = shape_.workgroupSize * shape_.raysPerLane;
+  const std::uint32_t raysPerDispatch = maxGroups * raysPerGroup;
   context_->submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
     timestamps_.begin(cmd, label);
     for (std::uint32_t first = 0; first < n; first += raysPerDispatch) {
       std::uint32_t count = std::min(raysPerDispatch, n - first);
       gpu::TracePush push{.params = glm::uvec4(n, static_cast<std::uint32_t>(mode), 0u, first)};
-      kernel.dispatch(cmd, gpu::groupsFor(count, gpu::kTraceWorkgroupSize * gpu::kTraceRaysPerLane), 1, 1, &push);
+      kernel.dispatch(cmd, gpu::groupsFor(count, raysPerGroup), 1, 1, &push);
     }
     timestamps_.end(cmd, label);
   });

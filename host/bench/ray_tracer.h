@@ -1,6 +1,7 @@
 // ray_tracer.h — traces a list of rays on the GPU with the production traversal (trace.comp).
 // Used by `obscura bench-rays` and the traversal tests, so the benchmark measures tested code.
 #pragma once
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -18,9 +19,21 @@ struct TraceResult {
   double gpuMs = 0.0;               // GPU time of the dispatches (timestamps), 0 if unavailable
 };
 
+// How trace.comp spreads rays over invocations (shared/host_device.h): lavapipe's refilling loop
+// of kTraceRaysPerLane rays per invocation, or a GPU's one ray per invocation.
+struct TraceShape {
+  std::uint32_t workgroupSize = gpu::kTraceWorkgroupSize;
+  std::uint32_t raysPerLane = gpu::kTraceRaysPerLane;
+  static TraceShape cpu() { return {}; }
+  static TraceShape gpu() { return {gpu::kTraceGpuWorkgroupSize, 1}; }
+  static TraceShape forDevice(const gpu::Context& context); // cpu() on a CPU device, gpu() otherwise
+};
+
 class RayTracer {
 public:
-  RayTracer(const gpu::Context& context, const SceneBuffers& scene);
+  // `shape` defaults to the device's (TraceShape::forDevice); a test may force either.
+  RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape = {});
+  const TraceShape& shape() const { return shape_; }
 
   TraceResult trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps = false);
 
@@ -28,6 +41,7 @@ private:
   TraceResult traceFitting(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps);
 
   const gpu::Context* context_;
+  TraceShape shape_;
   gpu::Kernel kernel_;      // the timed one
   gpu::Kernel stepsKernel_; // also records each ray's loop passes (compiled on first use)
   gpu::Timestamps timestamps_;

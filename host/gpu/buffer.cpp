@@ -24,18 +24,25 @@ Buffer::Buffer(const Context& context, vk::DeviceSize size, vk::BufferUsageFlags
   try {
     buffer_ = context.device().createBuffer({.size = size, .usage = usage | kTransfer});
     auto requirements = buffer_.getMemoryRequirements();
+    // Where the CPU can read the memory as fast as its own (host-cached: lavapipe's only memory
+    // type, integrated GPUs' shared memory), buffers are mapped and copied directly. Otherwise a
+    // device buffer takes plain device-local memory and its transfers go through a staging
+    // buffer: a discrete GPU's host-visible device memory (the PCIe BAR) is uncached for CPU
+    // reads (a 256 MB download took minutes on an H200) and, without resizable BAR, only 256 MB.
     constexpr auto kHost = vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent;
+    constexpr auto kHostCached = kHost | vk::MemoryPropertyFlagBits::eHostCached;
     std::uint32_t type =
         residence == Residence::Device
-            ? context.findMemoryType(requirements.memoryTypeBits, vk::MemoryPropertyFlagBits::eDeviceLocal, kHost)
-            : context.findMemoryType(requirements.memoryTypeBits, kHost);
+            ? context.findMemoryType(requirements.memoryTypeBits, vk::MemoryPropertyFlagBits::eDeviceLocal, kHostCached)
+            : context.findMemoryType(requirements.memoryTypeBits, kHost, kHostCached);
     memory_ = context.device().allocateMemory(
         {.allocationSize = requirements.size, .memoryTypeIndex = type});
     buffer_.bindMemory(*memory_, 0);
     auto flags = context.memoryTypeFlags(type);
-    if ((flags & vk::MemoryPropertyFlagBits::eHostVisible) &&
-        (flags & vk::MemoryPropertyFlagBits::eHostCoherent))
+    if ((flags & kHost) == kHost) {
       mapped_ = memory_.mapMemory(0, VK_WHOLE_SIZE);
+      hostCached_ = bool(flags & vk::MemoryPropertyFlagBits::eHostCached);
+    }
     gAllocatedBytes += requirements.size;
   } catch (const vk::OutOfDeviceMemoryError&) {
     throw DeviceError(fmt::format("out of device memory: buffer '{}' needs {:.1f} MiB", name,
@@ -70,7 +77,7 @@ void Buffer::download(const Context& context, void* data, vk::DeviceSize size,
   if (offset + size > size_)
     throw std::logic_error(fmt::format("download of {} bytes at {} overflows buffer '{}'", size,
                                        offset, name_));
-  if (mapped_) {
+  if (mapped_ && hostCached_) {
     std::memcpy(data, static_cast<const char*>(mapped_) + offset, size);
     return;
   }

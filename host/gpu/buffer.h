@@ -17,7 +17,8 @@
 
 namespace obscura::gpu {
 
-// Where a buffer lives: device-local (the default), or host-visible for staging.
+// Where a buffer lives: device-local (the default), or host-visible for staging (buffer.cpp says
+// which memory types each takes).
 enum class Residence { Device, Host };
 
 class Buffer {
@@ -56,6 +57,7 @@ private:
   vk::raii::Buffer buffer_ = nullptr;
   vk::DeviceSize size_ = 0;
   void* mapped_ = nullptr; // persistent mapping when the memory is host-visible
+  bool hostCached_ = false; // ...and cached, so that the CPU reads it at memory speed
   std::string name_;
 };
 

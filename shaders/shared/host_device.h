@@ -245,6 +245,11 @@ OBS_CONST uint kMaxEmissionSamples = 64u;
 // 48 KiB).
 OBS_CONST uint kTraceRaysPerLane = 64;
 OBS_CONST uint kTraceWorkgroupSize = 32;
+// ...and on a GPU (any device but a CPU; host/bench/ray_tracer.cpp): one ray per invocation, traced
+// directly by traverseBvh, in workgroups of 128. A GPU hides a lane's long ray behind other warps,
+// and trace.comp's lavapipe shape leaves an H200 at 0.25-0.34 Grays/s: 24 KiB of shared memory
+// per 32 invocations caps the warps an SM holds, and 16M rays are only 262k invocations.
+OBS_CONST uint kTraceGpuWorkgroupSize = 128;
 #ifdef __cplusplus
 static_assert(kTraceRaysPerLane <= 64, "traverseStream marks the rays it puts aside in a 64-bit mask");
 static_assert(kTraceWorkgroupSize * kTraceRaysPerLane * 12 <= 32768, "trace.comp's hits must fit shared memory");
@@ -372,6 +377,10 @@ OBS_CONST uint kSpecConstantGreyObscurance = 7u;
 // holds no more than kMaxSpatialLights lights (spares included); lavapipe otherwise runs the
 // unused selections masked for every light sample (5 % of the shadow pass).
 OBS_CONST uint kSpecConstantFlatLightSelection = 8u;
+// trace.comp's shape (kTraceRaysPerLane and kTraceWorkgroupSize above, or a GPU's: 1 and
+// kTraceGpuWorkgroupSize).
+OBS_CONST uint kSpecConstantTraceRaysPerLane = 9u;
+OBS_CONST uint kSpecConstantTraceWorkgroupSize = 10u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

@@ -6,6 +6,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <thread>
 
@@ -68,11 +69,12 @@ void expectAgreement(const Comparison& c, const char* what) {
 
 class GpuTraversal : public GpuTest {
 protected:
-  Comparison traceAndCompare(const scene::Scene& scene, std::size_t count, std::uint64_t seed) {
+  Comparison traceAndCompare(const scene::Scene& scene, std::size_t count, std::uint64_t seed,
+                             std::optional<render::TraceShape> shape = {}) {
     bvh::TriangleSoup soup = render::triangleSoup(scene);
     bvh::Bvh tree = bvh::build(soup);
     render::SceneBuffers buffers(context(), scene, tree);
-    render::RayTracer tracer(context(), buffers);
+    render::RayTracer tracer(context(), buffers, shape);
     auto rays = render::closestBenchRays(scene.bounds, count, seed);
     auto result = tracer.trace(rays, render::TraceMode::Closest);
     EXPECT_EQ(buffers.truncatedTraversals(), 0u);
@@ -110,6 +112,13 @@ TEST_F(GpuTraversal, CornellBoxMatchesBruteForce) {
 TEST_F(GpuTraversal, ModernHallMatchesBruteForce) {
   scene::Scene s = scene::loadGltf(sharedScene("modern-hall/modern-hall.gltf"));
   expectAgreement(traceAndCompare(s, 100000, 12), "modern-hall");
+}
+
+// The shape trace.comp takes on a GPU (one ray per invocation, workgroups of 128), run here on
+// lavapipe: the same answers as the brute force, like the refilling shape above.
+TEST_F(GpuTraversal, OneRayPerInvocationShapeMatchesBruteForce) {
+  scene::Scene soup = soupScene(randomSoup(3000, 1));
+  expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape::gpu()), "random soup, GPU shape");
 }
 
 TEST_F(GpuTraversal, ShadowRaysMatchCpuAnyHit) {

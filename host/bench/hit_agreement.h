@@ -1,0 +1,35 @@
+// hit_agreement.h — whether the GPU's answer for a ray is the CPU reference traversal's
+// (bench-rays --verify), and when it is not, whether the two differ only as two correct float
+// computations of the same test may.
+//
+// lavapipe runs the GLSL watertight test with the CPU's arithmetic, and the answers are identical.
+// A real GPU may contract a*b+c into one fma and divides to 2.5 ulp (the Vulkan spec's
+// precision), so a ray that grazes a triangle's edge, or meets two triangles at the same t (a
+// shared edge, coplanar overlaps), or ends on a surface, can get the other correct answer.
+// Anything else is a traversal error.
+#pragma once
+#include "bvh/bvh.h"
+#include "shared/host_device.h"
+
+namespace obscura::render {
+
+enum class HitAgreement {
+  Same,            // the same triangle (or both missed / both occluded)
+  WithinPrecision, // different, at an edge (smallest barycentric <= kEdgeBarycentric), a tie in t or at an end of the ray
+  Different,       // a traversal error
+};
+
+// The tolerances: far above a few ulp of float arithmetic, far below a triangle of a real scene.
+inline constexpr float kEdgeBarycentric = 1e-4f;
+inline constexpr float kRelativeT = 1e-5f;
+
+// A closest-hit ray: the CPU's bvh::closestHit against the GPU's hit.
+HitAgreement closestHitAgreement(const bvh::Ray& ray, const bvh::Hit& cpu, const gpu::GpuHit& gpu);
+
+// A shadow ray: the CPU's bvh::anyHit (occluded or not) against the GPU's; `cpuClosest` is the
+// CPU's closest hit on the same segment, whose barycentrics tell whether the CPU's occluder is
+// grazed when the GPU saw none.
+HitAgreement anyHitAgreement(const bvh::Ray& ray, bool cpuOccluded, const bvh::Hit& cpuClosest,
+                             const gpu::GpuHit& gpu);
+
+} // namespace obscura::render
