@@ -33,7 +33,7 @@ step() { # name command...: runs it under a time limit, everything into log.txt
   shift
   echo "==== $name: $*"
   start=$(date +%s%N)
-  timeout "$limit" "$@" 2>&1
+  timeout "$limit" stdbuf -oL -eL "$@" 2>&1
   rc=$?
   echo "==== $name: exit $rc after $((($(date +%s%N) - start) / 1000000)) ms"
 }
