@@ -51,6 +51,7 @@ struct BenchOptions {
   std::string passes;              // WxH: the paper's budget rendered, per pass
   std::vector<std::string> frames; // WxH each: the obscurance-only frame, Obscura against Embree
   std::string lanes;               // WxH: lane utilisation of that frame's rays in several orders
+  std::string traceShape;          // WxR: trace.comp's workgroup size and rays per invocation
   render::ObscuranceFrameWork frameWork; // its spp, rays per hit, dmax, seed
   DeviceOptions device;
 };
@@ -62,6 +63,24 @@ glm::uvec2 parseSize(const std::string& text, const char* option) {
   if (std::sscanf(text.c_str(), "%ux%u%c", &w, &h, &tail) != 2 || w == 0 || h == 0 || w > 16384 || h > 16384)
     throw InputError(fmt::format("{} {}: expected WIDTHxHEIGHT, e.g. 800x600 (1 to 16384 each)", option, text));
   return {w, h};
+}
+
+// --trace-shape WxR: trace.comp's workgroup size W (a multiple of 8, lavapipe's SIMD width) and
+// rays per invocation R (1 to kTraceRaysPerLane), for trying other shapes on a new device.
+render::TraceShape parseTraceShape(const std::string& text, const gpu::Context& context) {
+  unsigned w = 0, r = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%ux%u%c", &w, &r, &tail) != 2 || w == 0 || w % 8 != 0 || w > 1024 || r == 0 ||
+      r > gpu::kTraceRaysPerLane)
+    throw InputError(fmt::format("--trace-shape {}: expected WORKGROUPxRAYS, a workgroup of 8 to 1024 invocations "
+                                 "(a multiple of 8) and 1 to {} rays per invocation, e.g. 128x1",
+                                 text, gpu::kTraceRaysPerLane));
+  // trace.comp keeps 12 bytes of hit and steps per ray in shared memory.
+  if (w > context.info().maxComputeWorkGroupInvocations || std::size_t(w) * r * 12 > 32768)
+    throw InputError(fmt::format("--trace-shape {}: {} invocations of {} rays need {} bytes of shared memory "
+                                 "(at most 32768, and {} invocations)",
+                                 text, w, r, std::size_t(w) * r * 12, context.info().maxComputeWorkGroupInvocations));
+  return {w, r};
 }
 
 // Applies --move to the loaded scene and updates its BVH by refit or rebuild (traversal cost
@@ -328,7 +347,9 @@ void runBench(const BenchOptions& o) {
   if (!o.json) fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
 
   render::SceneBuffers buffers(context, loaded.scene, loaded.bvh);
-  render::RayTracer tracer(context, buffers);
+  std::optional<render::TraceShape> shape;
+  if (!o.traceShape.empty()) shape = parseTraceShape(o.traceShape, context);
+  render::RayTracer tracer(context, buffers, shape);
   auto closestRays = render::closestBenchRays(loaded.scene.bounds, o.rays, o.seed);
   auto shadowRays = render::shadowBenchRays(loaded.scene.bounds, o.rays, o.seed + 1);
   if (!o.saveRays.empty()) {
@@ -369,6 +390,8 @@ void runBench(const BenchOptions& o) {
   if (o.json) {
     nlohmann::json j = {{"scene", loaded.scene.sourcePath}, {"device", context.info().name},
                         {"rays", o.rays}, {"seed", o.seed},
+                        {"trace_workgroup_size", tracer.shape().workgroupSize},
+                        {"trace_rays_per_invocation", tracer.shape().raysPerLane},
                         {"triangles", loaded.scene.triangles.size()},
                         {"build_s", loaded.bvh.stats.buildSeconds},
                         {"bvh_nodes", loaded.bvh.stats.nodeCount}, {"bvh_depth", loaded.bvh.stats.maxDepth},
@@ -413,6 +436,8 @@ void runBench(const BenchOptions& o) {
                             {"group_steps", l.groupSteps}, {"utilisation", l.utilisation()}, {"gpu_ms", l.gpuMs}});
     fmt::print("{}\n", j.dump());
   } else {
+    fmt::print("trace.comp: workgroups of {}, {} ray(s) per invocation\n", tracer.shape().workgroupSize,
+               tracer.shape().raysPerLane);
     fmt::print("closest hit (a): {:8.2f} Mrays/s (best of {}, median {:.2f}), hit fraction {:.3f}, {:.1f} steps/ray "
                "({:.1f} as 8-lane groups run them)\n",
                closestMrays, o.repeats, n / (closest.medianMs * 1e3), closest.hitFraction, closest.meanSteps,
@@ -481,6 +506,9 @@ void addBenchRaysCommand(CLI::App& app) {
   cmd->add_option("--lanes", o->lanes,
                   "WxH: lane utilisation (loop passes per ray over those per 8-lane group) of the obscurance-only "
                   "frame's rays at this size, in the passes' order and coherent ones");
+  cmd->add_option("--trace-shape", o->traceShape,
+                  "WORKGROUPxRAYS: trace.comp's workgroup size and rays per invocation (default: 32x64 on a CPU "
+                  "device, 128x1 on a GPU)");
   cmd->add_option("--frame-spp", o->frameWork.spp, "--frame: samples per pixel")->check(CLI::Range(1u, 1024u));
   cmd->add_option("--frame-rays", o->frameWork.obscuranceRays, "--frame: obscurance rays per hit")
       ->check(CLI::Range(1u, 256u));

@@ -120,5 +120,25 @@ TEST_F(CliBench, BadPassesAndFrameOptionsAreRefusedByName) {
   EXPECT_CONTAINS(r.output, "--frame-dmax");
 }
 
+// Another trace.comp shape (here a GPU's, one ray per invocation) traces the same answers.
+TEST_F(CliBench, TraceShapeOptionTracesWithThatShapeAndVerifies) {
+  const auto r = runObscura("bench-rays " + cornellBox() + " --rays 2048 --repeats 1 --verify 2048 --json --trace-shape 64x1");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const nlohmann::json j = lastJsonLine(r.output);
+  EXPECT_EQ(j.at("trace_workgroup_size").get<int>(), 64);
+  EXPECT_EQ(j.at("trace_rays_per_invocation").get<int>(), 1);
+  EXPECT_EQ(j.at("mismatches").get<int>(), 0);
+  EXPECT_EQ(j.at("float_precision_differences").get<int>(), 0); // lavapipe computes as the CPU does
+  EXPECT_GT(j.at("closest_hit_fraction").get<double>(), 0.0);
+}
+
+TEST_F(CliBench, BadTraceShapeIsRefusedByName) {
+  for (const char* shape : {"128", "100x1", "32x65", "1024x64"}) {
+    const auto r = runObscura("bench-rays " + cornellBox() + " --rays 64 --trace-shape " + shape);
+    EXPECT_NE(r.exitCode, 0) << shape;
+    EXPECT_CONTAINS(r.output, std::string("--trace-shape ") + shape);
+  }
+}
+
 } // namespace
 } // namespace obscura::test
