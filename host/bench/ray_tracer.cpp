@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <fmt/core.h>
+
 #include "trace.spv.h"
 
 namespace obscura::render {
@@ -37,20 +39,30 @@ RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std
 }
 
 TraceResult RayTracer::trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps) {
+  return traceRepeated(rays, mode, 1, recordSteps);
+}
+
+TraceResult RayTracer::traceRepeated(std::span<const gpu::GpuRay> rays, TraceMode mode, std::uint32_t repeats,
+                                     bool recordSteps) {
+  repeats = std::max(repeats, 1u);
   // Texel views hold at most maxTexelBufferElements texels (two per ray): larger sets go in parts.
   const std::size_t maxRays = context_->info().maxTexelBufferElements / 2;
-  if (rays.size() <= maxRays) return traceFitting(rays, mode, recordSteps);
+  if (rays.size() <= maxRays) return traceFitting(rays, mode, recordSteps, repeats);
   TraceResult all;
+  all.repeatGpuMs.assign(repeats, 0.0);
   for (std::size_t first = 0; first < rays.size(); first += maxRays) {
-    TraceResult part = traceFitting(rays.subspan(first, std::min(maxRays, rays.size() - first)), mode, recordSteps);
+    TraceResult part =
+        traceFitting(rays.subspan(first, std::min(maxRays, rays.size() - first)), mode, recordSteps, repeats);
     all.hits.insert(all.hits.end(), part.hits.begin(), part.hits.end());
     all.steps.insert(all.steps.end(), part.steps.begin(), part.steps.end());
-    all.gpuMs += part.gpuMs;
+    for (std::uint32_t r = 0; r < repeats; ++r) all.repeatGpuMs[r] += part.repeatGpuMs[r];
   }
+  all.gpuMs = all.repeatGpuMs.front();
   return all;
 }
 
-TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps) {
+TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps,
+                                    std::uint32_t repeats) {
   using Usage = vk::BufferUsageFlagBits;
   const auto n = static_cast<std::uint32_t>(rays.size());
   gpu::TexelBuffer rayBuffer(*context_, std::max<std::size_t>(rays.size_bytes(), sizeof(gpu::GpuRay)),
@@ -69,20 +81,33 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
   const std::uint32_t maxGroups = std::min(context_->info().maxComputeWorkGroupCount[0], 65535u);
   const std::uint32_t raysPerGroup = shape_.workgroupSize * shape_.raysPerLane;
   const std::uint32_t raysPerDispatch = maxGroups * raysPerGroup;
+  auto repeatLabel = [&](std::uint32_t r) { return fmt::format("{}.{}", label, r); };
+  std::vector<double> before(repeats, 0.0);
+  for (std::uint32_t r = 0; r < repeats; ++r)
+    if (timestamps_.totalsMs().contains(repeatLabel(r))) before[r] = timestamps_.totalsMs().at(repeatLabel(r));
   context_->submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
-    timestamps_.begin(cmd, label);
-    for (std::uint32_t first = 0; first < n; first += raysPerDispatch) {
-      std::uint32_t count = std::min(raysPerDispatch, n - first);
-      gpu::TracePush push{.params = glm::uvec4(n, static_cast<std::uint32_t>(mode), 0u, first)};
-      kernel.dispatch(cmd, gpu::groupsFor(count, raysPerGroup), 1, 1, &push);
+    for (std::uint32_t r = 0; r < repeats; ++r) {
+      if (r > 0) { // the repeats write the same hits
+        vk::MemoryBarrier barrier{.srcAccessMask = vk::AccessFlagBits::eShaderWrite,
+                                  .dstAccessMask = vk::AccessFlagBits::eShaderWrite};
+        cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
+                            barrier, nullptr, nullptr);
+      }
+      timestamps_.begin(cmd, repeatLabel(r));
+      for (std::uint32_t first = 0; first < n; first += raysPerDispatch) {
+        std::uint32_t count = std::min(raysPerDispatch, n - first);
+        gpu::TracePush push{.params = glm::uvec4(n, static_cast<std::uint32_t>(mode), 0u, first)};
+        kernel.dispatch(cmd, gpu::groupsFor(count, raysPerGroup), 1, 1, &push);
+      }
+      timestamps_.end(cmd, repeatLabel(r));
     }
-    timestamps_.end(cmd, label);
   });
-  double before = timestamps_.totalsMs().contains(label) ? timestamps_.totalsMs().at(label) : 0.0;
   timestamps_.collect();
   TraceResult result;
-  result.gpuMs = timestamps_.available() ? timestamps_.totalsMs().at(label) - before : 0.0;
+  for (std::uint32_t r = 0; r < repeats; ++r)
+    result.repeatGpuMs.push_back(timestamps_.available() ? timestamps_.totalsMs().at(repeatLabel(r)) - before[r] : 0.0);
+  result.gpuMs = result.repeatGpuMs.front();
   result.hits = hitBuffer.buffer().download<gpu::GpuHit>(*context_);
   result.hits.resize(n);
   if (recordSteps) result.steps = stepBuffer.buffer().download<std::uint32_t>(*context_);

@@ -17,6 +17,7 @@ struct TraceResult {
   std::vector<gpu::GpuHit> hits;
   std::vector<std::uint32_t> steps; // loop passes per ray, when asked for
   double gpuMs = 0.0;               // GPU time of the dispatches (timestamps), 0 if unavailable
+  std::vector<double> repeatGpuMs;  // traceRepeated: each repeat's GPU time (the first is gpuMs)
 };
 
 // How trace.comp spreads rays over invocations (shared/host_device.h): lavapipe's refilling loop
@@ -25,7 +26,7 @@ struct TraceShape {
   std::uint32_t workgroupSize = gpu::kTraceWorkgroupSize;
   std::uint32_t raysPerLane = gpu::kTraceRaysPerLane;
   static TraceShape cpu() { return {}; }
-  static TraceShape gpu() { return {gpu::kTraceGpuWorkgroupSize, 1}; }
+  static TraceShape gpu() { return {gpu::kTraceGpuWorkgroupSize, gpu::kTraceGpuRaysPerLane}; }
   static TraceShape forDevice(const gpu::Context& context); // cpu() on a CPU device, gpu() otherwise
 };
 
@@ -36,9 +37,15 @@ public:
   const TraceShape& shape() const { return shape_; }
 
   TraceResult trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps = false);
+  // The same rays traced `repeats` times back to back in one submission, each repeat timed: a
+  // GPU that idles between submissions (the upload, the read-back) drops its clocks, and a short
+  // trace after such a pause ran 2-5x slower on an H200.
+  TraceResult traceRepeated(std::span<const gpu::GpuRay> rays, TraceMode mode, std::uint32_t repeats,
+                            bool recordSteps = false);
 
 private:
-  TraceResult traceFitting(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps);
+  TraceResult traceFitting(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps,
+                           std::uint32_t repeats);
 
   const gpu::Context* context_;
   TraceShape shape_;

@@ -141,8 +141,9 @@ BoxRay makeBoxRay(const glm::vec3& origin, const glm::vec3& direction) {
 }
 
 std::uint32_t hitChildren(const gpu::BvhNode& node, const BoxRay& ray, float tmin, float tmax) {
-  // kBoxFarScale of shaders/lib/intersect.glsl: 1 + 2 gamma(3) rounded to float.
-  constexpr float kFarScale = 1.0000004f;
+  // kBoxFarScale of shaders/lib/intersect.glsl: 1 + 2 gamma(7) rounded up to a float (a GPU's
+  // 2.5-ulp reciprocal; the CPU's bound would be gamma(3), the same boxes are tested on both).
+  constexpr float kFarScale = 1.000001f;
   std::uint32_t hits = 0;
   for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
     if (slotMeta(node, s) == 0) continue;

@@ -245,11 +245,13 @@ OBS_CONST uint kMaxEmissionSamples = 64u;
 // 48 KiB).
 OBS_CONST uint kTraceRaysPerLane = 64;
 OBS_CONST uint kTraceWorkgroupSize = 32;
-// ...and on a GPU (any device but a CPU; host/bench/ray_tracer.cpp): one ray per invocation, traced
-// directly by traverseBvh, in workgroups of 128. A GPU hides a lane's long ray behind other warps,
-// and trace.comp's lavapipe shape leaves an H200 at 0.25-0.34 Grays/s: 24 KiB of shared memory
-// per 32 invocations caps the warps an SM holds, and 16M rays are only 262k invocations.
-OBS_CONST uint kTraceGpuWorkgroupSize = 128;
+// ...and on a GPU (any device but a CPU; host/bench/ray_tracer.cpp): 8 rays per invocation in
+// workgroups of 32. On an H200 (docs/BENCHMARKS.md, "NVIDIA GPU") that beat one ray per invocation
+// (straight through traverseBvh; 128x1: modern-hall 3.06 Grays/s, Sponza 0.76) by 20-37 %
+// (3.69, 1.05), and the lavapipe shape (32x64: 0.97, 0.31), whose 24 KiB of shared memory per
+// 32 invocations caps the warps an SM holds, by 3-4x. `bench-rays --trace-shape` tries others.
+OBS_CONST uint kTraceGpuWorkgroupSize = 32;
+OBS_CONST uint kTraceGpuRaysPerLane = 8;
 #ifdef __cplusplus
 static_assert(kTraceRaysPerLane <= 64, "traverseStream marks the rays it puts aside in a 64-bit mask");
 static_assert(kTraceWorkgroupSize * kTraceRaysPerLane * 12 <= 32768, "trace.comp's hits must fit shared memory");

@@ -114,11 +114,32 @@ TEST_F(GpuTraversal, ModernHallMatchesBruteForce) {
   expectAgreement(traceAndCompare(s, 100000, 12), "modern-hall");
 }
 
-// The shape trace.comp takes on a GPU (one ray per invocation, workgroups of 128), run here on
-// lavapipe: the same answers as the brute force, like the refilling shape above.
-TEST_F(GpuTraversal, OneRayPerInvocationShapeMatchesBruteForce) {
+// trace.comp's other shapes, run here on lavapipe: a GPU's (8 rays per invocation, workgroups of
+// 32) and one ray per invocation straight through traverseBvh (kRaysPerLane = 1): the same
+// answers as the brute force, like the lavapipe shape above.
+TEST_F(GpuTraversal, GpuAndOneRayPerInvocationShapesMatchBruteForce) {
   scene::Scene soup = soupScene(randomSoup(3000, 1));
   expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape::gpu()), "random soup, GPU shape");
+  expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape{128, 1}), "random soup, one ray per invocation");
+}
+
+// Repeats traced back to back in one submission (bench-rays on a GPU) each give a time and the
+// same hits as one trace.
+TEST_F(GpuTraversal, RepeatedTraceTimesEachRepeatAndKeepsTheHits) {
+  scene::Scene soup = soupScene(randomSoup(500, 3));
+  bvh::Bvh tree = bvh::build(render::triangleSoup(soup));
+  render::SceneBuffers buffers(context(), soup, tree);
+  render::RayTracer tracer(context(), buffers);
+  auto rays = render::closestBenchRays(soup.bounds, 5000, 3);
+  auto once = tracer.trace(rays, render::TraceMode::Closest);
+  auto repeated = tracer.traceRepeated(rays, render::TraceMode::Closest, 3);
+  ASSERT_EQ(repeated.repeatGpuMs.size(), 3u);
+  for (double ms : repeated.repeatGpuMs) EXPECT_GT(ms, 0.0);
+  ASSERT_EQ(repeated.hits.size(), once.hits.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    ASSERT_EQ(repeated.hits[i].primitive, once.hits[i].primitive) << i;
+    ASSERT_EQ(repeated.hits[i].t, once.hits[i].t) << i;
+  }
 }
 
 TEST_F(GpuTraversal, ShadowRaysMatchCpuAnyHit) {
