@@ -1,8 +1,9 @@
 #version 460
-// trace.comp — traces a buffer of rays (closest hit or any hit). On lavapipe kTraceRaysPerLane per
-// invocation through one refilling traversal loop (lib/bvh_stream.glsl); on a GPU one per
-// invocation (kRaysPerLane = 1, a specialisation constant). Used by `obscura bench-rays` and by
-// the traversal tests, so the benchmark measures the code tested.
+// trace.comp — traces a buffer of rays (closest hit or any hit), kRaysPerLane per invocation
+// through one refilling traversal loop (lib/bvh_stream.glsl): 64 on lavapipe, 8 on a GPU (a
+// specialisation constant, as is the workgroup size; host/bench/ray_tracer.h); kRaysPerLane = 1
+// goes straight through traverseBvh. Used by `obscura bench-rays` and by the traversal tests, so
+// the benchmark measures the code tested.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
@@ -49,7 +50,7 @@ void streamHit(uint k, RayHit h) {
 #include "lib/bvh_stream.glsl"
 
 void main() {
-  if (kRaysPerLane == 1u) { // a GPU's shape: the ray straight through traverseBvh
+  if (kRaysPerLane == 1u) { // one ray per invocation: straight through traverseBvh
     const uint i = rayIndex(0u);
     if (i >= pc.params.x) return;
     GpuRay ray = streamRay(0u);

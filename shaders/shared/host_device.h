@@ -379,8 +379,8 @@ OBS_CONST uint kSpecConstantGreyObscurance = 7u;
 // holds no more than kMaxSpatialLights lights (spares included); lavapipe otherwise runs the
 // unused selections masked for every light sample (5 % of the shadow pass).
 OBS_CONST uint kSpecConstantFlatLightSelection = 8u;
-// trace.comp's shape (kTraceRaysPerLane and kTraceWorkgroupSize above, or a GPU's: 1 and
-// kTraceGpuWorkgroupSize).
+// trace.comp's shape (kTraceRaysPerLane and kTraceWorkgroupSize above, a GPU's
+// kTraceGpuRaysPerLane and kTraceGpuWorkgroupSize, or bench-rays --trace-shape).
 OBS_CONST uint kSpecConstantTraceRaysPerLane = 9u;
 OBS_CONST uint kSpecConstantTraceWorkgroupSize = 10u;
 OBS_CONST uint kPerLightRays = 4u;
