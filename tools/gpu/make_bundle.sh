@@ -9,7 +9,7 @@
 # client libraries) and the benchmark scenes from ../shared/scenes. The Vulkan loader travels
 # separately (.gl, see .library/device/README.md).
 set -euo pipefail
-bundle=${1:?usage: make_bundle.sh BUNDLE_DIR [BUILD_DIR]}
+bundle=${1:?usage: make_bundle.sh BUNDLE_DIR [BUILD_DIR] (.gpu-bundle is ignored by git)}
 source_dir=$(cd "$(dirname "$0")/../.." && pwd)
 build=${2:-/tmp/obscura-gpu-build}
 scenes=$source_dir/../shared/scenes
