@@ -90,7 +90,15 @@ void writePngRgba8(const std::string& path, int width, int height, const std::ve
   std::vector<unsigned char> rgb(std::size_t(width) * height * 3);
   for (std::size_t i = 0; i < rgb.size() / 3; ++i)
     for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = static_cast<unsigned char>((rgba[i] >> (8 * c)) & 0xFFu);
+#ifdef OBSCURA_HAVE_OPENIMAGEIO
+  // OpenImageIO's PNG (libpng, zlib) is a third the size of stb's at the same speed.
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  writeAtomically(path, [&](const std::string& temp) {
+    writeWithOiio(temp, path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+  });
+#else
   writeAtomically(path, [&](const std::string& temp) { writePngWithStb(temp, path, width, height, 3, rgb.data()); });
+#endif
 }
 
 void writeExr(const std::string& path, const Image& image) {

@@ -1,6 +1,6 @@
-// image_io.h — images in and out: EXR and reading through OpenImageIO, PNG written through stb
-// (io/stb_codec.h). A build without OpenImageIO (-DOBSCURA_WITH_OPENIMAGEIO=OFF) reads through
-// stb (no EXR) and writes uncompressed EXR (io/exr_writer.h).
+// image_io.h — images in and out through OpenImageIO. A build without it
+// (-DOBSCURA_WITH_OPENIMAGEIO=OFF) reads and writes PNG through stb (io/stb_codec.h), reads no
+// EXR and writes uncompressed EXR (io/exr_writer.h).
 //
 // EXR holds linear radiance and every AOV as channel layers ("albedo.R", "depth.Z", …). PNG is
 // for viewing only: exposure, then the sRGB curve, 8 bits [SPEC §5]. Files are written to a

@@ -1,5 +1,5 @@
-// PNG goes out through stb in every build and comes back through OpenImageIO where the build has
-// it, through stb where it does not: both readers must see the same file the same way.
+// The PNG writers (OpenImageIO's in the default build, stb's without it) and readers must see the
+// same file the same way; stb's are tested in every build, as a build without OpenImageIO uses them.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
+#include <vector>
 
 #include <fmt/core.h>
-#include <vector>
 
 #include "core/error.h"
 #include "io/image_io.h"
@@ -20,29 +20,41 @@ namespace obscura::io {
 namespace {
 namespace fs = std::filesystem;
 
-TEST(ImageIo, PngWrittenThroughStbReadsBackTheSameThroughBothReaders) {
-  const int width = 7, height = 5; // odd sizes: no row padding hides an off-by-one
+// Pixels whose three channels differ everywhere (an odd size: no row padding hides an off-by-one).
+std::vector<std::uint32_t> testPixels(int width, int height) {
   std::vector<std::uint32_t> rgba(std::size_t(width) * height);
   for (std::size_t i = 0; i < rgba.size(); ++i)
     rgba[i] = 0xFF000000u | std::uint32_t((i * 37) & 0xFF) | std::uint32_t((i * 11 + 3) & 0xFF) << 8 |
               std::uint32_t(255 - (i * 5 & 0xFF)) << 16;
-  const fs::path path = fs::temp_directory_path() / fmt::format("obscura-image-io-{}.png", ::getpid());
-  writePngRgba8(path.string(), width, height, rgba);
+  return rgba;
+}
 
-  const Image viaStb = readImageWithStb(path.string());
-  const Image viaReader = readImage(path.string()); // OpenImageIO in the default build
+void expectPixels(const Image& image, const std::vector<std::uint32_t>& rgba, int width, int height) {
+  ASSERT_EQ(image.width, width);
+  ASSERT_EQ(image.height, height);
+  ASSERT_EQ(image.channels, (std::vector<std::string>{"R", "G", "B"}));
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int c = 0; c < 3; ++c)
+        // 1e-6: OpenImageIO scales by 1/255 rather than dividing; one 8-bit step is 3.9e-3.
+        ASSERT_NEAR(image.at(x, y, c), float((rgba[std::size_t(y) * width + x] >> (8 * c)) & 0xFFu) / 255.0f, 1e-6f)
+            << "pixel " << x << "," << y << " channel " << c;
+}
+
+TEST(ImageIo, PngReadsBackTheSameThroughBothReadersFromBothWriters) {
+  const int width = 7, height = 5;
+  const std::vector<std::uint32_t> rgba = testPixels(width, height);
+  const fs::path path = fs::temp_directory_path() / fmt::format("obscura-image-io-{}.png", ::getpid());
+  // The build's writer (OpenImageIO's or stb's), then stb's whatever the build.
+  writePngRgba8(path.string(), width, height, rgba);
+  const Image viaStb = readImageWithStb(path.string()), viaReader = readImage(path.string());
+  std::vector<unsigned char> rgb;
+  for (std::uint32_t p : rgba)
+    for (int c = 0; c < 3; ++c) rgb.push_back(static_cast<unsigned char>((p >> (8 * c)) & 0xFFu));
+  writePngWithStb(path.string(), path.string(), width, height, 3, rgb.data());
+  const Image stbViaStb = readImageWithStb(path.string()), stbViaReader = readImage(path.string());
   fs::remove(path);
-  for (const Image* image : {&viaStb, &viaReader}) {
-    ASSERT_EQ(image->width, width);
-    ASSERT_EQ(image->height, height);
-    ASSERT_EQ(image->channels, (std::vector<std::string>{"R", "G", "B"}));
-    for (int y = 0; y < height; ++y)
-      for (int x = 0; x < width; ++x)
-        for (int c = 0; c < 3; ++c)
-          // 1e-6: OpenImageIO scales by 1/255 rather than dividing; one 8-bit step is 3.9e-3.
-          ASSERT_NEAR(image->at(x, y, c), float((rgba[std::size_t(y) * width + x] >> (8 * c)) & 0xFFu) / 255.0f, 1e-6f)
-              << "pixel " << x << "," << y << " channel " << c;
-  }
+  for (const Image* image : {&viaStb, &viaReader, &stbViaStb, &stbViaReader}) expectPixels(*image, rgba, width, height);
 }
 
 TEST(ImageIo, UnreadableImageNamesTheFileThroughStb) {

@@ -1,8 +1,8 @@
 // stb_codec.h — images through stb (stb_image_write, stb_image), which every build has.
 //
-// PNG is always written through here. OpenImageIO stays the reader and the EXR writer where the
-// build has it (OBSCURA_WITH_OPENIMAGEIO, the default); a build without it (a machine lent for
-// GPU benchmarks, where OpenImageIO's ~400 MB of dependencies cannot travel) reads through here.
+// OpenImageIO reads and writes images where the build has it (OBSCURA_WITH_OPENIMAGEIO, the
+// default); a build without it (a machine lent for GPU benchmarks, where OpenImageIO's ~400 MB of
+// dependencies cannot travel) reads and writes PNG through here. Its tests run in every build.
 #pragma once
 #include <string>
 
