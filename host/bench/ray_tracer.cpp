@@ -27,7 +27,7 @@ gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps) {
 } // namespace
 
 TraceShape TraceShape::forDevice(const gpu::Context& context) {
-  return context.info().type == "cpu" ? cpu() : gpu();
+  return context.info().type == "cpu" ? forCpu() : forGpu();
 }
 
 RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape)

@@ -20,14 +20,15 @@ struct TraceResult {
   std::vector<double> repeatGpuMs;  // traceRepeated: each repeat's GPU time (the first is gpuMs)
 };
 
-// How trace.comp spreads rays over invocations (shared/host_device.h): lavapipe's refilling loop
-// of kTraceRaysPerLane rays per invocation, or a GPU's one ray per invocation.
+// How trace.comp spreads rays over invocations (shared/host_device.h): the refilling loop of
+// kTraceRaysPerLane rays per invocation on lavapipe, of kTraceGpuRaysPerLane on a GPU; one ray per
+// invocation goes straight through traverseBvh.
 struct TraceShape {
   std::uint32_t workgroupSize = gpu::kTraceWorkgroupSize;
   std::uint32_t raysPerLane = gpu::kTraceRaysPerLane;
-  static TraceShape cpu() { return {}; }
-  static TraceShape gpu() { return {gpu::kTraceGpuWorkgroupSize, gpu::kTraceGpuRaysPerLane}; }
-  static TraceShape forDevice(const gpu::Context& context); // cpu() on a CPU device, gpu() otherwise
+  static TraceShape forCpu() { return {}; }
+  static TraceShape forGpu() { return {gpu::kTraceGpuWorkgroupSize, gpu::kTraceGpuRaysPerLane}; }
+  static TraceShape forDevice(const gpu::Context& context); // forCpu() on a CPU device, forGpu() otherwise
 };
 
 class RayTracer {

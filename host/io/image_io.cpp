@@ -91,7 +91,7 @@ void writePngRgba8(const std::string& path, int width, int height, const std::ve
   for (std::size_t i = 0; i < rgb.size() / 3; ++i)
     for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = static_cast<unsigned char>((rgba[i] >> (8 * c)) & 0xFFu);
 #ifdef OBSCURA_HAVE_OPENIMAGEIO
-  // OpenImageIO's PNG (libpng, zlib) is a third the size of stb's at the same speed.
+  // OpenImageIO's PNG (libpng, zlib) is smaller than stb's (the Cornell box: 269 KB against 396 KB).
   OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
   writeAtomically(path, [&](const std::string& temp) {
     writeWithOiio(temp, path, spec, OIIO::TypeDesc::UINT8, rgb.data());

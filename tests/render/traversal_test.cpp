@@ -119,7 +119,7 @@ TEST_F(GpuTraversal, ModernHallMatchesBruteForce) {
 // answers as the brute force, like the lavapipe shape above.
 TEST_F(GpuTraversal, GpuAndOneRayPerInvocationShapesMatchBruteForce) {
   scene::Scene soup = soupScene(randomSoup(3000, 1));
-  expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape::gpu()), "random soup, GPU shape");
+  expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape::forGpu()), "random soup, GPU shape");
   expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape{128, 1}), "random soup, one ray per invocation");
 }
 
