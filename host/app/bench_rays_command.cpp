@@ -514,8 +514,10 @@ void addBenchRaysCommand(CLI::App& app) {
                   "WxH: lane utilisation (loop passes per ray over those per 8-lane group) of the obscurance-only "
                   "frame's rays at this size, in the passes' order and coherent ones");
   cmd->add_option("--trace-shape", o->traceShape,
-                  "WORKGROUPxRAYS: trace.comp's workgroup size and rays per invocation (default: 32x64 on a CPU "
-                  "device, 128x1 on a GPU)");
+                  fmt::format("WORKGROUPxRAYS: trace.comp's workgroup size and rays per invocation (default: "
+                              "{}x{} on a CPU device, {}x{} on a GPU)",
+                              gpu::kTraceWorkgroupSize, gpu::kTraceRaysPerLane, gpu::kTraceGpuWorkgroupSize,
+                              gpu::kTraceGpuRaysPerLane));
   cmd->add_option("--frame-spp", o->frameWork.spp, "--frame: samples per pixel")->check(CLI::Range(1u, 1024u));
   cmd->add_option("--frame-rays", o->frameWork.obscuranceRays, "--frame: obscurance rays per hit")
       ->check(CLI::Range(1u, 256u));

@@ -45,6 +45,7 @@ nlohmann::json sceneJson(const LoadedScene& loaded) {
             {"leaves", b.leafCount},
             {"max_depth", b.maxDepth},
             {"sah_cost", b.sahCost},
+            {"wide_sah_cost", b.wideSahCost},
             {"median_fallbacks", b.medianFallbacks},
             {"bytes", loaded.bvh.nodes.size() * sizeof(gpu::BvhNode) +
                           loaded.bvh.triangles.size() * sizeof(gpu::BvhTriangle)}}}};
@@ -55,10 +56,10 @@ std::string sceneSummary(const LoadedScene& loaded) {
   const auto& b = loaded.bvh.stats;
   return fmt::format("scene: {} triangles ({} degenerate dropped), {} materials, {} textures, {} light "
                      "groups, {} punctual lights; loaded in {:.3f} s\n"
-                     "bvh: built in {:.3f} s, {} nodes, {} leaves, depth {}, SAH cost {:.2f}",
+                     "bvh: built in {:.3f} s, {} nodes, {} leaves, depth {}, SAH cost {:.2f} (binary), {:.2f} (8-wide)",
                      s.triangles.size(), s.stats.degenerateTrianglesDropped, s.materials.size(),
                      s.textures.size(), s.lightGroups.size(), s.punctualLights.size(), loaded.loadSeconds,
-                     b.buildSeconds, b.nodeCount, b.leafCount, b.maxDepth, b.sahCost);
+                     b.buildSeconds, b.nodeCount, b.leafCount, b.maxDepth, b.sahCost, b.wideSahCost);
 }
 
 } // namespace obscura::app

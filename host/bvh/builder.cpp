@@ -10,8 +10,9 @@
 //   2. buildRange(): per node, decide leaf / SAH split / median split (depth bound) / index split
 //      (no valid SAH split), partition the refs, recurse; big subtrees run on their own thread.
 //      Nodes go into a scratch array at indices that depend only on the range (no locks).
-//   3. writeWide(): collapse into 8-wide compressed nodes (gpu::BvhNode, wide_node.h), the
-//      triangles in the order the wide leaves need them, and the statistics.
+//   3. writeWide(): collapse into 8-wide compressed nodes (gpu::BvhNode, wide_node.h) by the
+//      SAH-optimal programme of wide_collapse.h, the triangles in the order the wide leaves need
+//      them, and the statistics.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -25,6 +26,7 @@
 #include <vector>
 
 #include "bvh/bvh.h"
+#include "bvh/wide_collapse.h"
 #include "bvh/wide_node.h"
 
 namespace obscura::bvh {
@@ -115,6 +117,7 @@ public:
     threads_ = std::max(1u, threads_);
     bins_ = std::clamp(options.bins, 2, kMaxBins);
     maxLeaf_ = std::clamp(options.maxLeafSize, 1u, gpu::kLeafMaxTriangles);
+    binaryLeaf_ = std::clamp(options.binaryLeafSize, 1u, maxLeaf_);
     // A few more tasks than threads so that uneven subtrees still keep every core busy.
     while ((1u << maxTaskDepth_) < 4 * threads_) ++maxTaskDepth_;
     if (threads_ == 1) maxTaskDepth_ = 0;
@@ -227,7 +230,7 @@ private:
       const SplitChoice split = binning.axis >= 0 ? bestSplit(begin, end, binning, box)
                                                   : SplitChoice{};
       const float leafCost = options_.intersectionCost * static_cast<float>(count) * box.area();
-      if (count <= maxLeaf_ && (!split.valid || leafCost <= split.cost)) return makeLeaf();
+      if (count <= binaryLeaf_ && (!split.valid || leafCost <= split.cost)) return makeLeaf();
 
       if (split.valid) {
         mid = partition(begin, end, binning, split, leftCentroids, rightCentroids);
@@ -410,70 +413,104 @@ private:
     }
   }
 
-  // ---- 3. Wide layout: collapse the binary tree into 8-wide nodes (Ylitie, Karras & Laine
-  // 2017, §3.2, with a greedy rule instead of their dynamic programme: a wide node starts with
-  // its binary node's two children and repeatedly opens the interior child of largest surface
-  // area, as long as its slots allow). Wide nodes are emitted breadth-first, so a node's interior
-  // children are consecutive and come after it (refit walks them backwards), and the triangles
-  // of a node's leaf children are consecutive, in the order the traversal's bit masks need them.
+  // ---- 3. Wide layout: collapse the binary tree into 8-wide nodes by the SAH-optimal programme
+  // of Ylitie, Karras & Laine 2017, §3.1 (wide_collapse.h), which also merges subtrees of at most
+  // maxLeaf triangles into one leaf slot. Wide nodes are emitted breadth-first, so a node's
+  // interior children are consecutive and come after it (refit walks them backwards), and the
+  // triangles of a node's leaf children are consecutive, in the order the traversal's bit masks
+  // need them.
   void writeWide(Bvh& bvh) {
     const TempNode& root = nodes_[0];
     rootArea_ = root.box.area();
     sah_ = 0.0;
-    std::vector<std::uint32_t> pending = {0}; // binary slot of each wide node, by wide index
-    std::vector<std::uint32_t> depth = {0};
     bvh.triangles.reserve(refs_.size());
     bvh.order.reserve(refs_.size());
     if (root.count > 0) {
       // A one-leaf tree: a root whose only child is the leaf.
       std::array<WideChild, gpu::kBvhWidth> slots{};
-      slots[0] = leafChild(root, bvh);
+      slots[0] = leafChild(root.first, root.count, root.box, bvh);
       bvh.nodes.emplace_back();
       writeWideNode(bvh.nodes[0], slots, 0, 0);
       bvh.stats.leafCount = 1;
       bvh.stats.maxDepth = 1;
       sah_ = double{options_.traversalCost} * areaRatio(root.box) +
              double{options_.intersectionCost} * root.count * areaRatio(root.box);
+      bvh.stats.sahCost = bvh.stats.wideSahCost = sah_;
+      bvh.stats.nodeCount = 1;
+      return;
     }
-    for (std::size_t w = 0; w < pending.size() && root.count == 0; ++w) {
-      std::vector<std::uint32_t> children = openChildren(pending[w]);
+    const std::vector<CollapseInput> binary = collapseInput();
+    const WideCollapse collapse(binary, CollapseCosts{.node = options_.wideNodeCost,
+                                                      .triangle = options_.intersectionCost,
+                                                      .maxLeafTriangles = maxLeaf_});
+    std::vector<std::uint32_t> pending = {0}; // binary slot of each wide node, by wide index
+    std::vector<std::uint32_t> depth = {0};
+    for (std::size_t w = 0; w < pending.size(); ++w) {
+      const std::vector<CollapsedSlot> children = collapse.slots(pending[w]);
       const std::array<int, gpu::kBvhWidth> slotOf = assignOctantSlots(pending[w], children);
       std::array<WideChild, gpu::kBvhWidth> slots{};
       const auto firstTriangle = static_cast<std::uint32_t>(bvh.triangles.size());
       const auto firstChild = static_cast<std::uint32_t>(pending.size());
       for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
         if (slotOf[s] < 0) continue;
-        const std::uint32_t c = children[static_cast<std::size_t>(slotOf[s])];
-        if (nodes_[c].count > 0) {
-          slots[s] = leafChild(nodes_[c], bvh);
+        const CollapsedSlot& child = children[static_cast<std::size_t>(slotOf[s])];
+        const TempNode& c = nodes_[child.node];
+        if (child.leaf) {
+          slots[s] = leafChild(firstRef(child.node), subtreeTriangles(child.node), c.box, bvh);
           slots[s].triangleOffset = slots[s].triangleOffset - firstTriangle;
           ++bvh.stats.leafCount;
           bvh.stats.maxDepth = std::max(bvh.stats.maxDepth, depth[w] + 1);
         } else {
           slots[s].kind = WideChild::Kind::Internal;
-          slots[s].box = toBox(nodes_[c].box);
-          pending.push_back(c);
+          slots[s].box = toBox(c.box);
+          pending.push_back(child.node);
           depth.push_back(depth[w] + 1);
         }
       }
       if (bvh.nodes.size() < pending.size()) bvh.nodes.resize(pending.size());
       writeWideNode(bvh.nodes[w], slots, firstChild, firstTriangle);
     }
-    if (root.count == 0) addBinarySah(0);
+    addBinarySah(0);
     bvh.stats.nodeCount = static_cast<std::uint32_t>(bvh.nodes.size());
     bvh.stats.sahCost = sah_;
+    bvh.stats.wideSahCost = collapse.cost();
   }
 
   static Box toBox(const Aabb& a) { return Box{a.lo, a.hi}; }
 
-  // Appends a binary leaf's triangles; returns its slot (triangleOffset = absolute first index).
-  WideChild leafChild(const TempNode& leaf, Bvh& bvh) const {
+  // The binary tree as the collapse reads it (unused scratch slots stay zero: never reached).
+  std::vector<CollapseInput> collapseInput() const {
+    std::vector<CollapseInput> in(nodes_.size());
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      const TempNode& t = nodes_[i];
+      in[i].area = t.box.area();
+      in[i].triangles = t.count;
+      in[i].child[0] = t.child[0];
+      in[i].child[1] = t.child[1];
+    }
+    return in;
+  }
+
+  // A subtree's refs are one range (partition() keeps the left child's refs first): from its
+  // leftmost leaf's first ref, as many as it holds.
+  std::uint32_t firstRef(std::uint32_t slot) const {
+    while (nodes_[slot].count == 0) slot = nodes_[slot].child[0];
+    return nodes_[slot].first;
+  }
+  std::uint32_t subtreeTriangles(std::uint32_t slot) const {
+    const TempNode& t = nodes_[slot];
+    return t.count > 0 ? t.count : subtreeTriangles(t.child[0]) + subtreeTriangles(t.child[1]);
+  }
+
+  // Appends the triangles of refs [first, first + count) as one leaf; returns its slot
+  // (triangleOffset = absolute first index).
+  WideChild leafChild(std::uint32_t first, std::uint32_t count, const Aabb& box, Bvh& bvh) const {
     WideChild c;
     c.kind = WideChild::Kind::Leaf;
-    c.box = toBox(leaf.box);
+    c.box = toBox(box);
     c.triangleOffset = static_cast<std::uint32_t>(bvh.triangles.size());
-    c.triangleCount = leaf.count;
-    for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i) {
+    c.triangleCount = count;
+    for (std::uint32_t i = first; i < first + count; ++i) {
       const std::uint32_t id = refs_[i].id;
       bvh.order.push_back(id);
       bvh.triangles.push_back({.v0 = gpu::vec4(soup_.v0[id], std::bit_cast<float>(id)),
@@ -483,38 +520,17 @@ private:
     return c;
   }
 
-  // The binary nodes that become the children of the wide node made from interior `slot`.
-  std::vector<std::uint32_t> openChildren(std::uint32_t slot) const {
-    std::vector<std::uint32_t> children = {nodes_[slot].child[0], nodes_[slot].child[1]};
-    while (children.size() < gpu::kBvhWidth) {
-      int widest = -1;
-      float widestArea = -1.0f;
-      for (std::size_t i = 0; i < children.size(); ++i) {
-        const TempNode& c = nodes_[children[i]];
-        if (c.count == 0 && c.box.area() > widestArea) {
-          widestArea = c.box.area();
-          widest = static_cast<int>(i);
-        }
-      }
-      if (widest < 0) break;
-      const TempNode& opened = nodes_[children[static_cast<std::size_t>(widest)]];
-      children[static_cast<std::size_t>(widest)] = opened.child[0];
-      children.push_back(opened.child[1]);
-    }
-    return children;
-  }
-
   // slotOf[s] = index into `children` placed in slot s, or -1. Slot bit k means "on the + side of
   // axis k" (host_device.h): greedily, the (child, slot) pair whose slot direction best matches
   // the child's offset from the parent's centre is placed first (Ylitie et al. 2017, §3.2).
   std::array<int, gpu::kBvhWidth> assignOctantSlots(std::uint32_t parent,
-                                                   const std::vector<std::uint32_t>& children) const {
+                                                   const std::vector<CollapsedSlot>& children) const {
     const Aabb& p = nodes_[parent].box;
     const glm::vec3 centre = 0.5f * (p.lo + p.hi);
     struct Pair { float cost; int child; int slot; };
     std::vector<Pair> pairs;
     for (std::size_t i = 0; i < children.size(); ++i) {
-      const Aabb& b = nodes_[children[i]].box;
+      const Aabb& b = nodes_[children[i].node].box;
       const glm::vec3 offset = 0.5f * (b.lo + b.hi) - centre;
       for (int s = 0; s < static_cast<int>(gpu::kBvhWidth); ++s) {
         const glm::vec3 dir((s & 1) ? 1.0f : -1.0f, (s & 2) ? 1.0f : -1.0f, (s & 4) ? 1.0f : -1.0f);
@@ -566,7 +582,8 @@ private:
   const BuildOptions& options_;
   unsigned threads_ = 1;
   int bins_ = 16;
-  std::uint32_t maxLeaf_ = 8;
+  std::uint32_t maxLeaf_ = 3;    // triangles of a wide leaf slot
+  std::uint32_t binaryLeaf_ = 1; // of a binary leaf, where the SAH may still split
   unsigned maxTaskDepth_ = 0;
   std::vector<PrimRef> refs_;
   std::vector<TempNode> nodes_;

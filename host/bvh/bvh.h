@@ -1,9 +1,10 @@
 // bvh.h — bounding volume hierarchy over a triangle soup: build, GPU layout, CPU traversal.
 //
 // The builder is binned SAH (Wald, "On fast Construction of SAH-based Bounding Volume
-// Hierarchies", 2007), parallel over subtrees, collapsed into 8-wide nodes with 8-bit quantised
-// child boxes (Ylitie, Karras & Laine 2017), see shaders/shared/host_device.h and wide_node.h. The
-// CPU traversal walks the same wide nodes and is the reference the GPU is tested against.
+// Hierarchies", 2007), parallel over subtrees, collapsed SAH-optimally (wide_collapse.h) into
+// 8-wide nodes with 8-bit quantised child boxes (Ylitie, Karras & Laine 2017), see
+// shaders/shared/host_device.h and wide_node.h. The CPU traversal walks the same wide nodes and
+// is the reference the GPU is tested against.
 #pragma once
 #include <cstdint>
 #include <limits>
@@ -17,10 +18,15 @@
 namespace obscura::bvh {
 
 struct BuildOptions {
-  int bins = 16;                 // SAH bins per axis
+  int bins = 32;                 // SAH bins per axis
   float traversalCost = 1.0f;    // SAH cost of visiting one node, relative to...
   float intersectionCost = 1.0f; // ...the cost of testing one triangle
-  std::uint32_t maxLeafSize = 3; // <= gpu::kLeafMaxTriangles
+  float wideNodeCost = 1.0f;     // the collapse's cost of visiting one 8-wide node (wide_collapse.h)
+  std::uint32_t maxLeafSize = 3; // triangles of a wide leaf slot, <= gpu::kLeafMaxTriangles
+  // Triangles of a binary leaf while the SAH could still split it: 1, as Ylitie et al. build, so
+  // that the collapse, not the binary build, decides which triangles share a leaf slot (Sponza:
+  // 13.1 -> 12.8 loop passes per closest-hit ray, docs/BENCHMARKS.md). <= maxLeafSize.
+  std::uint32_t binaryLeafSize = 1;
   unsigned threads = 0;          // 0 = hardware concurrency
 };
 
@@ -30,6 +36,7 @@ struct BuildStats {
   std::uint32_t leafCount = 0;   // leaf children (of 1..maxLeafSize triangles)
   std::uint32_t maxDepth = 0;    // of the wide tree (root's children: 1); <= gpu::kBvhMaxDepth, always
   double sahCost = 0.0;          // SAH cost of the binary tree before collapsing (root area = 1)
+  double wideSahCost = 0.0;      // SAH cost of the 8-wide tree, as the collapse minimised it
   std::uint32_t medianFallbacks = 0; // nodes split by median to honour the depth bound
 };
 

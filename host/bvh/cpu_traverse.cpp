@@ -17,9 +17,9 @@ namespace obscura::bvh {
 namespace {
 
 // Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013: the far distance of a box is scaled by
-// 1 + 2 gamma(3) inside hitChildren(), which makes the float slab test conservative; we pass the
-// current best t itself, so a triangle lying on its box's face whose t equals the best t (a tie,
-// won by the lower primitive id) is not culled by rounding.
+// 1 + 2 gamma(7) inside hitChildren() (kBoxFarScale), which makes the float slab test
+// conservative; we pass the current best t itself, so a triangle lying on its box's face whose t
+// equals the best t (a tie, won by the lower primitive id) is not culled by rounding.
 
 // A node group: interior children of node `node` not visited yet, as a bit mask over visit
 // order (bit k = slot k ^ octant), as the GPU keeps it.

@@ -54,7 +54,7 @@ struct BoxRay {
 };
 BoxRay makeBoxRay(const glm::vec3& origin, const glm::vec3& direction);
 
-// Bit s set: the ray meets slot s's decoded box within [tmin, tmax * (1 + 2 gamma(3))] (Ize,
+// Bit s set: the ray meets slot s's decoded box within [tmin, tmax * (1 + 2 gamma(7))] (Ize,
 // "Robust BVH Ray Traversal", JCGT 2013). Empty slots never hit.
 std::uint32_t hitChildren(const gpu::BvhNode& node, const BoxRay& ray, float tmin, float tmax);
 
