@@ -9,7 +9,7 @@
 namespace obscura::render {
 
 namespace {
-gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps) {
+gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, bool compactStack) {
   auto bindings = sceneBindingKinds();
   // rays (two RGBA32F texels each), hits (one RGBA32F texel each), steps (R32UI): texel views,
   // which lavapipe reads and writes a texel per lane at a time (an SSBO: a word per lane at a time).
@@ -21,7 +21,8 @@ gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps) {
           .pushConstantBytes = sizeof(gpu::TracePush),
           .specConstants = {{gpu::kSpecConstantTraceSteps, recordSteps ? 1u : 0u},
                             {gpu::kSpecConstantTraceRaysPerLane, shape.raysPerLane},
-                            {gpu::kSpecConstantTraceWorkgroupSize, shape.workgroupSize}},
+                            {gpu::kSpecConstantTraceWorkgroupSize, shape.workgroupSize},
+                            {gpu::kSpecConstantCompactStack, compactStack ? 1u : 0u}},
           .deferCompile = recordSteps};
 }
 } // namespace
@@ -30,9 +31,11 @@ TraceShape TraceShape::forDevice(const gpu::Context& context) {
   return context.info().type == "cpu" ? forCpu() : forGpu();
 }
 
-RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape)
+RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape,
+                     std::optional<bool> compactStack)
     : context_(&context), shape_(shape.value_or(TraceShape::forDevice(context))),
-      kernel_(context, traceKernelDesc(shape_, false)), stepsKernel_(context, traceKernelDesc(shape_, true)),
+      kernel_(context, traceKernelDesc(shape_, false, compactStack.value_or(scene.fitsCompactStack()))),
+      stepsKernel_(context, traceKernelDesc(shape_, true, compactStack.value_or(scene.fitsCompactStack()))),
       timestamps_(context) {
   scene.bindTo(kernel_);
   scene.bindTo(stepsKernel_);

@@ -34,7 +34,11 @@ struct TraceShape {
 class RayTracer {
 public:
   // `shape` defaults to the device's (TraceShape::forDevice); a test may force either.
-  RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape = {});
+  // `compactStack` (the kernel specialised for the compact traversal stack) defaults to whether
+  // the scene's BVH fits it; a test may force the general kernel, or the compact one (which
+  // throws where the BVH does not fit).
+  RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape = {},
+            std::optional<bool> compactStack = {});
   const TraceShape& shape() const { return shape_; }
 
   TraceResult trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps = false);

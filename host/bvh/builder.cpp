@@ -596,6 +596,10 @@ private:
 
 } // namespace
 
+bool fitsCompactStack(const Bvh& bvh) {
+  return bvh.nodes.size() <= gpu::kBvhCompactStackNodes && bvh.stats.maxDepth <= gpu::kBvhCompactStackMaxDepth;
+}
+
 Bvh build(const TriangleSoup& soup, const BuildOptions& options) {
   return Builder(soup, options).run();
 }

@@ -61,6 +61,11 @@ struct Bvh {
 // gives a root with two empty children.
 Bvh build(const TriangleSoup& soup, const BuildOptions& options = {});
 
+// Whether no traversal of `bvh` can overflow the compact register stack (shared/host_device.h:
+// at most kBvhCompactStackNodes nodes and depth kBvhCompactStackMaxDepth), so that kernels
+// specialised with kSpecConstantCompactStack may trace it.
+bool fitsCompactStack(const Bvh& bvh);
+
 // Refits `bvh` to the moved vertices of the same triangles (`soup` indexed as when it was built):
 // the tree keeps its topology, every box is recomputed bottom-up and quantised again. Linear in the size, so an object
 // edit updates the structure without a rebuild; the tree's quality degrades with large moves

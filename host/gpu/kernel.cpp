@@ -62,6 +62,33 @@ Kernel::Kernel(const Context& context, const KernelDesc& desc)
   for (auto& set : sets) sets_.push_back(std::move(set));
 }
 
+Kernel& Kernel::operator=(Kernel&& other) noexcept {
+  if (this == &other) return *this;
+  sets_.clear();
+  pool_ = nullptr;
+  pipeline_ = nullptr;
+  pipelineLayout_ = nullptr;
+  setLayout_ = nullptr;
+  context_ = other.context_;
+  name_ = std::move(other.name_);
+  bindings_ = std::move(other.bindings_);
+  pushBytes_ = other.pushBytes_;
+  setLayout_ = std::move(other.setLayout_);
+  pipelineLayout_ = std::move(other.pipelineLayout_);
+  spirv_ = other.spirv_;
+  specConstants_ = std::move(other.specConstants_);
+  pipeline_ = std::move(other.pipeline_);
+  pool_ = std::move(other.pool_);
+  sets_ = std::move(other.sets_);
+  return *this;
+}
+
+std::uint32_t Kernel::specConstant(std::uint32_t id) const {
+  for (const SpecConstant& c : specConstants_)
+    if (c.id == id) return c.value;
+  return 0;
+}
+
 void Kernel::compile() const {
   if (compiled()) return;
   const auto& device = context_->device();

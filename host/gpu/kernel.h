@@ -42,6 +42,10 @@ KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> sp
 class Kernel {
 public:
   Kernel(const Context& context, const KernelDesc& desc);
+  Kernel(Kernel&&) noexcept = default;
+  // Member-wise assignment would destroy the old descriptor pool before the old sets that are
+  // freed into it; this frees the old objects in reverse order of creation first.
+  Kernel& operator=(Kernel&& other) noexcept;
 
   void bind(std::uint32_t binding, const Buffer& buffer, std::uint32_t set = 0);
   void bind(std::uint32_t binding, const TexelBuffer& buffer, std::uint32_t set = 0);
@@ -56,6 +60,9 @@ public:
   // Creates the pipeline now if its compile was deferred (KernelDesc::deferCompile).
   void compile() const;
   bool compiled() const { return static_cast<bool>(*pipeline_); }
+  // The value of specialisation constant `id` (0 where the kernel does not set it: the default
+  // of every boolean specialisation constant here).
+  std::uint32_t specConstant(std::uint32_t id) const;
 
   const std::string& name() const { return name_; }
   std::uint32_t setCount() const { return static_cast<std::uint32_t>(sets_.size()); }

@@ -100,7 +100,8 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
                            .keptRaySamples = keptRaySamples(context, settings, runSpecular_),
                            .keptShadowRays = keptShadowRays(settings)},
              settings.maxBufferBytes),
-      primary_(context, frame_.layout().bandCount()), shadow_(context, shadingKernels()),
+      compactStack_(sceneBuffers_.fitsCompactStack()),
+      primary_(context, frame_.layout().bandCount(), compactStack_), shadow_(context, shadingKernels()),
       obscurance_(context, shadingKernels()), specularPass_(context, shadingKernels()),
       compose_(context, frame_.layout().bandCount()), tonemap_(context, frame_.layout().bandCount()),
       resolve_(context, frame_.layout().bandCount()), lightMix_(context, frame_.layout().bandCount()),
@@ -288,6 +289,14 @@ void ObscuranceRenderer::reset() {
         cmd.fillBuffer(buffer->handle(), 0, VK_WHOLE_SIZE, 0u);
     }
   });
+}
+
+void ObscuranceRenderer::makeTracingPasses(bool compactStack) {
+  compactStack_ = compactStack;
+  primary_ = PrimaryPass(*context_, frame_.layout().bandCount(), compactStack_);
+  shadow_ = ShadowPass(*context_, shadingKernels());
+  obscurance_ = ObscurancePass(*context_, shadingKernels());
+  specularPass_ = SpecularPass(*context_, shadingKernels());
 }
 
 void ObscuranceRenderer::uploadLights() {
@@ -513,6 +522,12 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
   bool rebind = true;
   if (sameSurfaces) rebind = sceneBuffers_.updateGeometry(edited, bvh);
   else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
+  // Compact-stack kernels could overflow their stack on this BVH (and would miss hits unnoticed):
+  // from now on the general ones.
+  if (compactStack_ && !sceneBuffers_.fitsCompactStack()) {
+    makeTracingPasses(false);
+    rebind = true;
+  }
   if (reflectorsOn()) markReflectors();
   if (rebind || emittersMoved) uploadLights();
   return emittersMoved;

@@ -190,16 +190,41 @@ uvec2 visitPassNode(PassItems it, inout uvec2 group, inout uint triangleBase, in
   return visit.group;
 }
 
-// The register stack: entries e0 (top) .. e7 as (s0.xy, s0.zw, s1.xy, ..., s3.zw); a push or a pop
-// shifts them all (vector selects; an indexed array would be a per-lane gather on lavapipe).
+// A kernel specialised for BVHs within the compact stack's limits (host_device.h,
+// kSpecConstantCompactStack): its register stack cannot overflow, so traverseBvh has no second
+// loop. The default is the general kernel, right for every BVH.
+layout(constant_id = kSpecConstantCompactStack) const bool kCompactStack = false;
+
+// The register stack's capacity in entries.
+const uint kRegisterStackEntries = kCompactStack ? kBvhCompactStack : kBvhRegisterStack;
+
+// The register stack: entries e0 (top) .. e7 as (s0.xy, s0.zw, s1.xy, ..., s3.zw), or compact,
+// e0 .. e15 as s0.x .. s3.w, each entry packed as node index << 16 | group.y (pending and
+// interior masks, 16 bits). A push or a pop shifts them all (vector selects; an indexed array
+// would be a per-lane gather on lavapipe).
 void pushRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uvec4 s3, uvec2 entry) {
-  s3 = uvec4(s2.zw, s3.xy);
-  s2 = uvec4(s1.zw, s2.xy);
-  s1 = uvec4(s0.zw, s1.xy);
-  s0 = uvec4(entry, s0.xy);
+  if (kCompactStack) {
+    s3 = uvec4(s2.w, s3.xyz);
+    s2 = uvec4(s1.w, s2.xyz);
+    s1 = uvec4(s0.w, s1.xyz);
+    s0 = uvec4((entry.x << 16) | entry.y, s0.xyz);
+  } else {
+    s3 = uvec4(s2.zw, s3.xy);
+    s2 = uvec4(s1.zw, s2.xy);
+    s1 = uvec4(s0.zw, s1.xy);
+    s0 = uvec4(entry, s0.xy);
+  }
 }
 
 uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uvec4 s3) {
+  if (kCompactStack) {
+    uint top = s0.x;
+    s0 = uvec4(s0.yzw, s1.x);
+    s1 = uvec4(s1.yzw, s2.x);
+    s2 = uvec4(s2.yzw, s3.x);
+    s3 = uvec4(s3.yzw, 0u);
+    return uvec2(top >> 16, top & 0xFFFFu);
+  }
   uvec2 top = s0.xy;
   s0 = uvec4(s0.zw, s1.xy);
   s1 = uvec4(s1.zw, s2.xy);
@@ -225,7 +250,8 @@ uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uve
 // touches memory. A ray whose stack would grow deeper stops there and is finished by a second
 // loop with an array stack, restarting from the root with the hit found so far (re-testing a
 // triangle never changes the result, so this is exact). That loop costs every 8-lane group one
-// (masked) pass when no ray overflowed.
+// (masked) pass when no ray overflowed; a compact-stack kernel (kCompactStack: 16 packed entries
+// in the same registers, for a BVH that cannot overflow them) has none.
 RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit, uint maxSteps) {
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);
@@ -261,8 +287,8 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
                                      negative, octant, tmin, hit.t);
       if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
-          if (stackSize == kBvhRegisterStack) {
-            overflow = true; // finished by the second loop
+          if (stackSize == kRegisterStackEntries) {
+            overflow = true; // finished by the second loop (never with kCompactStack)
             break;
           }
           pushRegisterStack(s0, s1, s2, s3, group);
@@ -286,6 +312,10 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
   // limiter counts the passes of both loops of the 8-lane group, which ran the first loop for as
   // many passes as its longest ray: an overflowed ray continues counting from there, so the
   // group stays within kMaxTraversalSteps passes in total.
+  //
+  // A compact-stack kernel leaves the second loop out (kCompactStack is a constant): lavapipe runs
+  // a loop's body at least once, masked, even where no lane overflowed.
+  if (kCompactStack) return hit;
   uint groupSteps = subgroupMax(hit.steps);
   if (overflow) hit.steps = groupSteps;
   uvec2 stack[kBvhStackSize];

@@ -12,8 +12,8 @@
 // every branch.
 //
 // The pass is traverseBvh's (bvh.glsl), with its register stack. A ray whose stack would grow
-// deeper than kBvhRegisterStack is put aside and traced again afterwards by traverseBvh, whose
-// second loop has the array stack (rare: exact either way).
+// deeper than the register stack holds is put aside and traced again afterwards by traverseBvh,
+// whose second loop has the array stack (rare: exact either way; never with kCompactStack).
 #ifndef OBSCURA_BVH_STREAM_GLSL
 #define OBSCURA_BVH_STREAM_GLSL
 
@@ -74,7 +74,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
                                      negative, octant, tmin, hit.t);
       if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
-          overflow = stackSize == kBvhRegisterStack;
+          overflow = stackSize == kRegisterStackEntries;
           pushRegisterStack(s0, s1, s2, s3, group);
           stackSize++;
         }

@@ -40,6 +40,14 @@ OBS_CONST uint kBvhMaxDepth = 48;
 OBS_CONST uint kBvhStackSize = 48;
 // Stack entries traversal keeps in registers (shaders/lib/bvh.glsl); deeper stacks take a slower path.
 OBS_CONST uint kBvhRegisterStack = 8;
+// The same registers hold twice as many entries packed into one word each (node index << 16 |
+// pending and interior masks) where the BVH has at most kBvhCompactStackNodes nodes. A traversal
+// pushes at most depth - 2 entries (one per level of interior nodes below the root that still
+// has children to visit), so a BVH within both limits never overflows the register stack and
+// its kernels need no slower path (kSpecConstantCompactStack).
+OBS_CONST uint kBvhCompactStack = 16;
+OBS_CONST uint kBvhCompactStackNodes = 65536;
+OBS_CONST uint kBvhCompactStackMaxDepth = kBvhCompactStack + 2;
 // Wide BVH: up to 8 children per node; a leaf child holds 1..kLeafMaxTriangles triangles.
 OBS_CONST uint kBvhWidth = 8;
 OBS_CONST uint kLeafMaxTriangles = 3u;
@@ -383,6 +391,11 @@ OBS_CONST uint kSpecConstantFlatLightSelection = 8u;
 // kTraceGpuRaysPerLane and kTraceGpuWorkgroupSize, or bench-rays --trace-shape).
 OBS_CONST uint kSpecConstantTraceRaysPerLane = 9u;
 OBS_CONST uint kSpecConstantTraceWorkgroupSize = 10u;
+// The specialisation constant (a bool) of a kernel that only traverses BVHs within the compact
+// stack's limits (kBvhCompactStackNodes, kBvhCompactStackMaxDepth): traverseBvh keeps 16 packed
+// entries in registers and has no second loop. lavapipe runs a loop's body at least once even
+// where no lane enters it, so that loop cost every traversal one full (masked) pass.
+OBS_CONST uint kSpecConstantCompactStack = 11u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

@@ -136,6 +136,49 @@ protected:
   bool secondLamp_ = false; // and its second lamp
 };
 
+// A BVH that outgrows the compact traversal stack in an edit (a rebuild may deepen the tree) is
+// traced by the general kernels from then on. The edit keeps the scene and swaps its BVH for a
+// comb (test_scenes.h) of depth 28, whose every level pushes a stack entry for the camera's rays
+// (along +x): the frame rendered after it is the one before it bit for bit, since no closest hit
+// depends on the BVH. The compact kernels would lose the hits below 16 entries, or be refused
+// when bound to the new BVH.
+TEST_F(GeometryEdit, ABvhThatOutgrowsTheCompactStackIsTracedByTheGeneralKernels) {
+  SceneBuilder b;
+  b.quad({-4, 0, -3}, {0, 0, 6}, {7, 0, 0}, b.glossy(glm::vec3(0.8f), 1.0f, 0.1f)); // floor, faces +y
+  const std::uint32_t light = b.lambertian(glm::vec3(0.7f)), dark = b.lambertian(glm::vec3(0.3f, 0.5f, 0.3f));
+  for (int i = 0; i < 4; ++i) // the far wall at x = 3, faces -x: a checkerboard of 12 quads
+    for (int j = 0; j < 3; ++j)
+      b.quad({3, static_cast<float>(j), -3 + 1.5f * static_cast<float>(i)}, {0, 0, 1.5f}, {0, 1, 0},
+             (i + j) % 2 == 0 ? light : dark);
+  b.quad({0, 2.99f, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f}, b.lambertian(glm::vec3(0.0f), glm::vec3(6.0f)), "lamp");
+  const scene::Scene scene = b.build();
+  const bvh::TriangleSoup soup = render::triangleSoup(scene);
+  const bvh::Bvh built = bvh::build(soup), comb = combBvh(soup);
+  ASSERT_TRUE(bvh::fitsCompactStack(built));
+  ASSERT_EQ(comb.stats.maxDepth, 28u);
+  ASSERT_FALSE(bvh::fitsCompactStack(comb));
+
+  render::ObscuranceSettings settings = editSettings();
+  settings.camera = lookCamera({-3, 1.5f, 0}, glm::normalize(glm::vec3(1, -0.2f, 0)), {0, 1, 0}, 0.9f);
+  render::ObscuranceRenderer r(context(), scene, built, settings);
+  EXPECT_TRUE(r.tracesWithCompactStack());
+  r.render();
+  const io::Image before = r.image();
+  r.updateGeometry(scene, comb, {});
+  EXPECT_FALSE(r.tracesWithCompactStack());
+  r.render();
+  const io::Image after = r.image();
+  EXPECT_EQ(r.stats().truncatedTraversals, 0u);
+  for (const char* channel : {"direct.R", "obscurance.Y", "specular.G", "depth.Z", "combined.B"}) {
+    const int c = before.channelIndex(channel);
+    std::size_t differ = 0;
+    for (int y = 0; y < before.height; ++y)
+      for (int x = 0; x < before.width; ++x)
+        if (std::bit_cast<std::uint32_t>(before.at(x, y, c)) != std::bit_cast<std::uint32_t>(after.at(x, y, c))) ++differ;
+    EXPECT_EQ(differ, 0u) << channel << ": pixels that differ after the edit";
+  }
+}
+
 TEST_F(GeometryEdit, MovedOccluderMatchesAFullRenderAndItsShadowIsRetraced) {
   // Near the lamp: its shadow on the floor lies far below its screen footprint.
   const std::uint64_t retraced = moveAndCompare({-0.8f, 2.5f, 0.0f}, {0.8f, 2.5f, 0.0f}, 0.5f);

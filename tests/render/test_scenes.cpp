@@ -1,8 +1,11 @@
 #include "render/test_scenes.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <thread>
 
+#include "bvh/wide_node.h"
 #include "shared/host_device.h"
 
 namespace obscura::test {
@@ -122,6 +125,44 @@ scene::Camera lookCamera(glm::vec3 position, glm::vec3 forward, glm::vec3 up, fl
   c.up = glm::normalize(up);
   c.yfov = yfov;
   return c;
+}
+
+bvh::Bvh combBvh(const bvh::TriangleSoup& soup) {
+  const auto n = static_cast<std::uint32_t>(soup.size());
+  const std::uint32_t levels = n - 1; // spine nodes with a rib
+  bvh::Box all;
+  for (std::size_t i = 0; i < soup.size(); ++i)
+    for (const glm::vec3& p : {soup.v0[i], soup.v1[i], soup.v2[i]}) all.grow(p);
+  // Node indices: spine k at 2k - 1 (the root is 0), rib k at 2k + 2.
+  bvh::Bvh tree;
+  tree.nodes.resize(2 * levels + 1);
+  auto oneLeaf = [&] {
+    std::array<bvh::WideChild, gpu::kBvhWidth> slots{};
+    slots[0] = {.kind = bvh::WideChild::Kind::Leaf, .box = all, .triangleOffset = 0, .triangleCount = 1};
+    return slots;
+  };
+  for (std::uint32_t k = 0; k <= levels; ++k) {
+    const std::uint32_t spine = k == 0 ? 0 : 2 * k - 1;
+    if (k == levels) {
+      bvh::writeWideNode(tree.nodes[spine], oneLeaf(), 0, levels);
+      continue;
+    }
+    std::array<bvh::WideChild, gpu::kBvhWidth> slots{};
+    slots[0] = {.kind = bvh::WideChild::Kind::Internal, .box = all};
+    slots[1] = {.kind = bvh::WideChild::Kind::Internal, .box = all};
+    bvh::writeWideNode(tree.nodes[spine], slots, 2 * k + 1, 0);
+    bvh::writeWideNode(tree.nodes[2 * k + 2], oneLeaf(), 0, k);
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    tree.order.push_back(i);
+    tree.triangles.push_back({.v0 = glm::vec4(soup.v0[i], std::bit_cast<float>(i)),
+                              .v1 = glm::vec4(soup.v1[i], 0.0f),
+                              .v2 = glm::vec4(soup.v2[i], 0.0f)});
+  }
+  tree.stats.nodeCount = 2 * levels + 1;
+  tree.stats.leafCount = n;
+  tree.stats.maxDepth = n;
+  return tree;
 }
 
 } // namespace obscura::test

@@ -33,6 +33,12 @@ scene::Scene soupScene(const bvh::TriangleSoup& soup);
 // The oracle of the traversal tests: brute force over every triangle, on all cores.
 std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vector<gpu::GpuRay>& rays);
 
+// A wide BVH built by hand over `soup` (n >= 2 triangles, every box the whole soup's), in which
+// a ray along +x pushes one stack entry per level: "spine" node k has the next spine node in
+// slot 0 and a "rib" node in slot 1, rib k holds triangle k, and the last spine node (depth
+// n - 1) triangle n - 1. Depth n, 2n - 1 nodes, triangles in soup order.
+bvh::Bvh combBvh(const bvh::TriangleSoup& soup);
+
 // A camera at `position` looking along `forward` with the given vertical field of view.
 scene::Camera lookCamera(glm::vec3 position, glm::vec3 forward, glm::vec3 up, float yfov);
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <optional>
 #include <random>
+#include <stdexcept>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -199,10 +200,9 @@ TEST_F(GpuTraversal, LongTraversalIsReportedNotTruncatedSilently) {
 }
 
 // Stacks deeper than the registers hold (gpu::kBvhRegisterStack) take the second, array-stack
-// loop of shaders/lib/bvh.glsl. A wide tree built by hand makes every level push: "spine" node k
-// has the next spine node in slot 0 and a "rib" node in slot 1, every box spans the whole scene,
-// so a ray along +x descends the spine first and leaves one rib group per level on the stack.
-// Ribs hold triangles that miss the x axis; the spine ends in the one triangle the rays hit.
+// loop of shaders/lib/bvh.glsl. combBvh (test_scenes.h) makes every level push: a ray along +x
+// descends the spine first and leaves one rib group per level on the stack. Ribs hold triangles
+// that miss the x axis; the spine ends in the one triangle the rays hit.
 struct Comb {
   bvh::TriangleSoup soup;
   bvh::Bvh tree;
@@ -220,63 +220,29 @@ Comb comb(std::uint32_t levels) {
     add({x, -0.9f, 1.1f}, {x, 1.1f, 1.1f}, {x, 1.1f, -0.9f}); // rib k: misses the axis
   }
   add({levels + 5.0f, -1.0f, -1.0f}, {levels + 5.0f, 3.0f, -1.0f}, {levels + 5.0f, -1.0f, 3.0f});
-  bvh::Box all;
-  for (std::size_t i = 0; i < c.soup.size(); ++i)
-    for (const glm::vec3& p : {c.soup.v0[i], c.soup.v1[i], c.soup.v2[i]}) all.grow(p);
-  // Node indices: spine k at 2k - 1 (the root is 0), rib k at 2k + 2; triangles in the order the
-  // leaves are written: rib k's triangle is k, the spine's end is `levels`.
-  const std::uint32_t nodes = 2 * levels + 1;
-  c.tree.nodes.resize(nodes);
-  auto leaf = [&](std::uint32_t triangle) {
-    std::array<bvh::WideChild, gpu::kBvhWidth> slots{};
-    slots[0] = {.kind = bvh::WideChild::Kind::Leaf, .box = all, .triangleOffset = 0, .triangleCount = 1};
-    return std::pair{slots, triangle};
-  };
-  for (std::uint32_t k = 0; k <= levels; ++k) {
-    const std::uint32_t spine = k == 0 ? 0 : 2 * k - 1;
-    if (k == levels) {
-      auto [slots, t] = leaf(levels);
-      bvh::writeWideNode(c.tree.nodes[spine], slots, 0, t);
-      continue;
-    }
-    std::array<bvh::WideChild, gpu::kBvhWidth> slots{};
-    slots[0] = {.kind = bvh::WideChild::Kind::Internal, .box = all};
-    slots[1] = {.kind = bvh::WideChild::Kind::Internal, .box = all};
-    bvh::writeWideNode(c.tree.nodes[spine], slots, 2 * k + 1, 0);
-    auto [ribSlots, t] = leaf(k);
-    bvh::writeWideNode(c.tree.nodes[2 * k + 2], ribSlots, 0, t);
-  }
-  for (std::uint32_t i = 0; i < c.soup.size(); ++i) {
-    c.tree.order.push_back(i);
-    c.tree.triangles.push_back({.v0 = glm::vec4(c.soup.v0[i], std::bit_cast<float>(i)),
-                                .v1 = glm::vec4(c.soup.v1[i], 0.0f),
-                                .v2 = glm::vec4(c.soup.v2[i], 0.0f)});
-  }
-  c.tree.stats.nodeCount = nodes;
-  c.tree.stats.leafCount = levels + 1;
-  c.tree.stats.maxDepth = levels + 1;
+  c.tree = combBvh(c.soup);
   return c;
 }
 
-TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
-  const std::uint32_t levels = 20;
-  static_assert(20 > gpu::kBvhRegisterStack + 2 && 20 < gpu::kBvhStackSize);
-  Comb c = comb(levels);
-  scene::Scene s = soupScene(c.soup);
-  render::SceneBuffers buffers(context(), s, c.tree);
-  render::RayTracer tracer(context(), buffers);
+// Rays along +x through the comb's spine (jittered within the ribs' gap).
+std::vector<gpu::GpuRay> combRays() {
   std::vector<gpu::GpuRay> rays;
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> jitter(-0.05f, 0.05f);
   for (int i = 0; i < 64; ++i)
     rays.push_back({glm::vec4(0.5f, jitter(rng), jitter(rng), 0.0f), glm::vec4(1.0f, 0.0f, 0.0f, INFINITY)});
+  return rays;
+}
+
+// The comb's closest hits match the brute force (the spine's last triangle), its any hits end at
+// that triangle's plane; returns each ray's loop passes.
+std::vector<std::uint32_t> expectCombHits(render::RayTracer& tracer, const Comb& c, std::uint32_t levels) {
+  std::vector<gpu::GpuRay> rays = combRays();
   auto result = tracer.trace(rays, render::TraceMode::Closest, true);
   auto cpu = bruteForce(c.soup, rays);
   for (std::size_t i = 0; i < rays.size(); ++i) {
     EXPECT_EQ(result.hits[i].primitive, cpu[i].primitive) << i;
     EXPECT_EQ(result.hits[i].t, cpu[i].t) << i;
-    // Every node is visited: the spine and the ribs (the overflow restarts from the root).
-    EXPECT_GE(result.steps[i], 2 * levels) << i;
   }
   EXPECT_EQ(result.hits[0].primitive, levels);
   // Any hit: not occluded short of the last triangle's plane, occluded beyond it.
@@ -288,7 +254,46 @@ TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
     EXPECT_EQ(blocked.hits[i].primitive, gpu::kInvalidIndex) << i;
     EXPECT_EQ(open.hits[i].primitive, levels) << i;
   }
+  return result.steps;
+}
+
+TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
+  const std::uint32_t levels = 20;
+  static_assert(20 > gpu::kBvhCompactStackMaxDepth && 20 < gpu::kBvhStackSize);
+  Comb c = comb(levels);
+  scene::Scene s = soupScene(c.soup);
+  render::SceneBuffers buffers(context(), s, c.tree);
+  ASSERT_FALSE(buffers.fitsCompactStack());
+  render::RayTracer tracer(context(), buffers);
+  const std::vector<std::uint32_t> steps = expectCombHits(tracer, c, levels);
+  // Every node is visited: the spine and the ribs (the overflow restarts from the root).
+  for (std::size_t i = 0; i < steps.size(); ++i) EXPECT_GE(steps[i], 2 * levels) << i;
   EXPECT_EQ(buffers.truncatedTraversals(), 0u);
+}
+
+// The compact stack (kSpecConstantCompactStack) has no second loop: the deepest BVH it accepts
+// must never overflow it. The comb of that depth pushes one entry per level below the root,
+// kBvhCompactStackMaxDepth - 2 = kBvhCompactStack in all, and still finds every hit, through
+// trace.comp's refilling loop and through traverseBvh (one ray per invocation, as the passes
+// trace). One level deeper does not fit, and a compact kernel refuses that BVH.
+TEST_F(GpuTraversal, CompactStackHoldsTheDeepestBvhItAccepts) {
+  const std::uint32_t levels = gpu::kBvhCompactStackMaxDepth - 1;
+  Comb c = comb(levels);
+  ASSERT_EQ(c.tree.stats.maxDepth, gpu::kBvhCompactStackMaxDepth);
+  scene::Scene s = soupScene(c.soup);
+  render::SceneBuffers buffers(context(), s, c.tree);
+  ASSERT_TRUE(buffers.fitsCompactStack());
+  for (const render::TraceShape shape : {render::TraceShape::forCpu(), render::TraceShape{128, 1}}) {
+    render::RayTracer tracer(context(), buffers, shape, true);
+    expectCombHits(tracer, c, levels);
+  }
+  EXPECT_EQ(buffers.truncatedTraversals(), 0u);
+
+  Comb deeper = comb(levels + 1);
+  scene::Scene deeperScene = soupScene(deeper.soup);
+  render::SceneBuffers deeperBuffers(context(), deeperScene, deeper.tree);
+  EXPECT_FALSE(deeperBuffers.fitsCompactStack());
+  EXPECT_THROW(render::RayTracer(context(), deeperBuffers, {}, true), std::logic_error);
 }
 
 class LoopLimiter : public GpuTest {};

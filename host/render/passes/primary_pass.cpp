@@ -22,20 +22,24 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 namespace {
 // Variant `v`: bit 0 the AOV accumulators, bit 1 the emission rays. Compiled on first use (a render
 // dispatches one or two of the four; each is an LLVM compile of the shader on lavapipe).
-gpu::KernelDesc primaryKernelDesc(std::uint32_t bands, std::uint32_t v) {
+gpu::KernelDesc primaryKernelDesc(std::uint32_t bands, std::uint32_t v, bool compactStack) {
   auto bindings = sceneBindingKinds();
   bindings.insert(bindings.end(), gpu::kPrimaryBindingCount - gpu::kSceneBindingCount,
                   gpu::BindingKind::StorageBuffer);
   return {.name = "primary", .spirv = kSpirv_primary, .bindings = bindings,
           .pushConstantBytes = sizeof(gpu::PrimaryPush),
-          .specConstants = {{gpu::kSpecConstantPrimaryAovs, v & 1u}, {gpu::kSpecConstantEmissionRays, (v >> 1) & 1u}},
+          .specConstants = {{gpu::kSpecConstantPrimaryAovs, v & 1u},
+                            {gpu::kSpecConstantEmissionRays, (v >> 1) & 1u},
+                            {gpu::kSpecConstantCompactStack, compactStack ? 1u : 0u}},
           .setCount = bands, .deferCompile = true};
 }
 } // namespace
 
-PrimaryPass::PrimaryPass(const gpu::Context& context, std::uint32_t bands)
-    : kernels_{gpu::Kernel(context, primaryKernelDesc(bands, 0u)), gpu::Kernel(context, primaryKernelDesc(bands, 1u)),
-               gpu::Kernel(context, primaryKernelDesc(bands, 2u)), gpu::Kernel(context, primaryKernelDesc(bands, 3u))} {}
+PrimaryPass::PrimaryPass(const gpu::Context& context, std::uint32_t bands, bool compactStack)
+    : kernels_{gpu::Kernel(context, primaryKernelDesc(bands, 0u, compactStack)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 1u, compactStack)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 2u, compactStack)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 3u, compactStack))} {}
 
 const gpu::Kernel& PrimaryPass::kernelFor(std::uint32_t flags) const {
   const bool sums = (flags & gpu::kPrimaryFlagGBufferOnly) == 0;

@@ -19,7 +19,9 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 
 class PrimaryPass {
 public:
-  PrimaryPass(const gpu::Context& context, std::uint32_t bands);
+  // `compactStack`: the kernels are specialised for a BVH that fits the compact traversal stack
+  // (SceneBuffers::fitsCompactStack).
+  PrimaryPass(const gpu::Context& context, std::uint32_t bands, bool compactStack);
 
   // Binds band `band`'s descriptor set: the scene, the frame's status counters and band buffers,
   // and the lights' render-time emission scales (which make M_s unit).

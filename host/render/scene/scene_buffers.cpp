@@ -3,6 +3,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <cstring>
 
 #include <fmt/core.h>
@@ -115,7 +116,7 @@ void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char
 } // namespace
 
 SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh)
-    : context_(&context) {
+    : context_(&context), fitsCompactStack_(bvh::fitsCompactStack(bvh)) {
   using Usage = vk::BufferUsageFlagBits;
   auto items = bvhTexels(bvh);
   checkTexelLimit(context, items.size(), "BVH nodes and triangles");
@@ -162,6 +163,7 @@ bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh
   auto shading = shadingData(scene, reflectors_);
   const std::size_t itemBytes = items.size() * sizeof(gpu::vec4);
   const std::size_t shadingBytes = shading.size() * sizeof(gpu::TriangleShading);
+  fitsCompactStack_ = bvh::fitsCompactStack(bvh);
   if (itemBytes == items_.buffer().size() && shadingBytes == shading_.size()) {
     items_.upload(*context_, items.data(), itemBytes);
     shading_.upload(*context_, shading);
@@ -177,6 +179,9 @@ bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh
 }
 
 void SceneBuffers::bindTo(gpu::Kernel& kernel, std::uint32_t set, const gpu::Buffer* status) const {
+  if (kernel.specConstant(gpu::kSpecConstantCompactStack) != 0 && !fitsCompactStack_)
+    throw std::logic_error(fmt::format("kernel '{}' is specialised for the compact traversal stack, which this "
+                                       "scene's BVH does not fit", kernel.name()));
   kernel.bind(gpu::kBindingBvhItems, items_, set);
   kernel.bind(gpu::kBindingShading, shading_, set);
   kernel.bind(gpu::kBindingMaterials, materials_, set);
