@@ -216,6 +216,17 @@ void pushRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uve
   }
 }
 
+// Whether the register stack is empty: stackSize entries, or, compact, a zero top entry (an entry
+// is never 0, its pending mask being non-empty; a pop shifts in zeros), which needs no counter.
+bool registerStackEmpty(uint stackSize, uvec4 s0) {
+  return kCompactStack ? s0.x == 0u : stackSize == 0u;
+}
+
+// Whether a push would overflow the register stack (never where kCompactStack).
+bool registerStackFull(uint stackSize) {
+  return !kCompactStack && stackSize == kRegisterStackEntries;
+}
+
 uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uvec4 s3) {
   if (kCompactStack) {
     uint top = s0.x;
@@ -287,8 +298,8 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
                                      negative, octant, tmin, hit.t);
       if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
-          if (stackSize == kRegisterStackEntries) {
-            overflow = true; // finished by the second loop (never with kCompactStack)
+          if (registerStackFull(stackSize)) {
+            overflow = true; // finished by the second loop
             break;
           }
           pushRegisterStack(s0, s1, s2, s3, group);
@@ -298,7 +309,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
       }
     }
     if ((group.y & 0xFFu) == 0u) {
-      if (stackSize == 0u) {
+      if (registerStackEmpty(stackSize, s0)) {
         if (triangleBits == 0u) break;
       } else { // the pop site
         group = popRegisterStack(s0, s1, s2, s3);

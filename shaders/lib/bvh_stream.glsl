@@ -52,6 +52,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       triangleBits = 0u;
       queuedBits = 0u;
       stackSize = 0u;
+      s0.x = 0u; // the compact stack's "empty"
       needRay = false;
     }
     // Out of passes: this ray ends as truncated, and so will the lane's next ones, without a pass.
@@ -62,6 +63,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       queuedBits = 0u;
       group.y = 0u;
       stackSize = 0u;
+      s0.x = 0u;
     } else {
       laneSteps++;
       hit.steps++;
@@ -74,7 +76,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
                                      negative, octant, tmin, hit.t);
       if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
-          overflow = stackSize == kRegisterStackEntries;
+          overflow = registerStackFull(stackSize);
           pushRegisterStack(s0, s1, s2, s3, group);
           stackSize++;
         }
@@ -82,7 +84,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       }
     }
     if ((group.y & 0xFFu) == 0u) {
-      if (stackSize == 0u) {
+      if (registerStackEmpty(stackSize, s0)) {
         done = done || triangleBits == 0u;
       } else { // the pop site
         group = popRegisterStack(s0, s1, s2, s3);
