@@ -3,19 +3,18 @@
 #ifndef OBSCURA_INTERSECT_GLSL
 #define OBSCURA_INTERSECT_GLSL
 
-// Per-ray constants of the watertight test, in matrix form: row i of the shear maps a vertex
-// relative to the origin into the ray's sheared space. The rows hold one 1, one -S and one 0, so
-// (x*r.x + y*r.y) + z*r.z rounds exactly like the CPU's a[kx] - Sx*a[kz] (multiplying by 1 or
-// 0 and adding 0 are exact), without dynamically indexed components, which are per-lane
-// gathers on lavapipe.
+// Per-ray constants of the watertight test: the axes kx, ky, kz packed in one word and the shear
+// (Sx, Sy, Sz), as the CPU keeps them. Six floats fewer than the shear as three matrix rows: on
+// lavapipe every live value of the traversal loop is a register per lane, and spills are a
+// quarter of a pass.
 struct WatertightRay {
   vec3 origin;
-  vec3 rowX;   // e_kx - Sx e_kz
-  vec3 rowY;   // e_ky - Sy e_kz
-  vec3 rowZ;   // Sz e_kz
+  vec3 shear; // Sx, Sy, Sz
+  uint axes;  // kx | ky << 2 | kz << 4
 };
 
-vec3 axisVector(int k) { return vec3(k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0); }
+// Component k of v by selects (a dynamically indexed component is a per-lane gather on lavapipe).
+float axisComponent(vec3 v, uint k) { return k == 0u ? v.x : (k == 1u ? v.y : v.z); }
 
 // Woop, Benthin & Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013 ([WBW]):
 // kz = the axis of largest |d| (the lowest one on ties, as on the CPU), kx/ky the next two
@@ -23,26 +22,28 @@ vec3 axisVector(int k) { return vec3(k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k =
 // Sz = 1/d[kz].
 WatertightRay prepareWatertightRay(vec3 origin, vec3 direction) {
   vec3 a = abs(direction);
-  int kz = 0;
-  if (a.y > a[kz]) kz = 1;
-  if (a.z > a[kz]) kz = 2;
-  int kx = kz == 2 ? 0 : kz + 1;
-  int ky = kx == 2 ? 0 : kx + 1;
-  float dz = direction[kz];
-  if (dz < 0.0) { int tmp = kx; kx = ky; ky = tmp; }
+  uint kz = 0u;
+  if (a.y > axisComponent(a, kz)) kz = 1u;
+  if (a.z > axisComponent(a, kz)) kz = 2u;
+  uint kx = kz == 2u ? 0u : kz + 1u;
+  uint ky = kx == 2u ? 0u : kx + 1u;
+  float dz = axisComponent(direction, kz);
+  if (dz < 0.0) { uint tmp = kx; kx = ky; ky = tmp; }
   WatertightRay r;
   r.origin = origin;
-  r.rowX = axisVector(kx) - (direction[kx] / dz) * axisVector(kz);
-  r.rowY = axisVector(ky) - (direction[ky] / dz) * axisVector(kz);
-  r.rowZ = (1.0 / dz) * axisVector(kz);
+  r.shear = vec3(axisComponent(direction, kx) / dz, axisComponent(direction, ky) / dz, 1.0 / dz);
+  r.axes = kx | (ky << 2) | (kz << 4);
   return r;
 }
 
-// Row times vector with a fixed, unfused evaluation order (see WatertightRay).
-float shearRow(vec3 row, vec3 p) {
-  precise float xy = p.x * row.x + p.y * row.y;
-  precise float r = xy + p.z * row.z;
-  return r;
+// The sheared x, y (and scaled z) of a vertex relative to the origin: p[kx] - Sx p[kz],
+// p[ky] - Sy p[kz], Sz p[kz], rounded as on the CPU (`precise`: no fused multiply-add).
+vec3 shearVertex(WatertightRay r, vec3 p) {
+  float pz = axisComponent(p, r.axes >> 4);
+  precise float x = axisComponent(p, r.axes & 3u) - r.shear.x * pz;
+  precise float y = axisComponent(p, (r.axes >> 2) & 3u) - r.shear.y * pz;
+  precise float z = r.shear.z * pz;
+  return vec3(x, y, z);
 }
 
 // a*b - c*d with its exact sign: when the float difference rounds to 0, the difference of the
@@ -93,9 +94,8 @@ bool intersectTriangle(WatertightRay r, vec3 p0, vec3 p1, vec3 p2, float tmin, f
   precise vec3 A = p0 - r.origin;
   precise vec3 B = p1 - r.origin;
   precise vec3 C = p2 - r.origin;
-  float Ax = shearRow(r.rowX, A), Ay = shearRow(r.rowY, A);
-  float Bx = shearRow(r.rowX, B), By = shearRow(r.rowY, B);
-  float Cx = shearRow(r.rowX, C), Cy = shearRow(r.rowY, C);
+  vec3 a = shearVertex(r, A), b = shearVertex(r, B), c = shearVertex(r, C);
+  float Ax = a.x, Ay = a.y, Bx = b.x, By = b.y, Cx = c.x, Cy = c.y;
   // Scaled barycentrics: U weighs v0 (edge v1-v2), V weighs v1, W weighs v2 [WBW §3.2].
   float U = edgeFunction(Cx, By, Cy, Bx);
   float V = edgeFunction(Ax, Cy, Ay, Cx);
@@ -106,7 +106,7 @@ bool intersectTriangle(WatertightRay r, vec3 p0, vec3 p1, vec3 p2, float tmin, f
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   precise float det = U + V + W;
   if (det == 0.0) return false;
-  float Az = shearRow(r.rowZ, A), Bz = shearRow(r.rowZ, B), Cz = shearRow(r.rowZ, C);
+  float Az = a.z, Bz = b.z, Cz = c.z;
   precise float T = (U * Az + V * Bz) + W * Cz;
   // Divide, then test the rounded t (not T against tmax*det): acceptance then depends on the
   // (ray, triangle) pair alone, not on the order in which a traversal tightened tmax.
@@ -115,8 +115,7 @@ bool intersectTriangle(WatertightRay r, vec3 p0, vec3 p1, vec3 p2, float tmin, f
   v = W / det;
   // A t that rounding could have made positive is no hit [PBR3 §3.9.5]: for a huge triangle the
   // error of t grows with its vertices, so the origin offset of a secondary ray cannot cover it.
-  // |Sz|: rowZ holds Sz in one component and exact zeros elsewhere.
-  float zScale = max(max(abs(r.rowZ.x), abs(r.rowZ.y)), abs(r.rowZ.z));
+  float zScale = abs(r.shear.z);
   float tError = triangleTError(Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz, U, V, W, det, zScale);
   return t > tmin && t > tError && t <= tmax;
 }
