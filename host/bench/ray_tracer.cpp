@@ -9,7 +9,7 @@
 namespace obscura::render {
 
 namespace {
-gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, bool compactStack) {
+gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::uint32_t compactStackVectors) {
   auto bindings = sceneBindingKinds();
   // rays (two RGBA32F texels each), hits (one RGBA32F texel each), steps (R32UI): texel views,
   // which lavapipe reads and writes a texel per lane at a time (an SSBO: a word per lane at a time).
@@ -22,7 +22,7 @@ gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, bool 
           .specConstants = {{gpu::kSpecConstantTraceSteps, recordSteps ? 1u : 0u},
                             {gpu::kSpecConstantTraceRaysPerLane, shape.raysPerLane},
                             {gpu::kSpecConstantTraceWorkgroupSize, shape.workgroupSize},
-                            {gpu::kSpecConstantCompactStack, compactStack ? 1u : 0u}},
+                            {gpu::kSpecConstantCompactStack, compactStackVectors}},
           .deferCompile = recordSteps};
 }
 } // namespace
@@ -32,10 +32,10 @@ TraceShape TraceShape::forDevice(const gpu::Context& context) {
 }
 
 RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape,
-                     std::optional<bool> compactStack)
+                     std::optional<std::uint32_t> compactStackVectors)
     : context_(&context), shape_(shape.value_or(TraceShape::forDevice(context))),
-      kernel_(context, traceKernelDesc(shape_, false, compactStack.value_or(scene.fitsCompactStack()))),
-      stepsKernel_(context, traceKernelDesc(shape_, true, compactStack.value_or(scene.fitsCompactStack()))),
+      kernel_(context, traceKernelDesc(shape_, false, compactStackVectors.value_or(scene.compactStackVectors()))),
+      stepsKernel_(context, traceKernelDesc(shape_, true, compactStackVectors.value_or(scene.compactStackVectors()))),
       timestamps_(context) {
   scene.bindTo(kernel_);
   scene.bindTo(stepsKernel_);

@@ -34,11 +34,11 @@ struct TraceShape {
 class RayTracer {
 public:
   // `shape` defaults to the device's (TraceShape::forDevice); a test may force either.
-  // `compactStack` (the kernel specialised for the compact traversal stack) defaults to whether
-  // the scene's BVH fits it; a test may force the general kernel, or the compact one (which
-  // throws where the BVH does not fit).
+  // `compactStackVectors` (kSpecConstantCompactStack) defaults to what the scene's BVH needs; a
+  // test may force the general kernel (0) or any compact stack (which throws where the BVH
+  // could overflow it).
   RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape = {},
-            std::optional<bool> compactStack = {});
+            std::optional<std::uint32_t> compactStackVectors = {});
   const TraceShape& shape() const { return shape_; }
 
   TraceResult trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps = false);

@@ -596,8 +596,10 @@ private:
 
 } // namespace
 
-bool fitsCompactStack(const Bvh& bvh) {
-  return bvh.nodes.size() <= gpu::kBvhCompactStackNodes && bvh.stats.maxDepth <= gpu::kBvhCompactStackMaxDepth;
+std::uint32_t compactStackVectors(const Bvh& bvh) {
+  if (bvh.nodes.size() > gpu::kBvhCompactStackNodes || bvh.stats.maxDepth > gpu::kBvhCompactStackMaxDepth) return 0;
+  const std::uint32_t entries = bvh.stats.maxDepth > 2 ? bvh.stats.maxDepth - 2 : 0;
+  return std::max(1u, (entries + 3) / 4);
 }
 
 Bvh build(const TriangleSoup& soup, const BuildOptions& options) {

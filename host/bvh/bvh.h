@@ -61,10 +61,15 @@ struct Bvh {
 // gives a root with two empty children.
 Bvh build(const TriangleSoup& soup, const BuildOptions& options = {});
 
-// Whether no traversal of `bvh` can overflow the compact register stack (shared/host_device.h:
-// at most kBvhCompactStackNodes nodes and depth kBvhCompactStackMaxDepth), so that kernels
-// specialised with kSpecConstantCompactStack may trace it.
-bool fitsCompactStack(const Bvh& bvh);
+// The uvec4 registers of compact stack (shared/host_device.h) that no traversal of `bvh` can
+// overflow: ceil((depth - 2) / 4), at least 1; 0 where `bvh` is beyond the compact stack's limits
+// (more than kBvhCompactStackNodes nodes, or deeper than kBvhCompactStackMaxDepth).
+std::uint32_t compactStackVectors(const Bvh& bvh);
+// Whether a kernel specialised with `kernelVectors` (kSpecConstantCompactStack; 0: the general
+// kernel) may trace a BVH that needs `needed` (compactStackVectors).
+inline bool compactStackHolds(std::uint32_t kernelVectors, std::uint32_t needed) {
+  return kernelVectors == 0 || (needed != 0 && kernelVectors >= needed);
+}
 
 // Refits `bvh` to the moved vertices of the same triangles (`soup` indexed as when it was built):
 // the tree keeps its topology, every box is recomputed bottom-up and quantised again. Linear in the size, so an object

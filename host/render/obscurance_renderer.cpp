@@ -100,8 +100,8 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
                            .keptRaySamples = keptRaySamples(context, settings, runSpecular_),
                            .keptShadowRays = keptShadowRays(settings)},
              settings.maxBufferBytes),
-      compactStack_(sceneBuffers_.fitsCompactStack()),
-      primary_(context, frame_.layout().bandCount(), compactStack_), shadow_(context, shadingKernels()),
+      compactStackVectors_(sceneBuffers_.compactStackVectors()),
+      primary_(context, frame_.layout().bandCount(), compactStackVectors_), shadow_(context, shadingKernels()),
       obscurance_(context, shadingKernels()), specularPass_(context, shadingKernels()),
       compose_(context, frame_.layout().bandCount()), tonemap_(context, frame_.layout().bandCount()),
       resolve_(context, frame_.layout().bandCount()), lightMix_(context, frame_.layout().bandCount()),
@@ -291,9 +291,9 @@ void ObscuranceRenderer::reset() {
   });
 }
 
-void ObscuranceRenderer::makeTracingPasses(bool compactStack) {
-  compactStack_ = compactStack;
-  primary_ = PrimaryPass(*context_, frame_.layout().bandCount(), compactStack_);
+void ObscuranceRenderer::makeTracingPasses(std::uint32_t compactStackVectors) {
+  compactStackVectors_ = compactStackVectors;
+  primary_ = PrimaryPass(*context_, frame_.layout().bandCount(), compactStackVectors_);
   shadow_ = ShadowPass(*context_, shadingKernels());
   obscurance_ = ObscurancePass(*context_, shadingKernels());
   specularPass_ = SpecularPass(*context_, shadingKernels());
@@ -522,10 +522,10 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
   bool rebind = true;
   if (sameSurfaces) rebind = sceneBuffers_.updateGeometry(edited, bvh);
   else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
-  // Compact-stack kernels could overflow their stack on this BVH (and would miss hits unnoticed):
-  // from now on the general ones.
-  if (compactStack_ && !sceneBuffers_.fitsCompactStack()) {
-    makeTracingPasses(false);
+  // Compact-stack kernels could overflow their stack on a deeper BVH (and would miss hits
+  // unnoticed): the passes are made again for what this one needs (0: the general stack).
+  if (!bvh::compactStackHolds(compactStackVectors_, sceneBuffers_.compactStackVectors())) {
+    makeTracingPasses(sceneBuffers_.compactStackVectors());
     rebind = true;
   }
   if (reflectorsOn()) markReflectors();

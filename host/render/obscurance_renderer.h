@@ -230,19 +230,20 @@ public:
   std::uint32_t secondaryReflectors() const { return reflectorsMarked_; }
   // Bytes of device memory held: scene, lights and frame (the real allocations).
   std::uint64_t deviceBytes() const;
-  // Whether the tracing passes run the compact-stack kernels (the scene's BVH fits that stack).
-  bool tracesWithCompactStack() const { return compactStack_; }
+  // The compact traversal stack the tracing passes' kernels keep (0: the general stack).
+  std::uint32_t compactStackVectors() const { return compactStackVectors_; }
 
 private:
   // What the shading passes' kernels are specialised for: the frame's bands, the flat light
   // selection where this render can take no other, and the compact stack (settings_, frame_ and
-  // compactStack_ are made first).
+  // compactStackVectors_ are made first).
   ShadingSpecialisation shadingKernels() const {
     return shadingSpecialisation(frame_.layout().bandCount(), settings_.lightSampling == LightSampling::Spatial,
-                                 frame_.lightCapacity(), compactStack_);
+                                 frame_.lightCapacity(), compactStackVectors_);
   }
-  // Makes the tracing passes again, specialised for the compact stack or not (bind them after).
-  void makeTracingPasses(bool compactStack);
+  // Makes the tracing passes again for a compact stack of that many vectors, or the general one
+  // (0); bind them after.
+  void makeTracingPasses(std::uint32_t compactStackVectors);
   void uploadLights();
   // The Reached ambient model: what every light reaches in `scene`. After a geometry edit that
   // kept the lights, `changed` (the edited objects' old and new boxes) lets each light re-trace
@@ -335,9 +336,9 @@ private:
   std::size_t bvhNodes_ = 0;            // ...after this many nodes
 
   // Passes. Those that trace (primary to specular) are specialised for the compact traversal stack
-  // where the scene's BVH fits it (compactStack_); an edit whose BVH outgrows it makes them again
-  // with the general kernels (makeTracingPasses).
-  bool compactStack_ = false;
+  // the scene's BVH needs (compactStackVectors_; 0: the general stack); an edit whose BVH
+  // outgrows it makes them again (makeTracingPasses).
+  std::uint32_t compactStackVectors_ = 0;
   PrimaryPass primary_;
   ShadowPass shadow_;
   ObscurancePass obscurance_;

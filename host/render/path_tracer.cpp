@@ -19,12 +19,12 @@ using Usage = vk::BufferUsageFlagBits;
 using Clock = std::chrono::steady_clock;
 constexpr std::uint64_t kAccumulator = gpu::kAccumulatorVec4s * sizeof(glm::vec4);
 
-gpu::KernelDesc pathKernelDesc(std::uint32_t bands, bool compactStack) {
+gpu::KernelDesc pathKernelDesc(std::uint32_t bands, std::uint32_t compactStackVectors) {
   auto bindings = sceneBindingKinds();
   bindings.insert(bindings.end(), gpu::kPathBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
   return {.name = "pathtrace", .spirv = kSpirv_pathtrace, .bindings = bindings,
           .pushConstantBytes = sizeof(gpu::PathPush),
-          .specConstants = {{gpu::kSpecConstantCompactStack, compactStack ? 1u : 0u}},
+          .specConstants = {{gpu::kSpecConstantCompactStack, compactStackVectors}},
           .setCount = bands};
 }
 
@@ -52,7 +52,7 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
       layout_(FrameLayout::split(settings.width, settings.height, kAccumulator,
                                  maxBufferBytes ? maxBufferBytes : context.info().maxStorageBufferRange,
                                  "the radiance accumulator")),
-      kernel_(context, pathKernelDesc(layout_.bandCount(), sceneBuffers_.fitsCompactStack())), stream_(context), timestamps_(context) {
+      kernel_(context, pathKernelDesc(layout_.bandCount(), sceneBuffers_.compactStackVectors())), stream_(context), timestamps_(context) {
   if (pathTraceBytesNeeded(settings.width, settings.height) > context.info().deviceLocalBytes)
     throw InputError(fmt::format("{}x{}: path tracing needs {:.1f} MiB, more than the device offers", settings.width,
                                  settings.height,

@@ -191,22 +191,21 @@ uvec2 visitPassNode(PassItems it, inout uvec2 group, inout uint triangleBase, in
 }
 
 // A kernel specialised for BVHs within the compact stack's limits (host_device.h,
-// kSpecConstantCompactStack): its register stack cannot overflow, so traverseBvh has no second
-// loop. The default is the general kernel, right for every BVH.
-layout(constant_id = kSpecConstantCompactStack) const bool kCompactStack = false;
-
-// The register stack's capacity in entries.
-const uint kRegisterStackEntries = kCompactStack ? kBvhCompactStack : kBvhRegisterStack;
+// kSpecConstantCompactStack): its register stack of kCompactStackVectors uvec4 cannot overflow,
+// so traverseBvh has no second loop. The default (0) is the general kernel, right for every BVH.
+layout(constant_id = kSpecConstantCompactStack) const uint kCompactStackVectors = 0u;
+const bool kCompactStack = kCompactStackVectors > 0u;
 
 // The register stack: entries e0 (top) .. e7 as (s0.xy, s0.zw, s1.xy, ..., s3.zw), or compact,
 // e0 .. e15 as s0.x .. s3.w, each entry packed as node index << 16 | group.y (pending and
-// interior masks, 16 bits). A push or a pop shifts them all (vector selects; an indexed array
-// would be a per-lane gather on lavapipe).
+// interior masks, 16 bits), of which a kernel keeps the first kCompactStackVectors (the others
+// are never written, and the compiler drops them). A push or a pop shifts them all (vector
+// selects; an indexed array would be a per-lane gather on lavapipe).
 void pushRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uvec4 s3, uvec2 entry) {
   if (kCompactStack) {
-    s3 = uvec4(s2.w, s3.xyz);
-    s2 = uvec4(s1.w, s2.xyz);
-    s1 = uvec4(s0.w, s1.xyz);
+    if (kCompactStackVectors > 3u) s3 = uvec4(s2.w, s3.xyz);
+    if (kCompactStackVectors > 2u) s2 = uvec4(s1.w, s2.xyz);
+    if (kCompactStackVectors > 1u) s1 = uvec4(s0.w, s1.xyz);
     s0 = uvec4((entry.x << 16) | entry.y, s0.xyz);
   } else {
     s3 = uvec4(s2.zw, s3.xy);
@@ -224,16 +223,16 @@ bool registerStackEmpty(uint stackSize, uvec4 s0) {
 
 // Whether a push would overflow the register stack (never where kCompactStack).
 bool registerStackFull(uint stackSize) {
-  return !kCompactStack && stackSize == kRegisterStackEntries;
+  return !kCompactStack && stackSize == kBvhRegisterStack;
 }
 
 uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uvec4 s3) {
   if (kCompactStack) {
     uint top = s0.x;
-    s0 = uvec4(s0.yzw, s1.x);
-    s1 = uvec4(s1.yzw, s2.x);
-    s2 = uvec4(s2.yzw, s3.x);
-    s3 = uvec4(s3.yzw, 0u);
+    s0 = uvec4(s0.yzw, kCompactStackVectors > 1u ? s1.x : 0u);
+    if (kCompactStackVectors > 1u) s1 = uvec4(s1.yzw, kCompactStackVectors > 2u ? s2.x : 0u);
+    if (kCompactStackVectors > 2u) s2 = uvec4(s2.yzw, kCompactStackVectors > 3u ? s3.x : 0u);
+    if (kCompactStackVectors > 3u) s3 = uvec4(s3.yzw, 0u);
     return uvec2(top >> 16, top & 0xFFFFu);
   }
   uvec2 top = s0.xy;
@@ -261,8 +260,8 @@ uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uve
 // touches memory. A ray whose stack would grow deeper stops there and is finished by a second
 // loop with an array stack, restarting from the root with the hit found so far (re-testing a
 // triangle never changes the result, so this is exact). That loop costs every 8-lane group one
-// (masked) pass when no ray overflowed; a compact-stack kernel (kCompactStack: 16 packed entries
-// in the same registers, for a BVH that cannot overflow them) has none.
+// (masked) pass when no ray overflowed; a compact-stack kernel (kCompactStack: up to 16 packed
+// entries in the same registers, for a BVH that cannot overflow them) has none.
 RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit, uint maxSteps) {
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);

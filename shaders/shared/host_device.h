@@ -44,8 +44,10 @@ OBS_CONST uint kBvhRegisterStack = 8;
 // pending and interior masks) where the BVH has at most kBvhCompactStackNodes nodes. A traversal
 // pushes at most depth - 2 entries (one per level of interior nodes below the root that still
 // has children to visit), so a BVH within both limits never overflows the register stack and
-// its kernels need no slower path (kSpecConstantCompactStack).
+// its kernels need no slower path (kSpecConstantCompactStack), and a shallower BVH needs fewer
+// of the four uvec4 registers: ceil((depth - 2) / 4), at least one.
 OBS_CONST uint kBvhCompactStack = 16;
+OBS_CONST uint kBvhCompactStackVectors = 4; // uvec4 registers of 4 entries
 OBS_CONST uint kBvhCompactStackNodes = 65536;
 OBS_CONST uint kBvhCompactStackMaxDepth = kBvhCompactStack + 2;
 // Wide BVH: up to 8 children per node; a leaf child holds 1..kLeafMaxTriangles triangles.
@@ -391,10 +393,12 @@ OBS_CONST uint kSpecConstantFlatLightSelection = 8u;
 // kTraceGpuRaysPerLane and kTraceGpuWorkgroupSize, or bench-rays --trace-shape).
 OBS_CONST uint kSpecConstantTraceRaysPerLane = 9u;
 OBS_CONST uint kSpecConstantTraceWorkgroupSize = 10u;
-// The specialisation constant (a bool) of a kernel that only traverses BVHs within the compact
-// stack's limits (kBvhCompactStackNodes, kBvhCompactStackMaxDepth): traverseBvh keeps 16 packed
-// entries in registers and has no second loop. lavapipe runs a loop's body at least once even
-// where no lane enters it, so that loop cost every traversal one full (masked) pass.
+// The specialisation constant (a uint) of a kernel that only traverses BVHs within the compact
+// stack's limits (kBvhCompactStackNodes, kBvhCompactStackMaxDepth): the uvec4 registers of packed
+// entries traverseBvh keeps (1..kBvhCompactStackVectors, as deep as the BVH needs), with no
+// second loop; 0 (the default) is the general kernel. lavapipe runs a loop's body at least once
+// even where no lane enters it, so that loop cost every traversal one full (masked) pass, and
+// every live register of the loop counts: spills are a quarter of a pass.
 OBS_CONST uint kSpecConstantCompactStack = 11u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;

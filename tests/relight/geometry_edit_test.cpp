@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -137,45 +138,52 @@ protected:
 };
 
 // A BVH that outgrows the compact traversal stack in an edit (a rebuild may deepen the tree) is
-// traced by the general kernels from then on. The edit keeps the scene and swaps its BVH for a
-// comb (test_scenes.h) of depth 28, whose every level pushes a stack entry for the camera's rays
-// (along +x): the frame rendered after it is the one before it bit for bit, since no closest hit
-// depends on the BVH. The compact kernels would lose the hits below 16 entries, or be refused
-// when bound to the new BVH.
-TEST_F(GeometryEdit, ABvhThatOutgrowsTheCompactStackIsTracedByTheGeneralKernels) {
-  SceneBuilder b;
-  b.quad({-4, 0, -3}, {0, 0, 6}, {7, 0, 0}, b.glossy(glm::vec3(0.8f), 1.0f, 0.1f)); // floor, faces +y
-  const std::uint32_t light = b.lambertian(glm::vec3(0.7f)), dark = b.lambertian(glm::vec3(0.3f, 0.5f, 0.3f));
-  for (int i = 0; i < 4; ++i) // the far wall at x = 3, faces -x: a checkerboard of 12 quads
-    for (int j = 0; j < 3; ++j)
-      b.quad({3, static_cast<float>(j), -3 + 1.5f * static_cast<float>(i)}, {0, 0, 1.5f}, {0, 1, 0},
-             (i + j) % 2 == 0 ? light : dark);
-  b.quad({0, 2.99f, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f}, b.lambertian(glm::vec3(0.0f), glm::vec3(6.0f)), "lamp");
-  const scene::Scene scene = b.build();
-  const bvh::TriangleSoup soup = render::triangleSoup(scene);
-  const bvh::Bvh built = bvh::build(soup), comb = combBvh(soup);
-  ASSERT_TRUE(bvh::fitsCompactStack(built));
-  ASSERT_EQ(comb.stats.maxDepth, 28u);
-  ASSERT_FALSE(bvh::fitsCompactStack(comb));
+// traced by kernels made again for it: a deeper compact stack, or the general one. The edit keeps
+// the scene and swaps its BVH for a comb (test_scenes.h) as deep as the scene has triangles,
+// whose every level pushes a stack entry for the camera's rays (along +x): the frame rendered
+// after it is the one before it bit for bit, since no closest hit depends on the BVH. The old
+// kernels would lose the hits their stack cannot hold, or be refused when bound to the new BVH.
+TEST_F(GeometryEdit, ABvhThatOutgrowsTheCompactStackIsTracedByKernelsMadeForIt) {
+  // The far wall (x = 3, faces -x) as a checkerboard of `columns` x `rows` quads.
+  const auto room = [](int columns, int rows) {
+    SceneBuilder b;
+    b.quad({-4, 0, -3}, {0, 0, 6}, {7, 0, 0}, b.glossy(glm::vec3(0.8f), 1.0f, 0.1f)); // floor, faces +y
+    const std::uint32_t light = b.lambertian(glm::vec3(0.7f)), dark = b.lambertian(glm::vec3(0.3f, 0.5f, 0.3f));
+    const float w = 6.0f / static_cast<float>(columns), h = 3.0f / static_cast<float>(rows);
+    for (int i = 0; i < columns; ++i)
+      for (int j = 0; j < rows; ++j)
+        b.quad({3, h * static_cast<float>(j), -3 + w * static_cast<float>(i)}, {0, 0, w}, {0, h, 0},
+               (i + j) % 2 == 0 ? light : dark);
+    b.quad({0, 2.99f, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f}, b.lambertian(glm::vec3(0.0f), glm::vec3(6.0f)), "lamp");
+    return b.build();
+  };
+  // 16 triangles: a comb of depth 16 needs all four registers; 28: beyond the compact stack.
+  for (const auto& [columns, rows, combVectors] : {std::tuple{3, 2, 4u}, std::tuple{4, 3, 0u}}) {
+    const scene::Scene scene = room(columns, rows);
+    const bvh::TriangleSoup soup = render::triangleSoup(scene);
+    const bvh::Bvh built = bvh::build(soup), comb = combBvh(soup);
+    ASSERT_EQ(bvh::compactStackVectors(built), 1u);
+    ASSERT_EQ(bvh::compactStackVectors(comb), combVectors);
 
-  render::ObscuranceSettings settings = editSettings();
-  settings.camera = lookCamera({-3, 1.5f, 0}, glm::normalize(glm::vec3(1, -0.2f, 0)), {0, 1, 0}, 0.9f);
-  render::ObscuranceRenderer r(context(), scene, built, settings);
-  EXPECT_TRUE(r.tracesWithCompactStack());
-  r.render();
-  const io::Image before = r.image();
-  r.updateGeometry(scene, comb, {});
-  EXPECT_FALSE(r.tracesWithCompactStack());
-  r.render();
-  const io::Image after = r.image();
-  EXPECT_EQ(r.stats().truncatedTraversals, 0u);
-  for (const char* channel : {"direct.R", "obscurance.Y", "specular.G", "depth.Z", "combined.B"}) {
-    const int c = before.channelIndex(channel);
-    std::size_t differ = 0;
-    for (int y = 0; y < before.height; ++y)
-      for (int x = 0; x < before.width; ++x)
-        if (std::bit_cast<std::uint32_t>(before.at(x, y, c)) != std::bit_cast<std::uint32_t>(after.at(x, y, c))) ++differ;
-    EXPECT_EQ(differ, 0u) << channel << ": pixels that differ after the edit";
+    render::ObscuranceSettings settings = editSettings();
+    settings.camera = lookCamera({-3, 1.5f, 0}, glm::normalize(glm::vec3(1, -0.2f, 0)), {0, 1, 0}, 0.9f);
+    render::ObscuranceRenderer r(context(), scene, built, settings);
+    EXPECT_EQ(r.compactStackVectors(), 1u);
+    r.render();
+    const io::Image before = r.image();
+    r.updateGeometry(scene, comb, {});
+    EXPECT_EQ(r.compactStackVectors(), combVectors);
+    r.render();
+    const io::Image after = r.image();
+    EXPECT_EQ(r.stats().truncatedTraversals, 0u);
+    for (const char* channel : {"direct.R", "obscurance.Y", "specular.G", "depth.Z", "combined.B"}) {
+      const int c = before.channelIndex(channel);
+      std::size_t differ = 0;
+      for (int y = 0; y < before.height; ++y)
+        for (int x = 0; x < before.width; ++x)
+          if (std::bit_cast<std::uint32_t>(before.at(x, y, c)) != std::bit_cast<std::uint32_t>(after.at(x, y, c))) ++differ;
+      EXPECT_EQ(differ, 0u) << soup.size() << " triangles, " << channel << ": pixels that differ after the edit";
+    }
   }
 }
 

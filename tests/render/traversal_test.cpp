@@ -263,7 +263,7 @@ TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
   Comb c = comb(levels);
   scene::Scene s = soupScene(c.soup);
   render::SceneBuffers buffers(context(), s, c.tree);
-  ASSERT_FALSE(buffers.fitsCompactStack());
+  ASSERT_EQ(buffers.compactStackVectors(), 0u);
   render::RayTracer tracer(context(), buffers);
   const std::vector<std::uint32_t> steps = expectCombHits(tracer, c, levels);
   // Every node is visited: the spine and the ribs (the overflow restarts from the root).
@@ -271,29 +271,35 @@ TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
   EXPECT_EQ(buffers.truncatedTraversals(), 0u);
 }
 
-// The compact stack (kSpecConstantCompactStack) has no second loop: the deepest BVH it accepts
-// must never overflow it. The comb of that depth pushes one entry per level below the root,
-// kBvhCompactStackMaxDepth - 2 = kBvhCompactStack in all, and still finds every hit, through
-// trace.comp's refilling loop and through traverseBvh (one ray per invocation, as the passes
-// trace). One level deeper does not fit, and a compact kernel refuses that BVH.
+// The compact stack (kSpecConstantCompactStack) has no second loop: the deepest BVH a stack of v
+// uvec4 registers accepts must never overflow it. The comb of depth 4 v + 2 pushes one entry per
+// level below the root, 4 v in all, and still finds every hit, through trace.comp's refilling
+// loop and through traverseBvh (one ray per invocation, as the passes trace). One level deeper
+// needs a register more, and a kernel with v refuses that BVH; beyond 4 registers (depth 18) the
+// general stack takes it.
 TEST_F(GpuTraversal, CompactStackHoldsTheDeepestBvhItAccepts) {
-  const std::uint32_t levels = gpu::kBvhCompactStackMaxDepth - 1;
-  Comb c = comb(levels);
-  ASSERT_EQ(c.tree.stats.maxDepth, gpu::kBvhCompactStackMaxDepth);
-  scene::Scene s = soupScene(c.soup);
-  render::SceneBuffers buffers(context(), s, c.tree);
-  ASSERT_TRUE(buffers.fitsCompactStack());
-  for (const render::TraceShape shape : {render::TraceShape::forCpu(), render::TraceShape{128, 1}}) {
-    render::RayTracer tracer(context(), buffers, shape, true);
-    expectCombHits(tracer, c, levels);
-  }
-  EXPECT_EQ(buffers.truncatedTraversals(), 0u);
+  for (std::uint32_t v = 1; v <= gpu::kBvhCompactStackVectors; ++v) {
+    const std::uint32_t levels = 4 * v + 1;
+    Comb c = comb(levels);
+    ASSERT_EQ(c.tree.stats.maxDepth, 4 * v + 2);
+    scene::Scene s = soupScene(c.soup);
+    render::SceneBuffers buffers(context(), s, c.tree);
+    ASSERT_EQ(buffers.compactStackVectors(), v);
+    for (const render::TraceShape shape : {render::TraceShape::forCpu(), render::TraceShape{128, 1}}) {
+      render::RayTracer tracer(context(), buffers, shape, v);
+      // The ribs' triangles miss the rays, so a rib dropped from the stack would not change the
+      // hits: every one of the 2 levels + 1 nodes must be visited, one per pass at most.
+      for (const std::uint32_t steps : expectCombHits(tracer, c, levels)) EXPECT_GE(steps, 2 * levels + 1) << v;
+    }
+    EXPECT_EQ(buffers.truncatedTraversals(), 0u);
 
-  Comb deeper = comb(levels + 1);
-  scene::Scene deeperScene = soupScene(deeper.soup);
-  render::SceneBuffers deeperBuffers(context(), deeperScene, deeper.tree);
-  EXPECT_FALSE(deeperBuffers.fitsCompactStack());
-  EXPECT_THROW(render::RayTracer(context(), deeperBuffers, {}, true), std::logic_error);
+    Comb deeper = comb(levels + 1);
+    scene::Scene deeperScene = soupScene(deeper.soup);
+    render::SceneBuffers deeperBuffers(context(), deeperScene, deeper.tree);
+    EXPECT_EQ(deeperBuffers.compactStackVectors(), v < gpu::kBvhCompactStackVectors ? v + 1 : 0u);
+    EXPECT_THROW(render::RayTracer(context(), deeperBuffers, {}, v), std::logic_error);
+  }
+  static_assert(4 * gpu::kBvhCompactStackVectors + 2 == gpu::kBvhCompactStackMaxDepth);
 }
 
 class LoopLimiter : public GpuTest {};

@@ -19,9 +19,9 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 
 class PrimaryPass {
 public:
-  // `compactStack`: the kernels are specialised for a BVH that fits the compact traversal stack
-  // (SceneBuffers::fitsCompactStack).
-  PrimaryPass(const gpu::Context& context, std::uint32_t bands, bool compactStack);
+  // `compactStackVectors`: the kernels' compact traversal stack (SceneBuffers::compactStackVectors;
+  // 0: the general stack).
+  PrimaryPass(const gpu::Context& context, std::uint32_t bands, std::uint32_t compactStackVectors);
 
   // Binds band `band`'s descriptor set: the scene, the frame's status counters and band buffers,
   // and the lights' render-time emission scales (which make M_s unit).

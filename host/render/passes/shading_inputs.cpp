@@ -3,10 +3,10 @@
 namespace obscura::render {
 
 ShadingSpecialisation shadingSpecialisation(std::uint32_t bands, bool spatialSampling, std::uint32_t lightCapacity,
-                                            bool compactStack) {
+                                            std::uint32_t compactStackVectors) {
   return {.bands = bands,
           .flatLightSelection = spatialSampling && lightCapacity <= gpu::kMaxSpatialLights,
-          .compactStack = compactStack};
+          .compactStackVectors = compactStackVectors};
 }
 
 gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
@@ -15,7 +15,8 @@ gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_
   gpu::KernelDesc desc{.name = name, .spirv = spirv, .bindings = bindings, .pushConstantBytes = sizeof(gpu::ShadePush),
                        .setCount = s.bands};
   if (s.flatLightSelection) desc.specConstants.push_back({.id = gpu::kSpecConstantFlatLightSelection, .value = 1u});
-  if (s.compactStack) desc.specConstants.push_back({.id = gpu::kSpecConstantCompactStack, .value = 1u});
+  if (s.compactStackVectors != 0)
+    desc.specConstants.push_back({.id = gpu::kSpecConstantCompactStack, .value = s.compactStackVectors});
   return desc;
 }
 

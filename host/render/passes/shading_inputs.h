@@ -28,16 +28,16 @@ struct ShadingSpecialisation {
   // Lights chosen by the flat spatial selection alone (kSpecConstantFlatLightSelection): the
   // render samples lights spatially and its frame holds at most kMaxSpatialLights lights.
   bool flatLightSelection = false;
-  // The scene's BVH fits the compact traversal stack (kSpecConstantCompactStack,
-  // SceneBuffers::fitsCompactStack): no second traversal loop.
-  bool compactStack = false;
+  // The compact traversal stack's uvec4 registers (kSpecConstantCompactStack,
+  // SceneBuffers::compactStackVectors; 0: the general stack with its second loop).
+  std::uint32_t compactStackVectors = 0;
 };
 
 // The shading specialisation of a render: flat selection where it is the only one its dispatches
 // can take (spatial sampling, no more lights than kMaxSpatialLights, spare slots included), the
 // compact stack where the scene's BVH fits it.
 ShadingSpecialisation shadingSpecialisation(std::uint32_t bands, bool spatialSampling, std::uint32_t lightCapacity,
-                                            bool compactStack);
+                                            std::uint32_t compactStackVectors);
 
 // The kernel description every shading pass shares: scene bindings, then the shading bindings,
 // ShadePush, one descriptor set per band.

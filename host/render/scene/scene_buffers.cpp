@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <cstring>
 
 #include <fmt/core.h>
@@ -116,7 +117,7 @@ void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char
 } // namespace
 
 SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh)
-    : context_(&context), fitsCompactStack_(bvh::fitsCompactStack(bvh)) {
+    : context_(&context), compactStackVectors_(bvh::compactStackVectors(bvh)) {
   using Usage = vk::BufferUsageFlagBits;
   auto items = bvhTexels(bvh);
   checkTexelLimit(context, items.size(), "BVH nodes and triangles");
@@ -163,7 +164,7 @@ bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh
   auto shading = shadingData(scene, reflectors_);
   const std::size_t itemBytes = items.size() * sizeof(gpu::vec4);
   const std::size_t shadingBytes = shading.size() * sizeof(gpu::TriangleShading);
-  fitsCompactStack_ = bvh::fitsCompactStack(bvh);
+  compactStackVectors_ = bvh::compactStackVectors(bvh);
   if (itemBytes == items_.buffer().size() && shadingBytes == shading_.size()) {
     items_.upload(*context_, items.data(), itemBytes);
     shading_.upload(*context_, shading);
@@ -179,9 +180,13 @@ bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh
 }
 
 void SceneBuffers::bindTo(gpu::Kernel& kernel, std::uint32_t set, const gpu::Buffer* status) const {
-  if (kernel.specConstant(gpu::kSpecConstantCompactStack) != 0 && !fitsCompactStack_)
-    throw std::logic_error(fmt::format("kernel '{}' is specialised for the compact traversal stack, which this "
-                                       "scene's BVH does not fit", kernel.name()));
+  const std::uint32_t kernelVectors = kernel.specConstant(gpu::kSpecConstantCompactStack);
+  if (!bvh::compactStackHolds(kernelVectors, compactStackVectors_))
+    throw std::logic_error(fmt::format("kernel '{}' is specialised for a compact traversal stack of {} vectors, "
+                                       "which this scene's BVH could overflow (it needs {})",
+                                       kernel.name(), kernelVectors,
+                                       compactStackVectors_ == 0 ? "the general stack"
+                                                                 : std::to_string(compactStackVectors_)));
   kernel.bind(gpu::kBindingBvhItems, items_, set);
   kernel.bind(gpu::kBindingShading, shading_, set);
   kernel.bind(gpu::kBindingMaterials, materials_, set);

@@ -40,18 +40,18 @@ public:
 
   // Binds bindings 0..5 of descriptor set `set` of `kernel`. Binding 5 (status counters) is the
   // scene's own unless `status` is given: a renderer counts its frame's rays in its own buffer.
-  // Throws std::logic_error for a compact-stack kernel when this BVH does not fit that stack.
+  // Throws std::logic_error for a compact-stack kernel whose stack this BVH could overflow.
   void bindTo(gpu::Kernel& kernel, std::uint32_t set = 0, const gpu::Buffer* status = nullptr) const;
 
-  // Whether kernels specialised for the compact register stack may trace this BVH
-  // (bvh::fitsCompactStack); kept up to date by updateGeometry.
-  bool fitsCompactStack() const { return fitsCompactStack_; }
+  // The compact register stack this BVH needs (bvh::compactStackVectors; 0: beyond it), kept up to
+  // date by updateGeometry: the specialisation of the kernels that trace it.
+  std::uint32_t compactStackVectors() const { return compactStackVectors_; }
 
   // After an edit that kept the materials and textures (a move or a removal): uploads the BVH items
   // and the triangles' shading data again, in place when their sizes stayed (the texel buffer's
   // view and every descriptor stay valid), else into new buffers (rebind the kernels then).
   // Returns true when the buffers were re-created. A caller with compact-stack kernels checks
-  // fitsCompactStack() after it: bound in place, they would not notice a deeper BVH.
+  // compactStackVectors() after it: bound in place, they would not notice a deeper BVH.
   bool updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh);
 
   // Marks the important secondary reflectors (one flag per triangle of `scene`, whose triangles
@@ -77,7 +77,7 @@ private:
   gpu::Buffer texels_;
   StatusCounters status_;
   std::uint64_t bytes_ = 0;
-  bool fitsCompactStack_ = false;
+  std::uint32_t compactStackVectors_ = 0;
   std::vector<std::string> notes_;
   std::vector<std::uint8_t> reflectors_; // per triangle (empty: none marked)
 };
