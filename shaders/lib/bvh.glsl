@@ -55,6 +55,13 @@ uint hitQuad(uvec3 nearWords, uvec3 farWords, vec3 nodeOrigin, vec3 scale, vec3 
   return (h.x ? 1u : 0u) | (h.y ? 2u : 0u) | (h.z ? 4u : 0u) | (h.w ? 8u : 0u);
 }
 
+// The octant of a direction: bit k set where its component k is negative, as safeReciprocal picks
+// the sign (so the near plane of axis k is the box's hi side).
+uint rayOctant(vec3 direction) {
+  bvec3 negative = lessThan(direction, vec3(0.0));
+  return (negative.x ? 1u : 0u) | (negative.y ? 2u : 0u) | (negative.z ? 4u : 0u);
+}
+
 // Moves bit s of an 8-bit slot mask to bit s ^ octant: the order in which a ray of that octant
 // visits the slots (host_device.h: slot bit k = the + side of axis k).
 uint slotsToVisitOrder(uint m, uint octant) {
@@ -72,8 +79,11 @@ struct NodeVisit {
   uvec2 group;        // x: node index of the first interior child; y: pending (visit order) | interior mask << 8
 };
 
-NodeVisit visitNode(vec4 n0, vec4 n1, vec4 n2, vec4 n3, vec4 n4, vec3 rayOrigin, vec3 invDir, bvec3 negative,
-                    uint octant, float tmin, float tmax) {
+NodeVisit visitNode(vec4 n0, vec4 n1, vec4 n2, vec4 n3, vec4 n4, vec3 rayOrigin, vec3 invDir, uint octant,
+                    float tmin, float tmax) {
+  // The direction's signs from its octant, not carried: every live value of a traversal loop is a
+  // register per lane on lavapipe.
+  bvec3 negative = notEqual(uvec3(octant) & uvec3(1u, 2u, 4u), uvec3(0u));
   uint bits = floatBitsToUint(n0.w);
   vec3 scale = uintBitsToFloat(uvec3(bits & 0xFFu, (bits >> 8) & 0xFFu, (bits >> 16) & 0xFFu) << 23);
   uint imask = bits >> 24;
@@ -176,10 +186,10 @@ bool testPassTriangle(PassItems it, WatertightRay wr, float tmin, float tmax, bo
 // triangle group (or the queued one behind it). Returns the node group of its interior children
 // hit (none where y & 0xFF is 0); pushing what is left of `group` is the caller's (its stack).
 uvec2 visitPassNode(PassItems it, inout uvec2 group, inout uint triangleBase, inout uint triangleBits,
-                    inout uint queuedBase, inout uint queuedBits, vec3 origin, vec3 invDir, bvec3 negative,
-                    uint octant, float tmin, float tmax) {
+                    inout uint queuedBase, inout uint queuedBits, vec3 origin, vec3 invDir, uint octant,
+                    float tmin, float tmax) {
   group.y &= ~it.bit;
-  NodeVisit visit = visitNode(it.n0, it.n1, it.n2, it.n3, it.n4, origin, invDir, negative, octant, tmin, tmax);
+  NodeVisit visit = visitNode(it.n0, it.n1, it.n2, it.n3, it.n4, origin, invDir, octant, tmin, tmax);
   if (triangleBits == 0u) {
     triangleBase = visit.triangleBase;
     triangleBits = visit.triangleBits;
@@ -265,8 +275,7 @@ uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uve
 RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit, uint maxSteps) {
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);
-  bvec3 negative = lessThan(direction, vec3(0.0)); // as safeReciprocal picks the sign
-  uint octant = (negative.x ? 1u : 0u) | (negative.y ? 2u : 0u) | (negative.z ? 4u : 0u);
+  uint octant = rayOctant(direction);
   RayHit hit;
   hit.t = tmax;
   hit.u = 0.0;
@@ -294,7 +303,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     if (it.onTriangle && testPassTriangle(it, wr, tmin, tmax, anyHit, hit) && anyHit) break;
     if (it.onNode) {
       uvec2 children = visitPassNode(it, group, triangleBase, triangleBits, queuedBase, queuedBits, origin, invDir,
-                                     negative, octant, tmin, hit.t);
+                                     octant, tmin, hit.t);
       if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
           if (registerStackFull(stackSize)) {
@@ -343,7 +352,7 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
     if (it.onTriangle && testPassTriangle(it, wr, tmin, tmax, anyHit, hit) && anyHit) break;
     if (it.onNode) {
       uvec2 children = visitPassNode(it, group, triangleBase, triangleBits, queuedBase, queuedBits, origin, invDir,
-                                     negative, octant, tmin, hit.t);
+                                     octant, tmin, hit.t);
       if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) stack[stackSize++] = group; // the push site
         group = children;

@@ -22,7 +22,6 @@
 uint traverseStream(uint count, bool anyHit, uint maxSteps) {
   WatertightRay wr;
   vec3 origin = vec3(0.0), invDir = vec3(0.0);
-  bvec3 negative = bvec3(false);
   uint octant = 0u;
   float tmin = 0.0, tmax = 0.0;
   RayHit hit;
@@ -45,8 +44,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
       tmax = ray.direction.w;
       wr = prepareWatertightRay(origin, ray.direction.xyz);
       invDir = safeReciprocal(ray.direction.xyz);
-      negative = lessThan(ray.direction.xyz, vec3(0.0));
-      octant = (negative.x ? 1u : 0u) | (negative.y ? 2u : 0u) | (negative.z ? 4u : 0u);
+      octant = rayOctant(ray.direction.xyz);
       hit = RayHit(tmax, 0.0, 0.0, kInvalidIndex, kInvalidIndex, 0u);
       group = uvec2(0u, (1u << octant) | (1u << 8));
       triangleBits = 0u;
@@ -73,7 +71,7 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
     bool overflow = false;
     if (it.onNode && !done) {
       uvec2 children = visitPassNode(it, group, triangleBase, triangleBits, queuedBase, queuedBits, origin, invDir,
-                                     negative, octant, tmin, hit.t);
+                                     octant, tmin, hit.t);
       if ((children.y & 0xFFu) != 0u) {
         if ((group.y & 0xFFu) != 0u) { // the push site
           overflow = registerStackFull(stackSize);
