@@ -568,6 +568,32 @@ TEST(Bvh, SmallSoupsOfEverySize) {
     checkSoup(randomSoup(n, 50 + n), 500, "n=" + std::to_string(n));
 }
 
+// The compact traversal stack a BVH needs: one uvec4 of 4 entries per 4 levels of interior nodes
+// below the root (a traversal pushes at most depth - 2 entries), none beyond depth 18 or 65,536
+// nodes; a kernel may trace a BVH when it has at least as many registers, or the general stack.
+TEST(Bvh, CompactStackVectorsFollowTheDepthAndTheNodeLimit) {
+  Bvh b;
+  b.nodes.resize(10);
+  const std::map<std::uint32_t, std::uint32_t> expected = {{0, 1}, {1, 1}, {2, 1}, {3, 1}, {6, 1}, {7, 2},
+                                                           {10, 2}, {11, 3}, {14, 3}, {15, 4}, {18, 4}, {19, 0}};
+  for (const auto& [depth, vectors] : expected) {
+    b.stats.maxDepth = depth;
+    EXPECT_EQ(compactStackVectors(b), vectors) << "depth " << depth;
+  }
+  b.stats.maxDepth = 5;
+  b.nodes.resize(gpu::kBvhCompactStackNodes);
+  EXPECT_EQ(compactStackVectors(b), 1u);
+  b.nodes.resize(gpu::kBvhCompactStackNodes + 1);
+  EXPECT_EQ(compactStackVectors(b), 0u);
+
+  EXPECT_TRUE(compactStackHolds(0, 0));  // the general kernel traces anything
+  EXPECT_TRUE(compactStackHolds(0, 3));
+  EXPECT_TRUE(compactStackHolds(3, 2));
+  EXPECT_TRUE(compactStackHolds(2, 2));
+  EXPECT_FALSE(compactStackHolds(1, 2));
+  EXPECT_FALSE(compactStackHolds(4, 0)); // beyond the compact stack
+}
+
 TEST(Bvh, ThreadCountDoesNotChangeTheTree) {
   const TriangleSoup soup = randomSoup(50000, 77);
   BuildOptions one, many;
