@@ -152,23 +152,21 @@ SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std
   r.bestMs = times.front();
   r.medianMs = times[times.size() / 2];
   // Optional check of the first `verify` rays against the CPU reference traversal.
+  const bool shadowRays = mode == render::TraceMode::Any;
   for (std::size_t i = 0; i < std::min(o.verify, rays.size()); ++i) {
     bvh::Ray ray{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
-    render::HitAgreement agreement =
-        mode == render::TraceMode::Closest
-            ? render::closestHitAgreement(ray, bvh::closestHit(loaded.bvh, ray), first.hits[i])
-            : render::anyHitAgreement(ray, bvh::anyHit(loaded.bvh, ray), bvh::closestHit(loaded.bvh, ray),
-                                      first.hits[i]);
+    const bvh::Hit cpu = bvh::closestHit(loaded.bvh, ray);
+    const bool cpuOccluded = shadowRays && bvh::anyHit(loaded.bvh, ray);
+    const gpu::GpuHit& g = first.hits[i];
+    const render::HitAgreement agreement = shadowRays ? render::anyHitAgreement(ray, cpuOccluded, cpu, g)
+                                                      : render::closestHitAgreement(ray, cpu, g);
     if (agreement == render::HitAgreement::Different && ++r.mismatches <= 5) {
-      const bvh::Hit cpu = bvh::closestHit(loaded.bvh, ray);
-      const gpu::GpuHit& g = first.hits[i];
       r.mismatchExamples.push_back(fmt::format(
           "{} ray {}: origin ({}, {}, {}) direction ({}, {}, {}) t in ({}, {}); CPU closest t {} u {} v {} "
           "triangle {}{}; GPU t {} u {} v {} triangle {}",
-          mode == render::TraceMode::Closest ? "closest" : "shadow", i, ray.origin.x, ray.origin.y, ray.origin.z,
-          ray.direction.x, ray.direction.y, ray.direction.z, ray.tmin, ray.tmax, cpu.t, cpu.u, cpu.v, cpu.primitive,
-          mode == render::TraceMode::Any ? fmt::format(" (occluded: {})", bvh::anyHit(loaded.bvh, ray)) : "", g.t,
-          g.u, g.v, g.primitive));
+          shadowRays ? "shadow" : "closest", i, ray.origin.x, ray.origin.y, ray.origin.z, ray.direction.x,
+          ray.direction.y, ray.direction.z, ray.tmin, ray.tmax, cpu.t, cpu.u, cpu.v, cpu.primitive,
+          shadowRays ? fmt::format(" (occluded: {})", cpuOccluded) : "", g.t, g.u, g.v, g.primitive));
     }
     if (agreement == render::HitAgreement::WithinPrecision) ++r.precisionDifferences;
   }

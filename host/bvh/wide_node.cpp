@@ -141,9 +141,8 @@ BoxRay makeBoxRay(const glm::vec3& origin, const glm::vec3& direction) {
 }
 
 std::uint32_t hitChildren(const gpu::BvhNode& node, const BoxRay& ray, float tmin, float tmax) {
-  // kBoxFarScale of shaders/lib/intersect.glsl: 1 + 2 gamma(7) rounded up to a float (a GPU's
-  // 2.5-ulp reciprocal; the CPU's bound would be gamma(3), the same boxes are tested on both).
-  constexpr float kFarScale = 1.000001f;
+  // gpu::kBoxFarScale covers a GPU's 2.5-ulp reciprocal; the CPU's bound would be gamma(3), but
+  // the same boxes are tested on both.
   std::uint32_t hits = 0;
   for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
     if (slotMeta(node, s) == 0) continue;
@@ -157,7 +156,7 @@ std::uint32_t hitChildren(const gpu::BvhNode& node, const BoxRay& ray, float tmi
       tNear = std::max(tNear, t0);
       tFar = std::min(tFar, t1);
     }
-    if (tNear <= tFar * kFarScale) hits |= 1u << s;
+    if (tNear <= tFar * gpu::kBoxFarScale) hits |= 1u << s;
   }
   return hits;
 }

@@ -131,14 +131,6 @@ vec3 safeReciprocal(vec3 d) {
   return vec3(d.x < 0.0 ? -1.0 : 1.0, d.y < 0.0 ? -1.0 : 1.0, d.z < 0.0 ? -1.0 : 1.0) / m;
 }
 
-// Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013: scaling the far distance by 1 + 2 gamma(n)
-// makes the float slab test conservative, so rounding never culls a box the ray touches. Ize's
-// n = 3 (a subtraction, a product, a correctly rounded reciprocal) holds on the CPU and lavapipe;
-// Vulkan lets a GPU divide to 2.5 ulp, five half-ulp roundings instead of one, so n = 7:
-// 1 + 2 gamma(7) = 1 + 8.3e-7, rounded up to a float (1 + 8 ulp). An NVIDIA H200 returned a
-// farther, nearly coincident triangle instead of the nearer one for 1 Sponza ray in 10^5
-// (docs/BENCHMARKS.md); a box culled by the too-tight bound is the likely cause.
-const float kBoxFarScale = 1.000001;
 
 // Slab test; returns (tnear, tfar): the box is hit when tnear <= tfar.
 vec2 intersectBox(vec3 lo, vec3 hi, vec3 origin, vec3 invDir, float tmin, float tmax) {

@@ -135,6 +135,15 @@ OBS_CONST uint kMaxSpatialLights = 64u;
 // The importance bound of a spot reaches this cosine past its outer cone (rounding slack; no
 // cosine factor inside the cone): lights.glsl and its C++ twin, render/scene/light_selection.h.
 OBS_CONST float kSpotConeSlack = 0.99999f;
+// Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013: scaling a box's far distance by 1 + 2 gamma(n)
+// makes the float slab test conservative, so rounding never culls a box the ray touches. Ize's
+// n = 3 (a subtraction, a product, a correctly rounded reciprocal) holds on the CPU and lavapipe;
+// Vulkan lets a GPU divide to 2.5 ulp, five half-ulp roundings instead of one, so n = 7:
+// 1 + 2 gamma(7) = 1 + 8.3e-7, rounded up to a float (1 + 8 ulp). An NVIDIA H200 returned a
+// farther, nearly coincident triangle instead of the nearer one for 1 Sponza ray in 10^5
+// (docs/BENCHMARKS.md); a box culled by the too-tight bound is the likely cause. The GPU's box
+// tests (lib/intersect.glsl, lib/bvh.glsl) and the CPU's (host/bvh/wide_node.cpp) share it.
+OBS_CONST float kBoxFarScale = 1.000001f;
 
 struct GpuLight {
   vec4 position;  // 0:  point/spot: world position, w = range (0 = infinite); area: centre of the
