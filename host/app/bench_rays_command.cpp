@@ -52,6 +52,7 @@ struct BenchOptions {
   std::vector<std::string> frames; // WxH each: the obscurance-only frame, Obscura against Embree
   std::string lanes;               // WxH: lane utilisation of that frame's rays in several orders
   std::string traceShape;          // WxR: trace.comp's workgroup size and rays per invocation
+  std::optional<std::uint32_t> stackRegisters; // the kernel's compact-stack registers (0: the general kernel)
   render::ObscuranceFrameWork frameWork; // its spp, rays per hit, dmax, seed
   DeviceOptions device;
 };
@@ -153,13 +154,15 @@ SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std
   r.medianMs = times[times.size() / 2];
   // Optional check of the first `verify` rays against the CPU reference traversal.
   const bool shadowRays = mode == render::TraceMode::Any;
+  const bvh::TriangleSoup soup = o.verify > 0 ? render::triangleSoup(loaded.scene) : bvh::TriangleSoup{};
   for (std::size_t i = 0; i < std::min(o.verify, rays.size()); ++i) {
     bvh::Ray ray{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
     const bvh::Hit cpu = bvh::closestHit(loaded.bvh, ray);
     const bool cpuOccluded = shadowRays && bvh::anyHit(loaded.bvh, ray);
     const gpu::GpuHit& g = first.hits[i];
-    const render::HitAgreement agreement = shadowRays ? render::anyHitAgreement(ray, cpuOccluded, cpu, g)
-                                                      : render::closestHitAgreement(ray, cpu, g);
+    const render::HitAgreement agreement =
+        shadowRays ? render::anyHitAgreement(ray, cpuOccluded, cpu, g)
+                   : render::closestHitAgreement(ray, cpu, g, &soup);
     if (agreement == render::HitAgreement::Different && ++r.mismatches <= 5) {
       r.mismatchExamples.push_back(fmt::format(
           "{} ray {}: origin ({}, {}, {}) direction ({}, {}, {}) t in ({}, {}); CPU closest t {} u {} v {} "
@@ -353,7 +356,10 @@ void runBench(const BenchOptions& o) {
   render::SceneBuffers buffers(context, loaded.scene, loaded.bvh);
   std::optional<render::TraceShape> shape;
   if (!o.traceShape.empty()) shape = parseTraceShape(o.traceShape, context);
-  render::RayTracer tracer(context, buffers, shape);
+  if (o.stackRegisters && !bvh::compactStackHolds(*o.stackRegisters, buffers.compactStackVectors()))
+    throw InputError(fmt::format("--stack-registers {}: this BVH (depth {}) needs {} (or 0, the general kernel)",
+                                 *o.stackRegisters, loaded.bvh.stats.maxDepth, buffers.compactStackVectors()));
+  render::RayTracer tracer(context, buffers, shape, o.stackRegisters);
   auto closestRays = render::closestBenchRays(loaded.scene.bounds, o.rays, o.seed);
   auto shadowRays = render::shadowBenchRays(loaded.scene.bounds, o.rays, o.seed + 1);
   if (!o.saveRays.empty()) {
@@ -516,6 +522,11 @@ void addBenchRaysCommand(CLI::App& app) {
                               "{}x{} on a CPU device, {}x{} on a GPU)",
                               gpu::kTraceWorkgroupSize, gpu::kTraceRaysPerLane, gpu::kTraceGpuWorkgroupSize,
                               gpu::kTraceGpuRaysPerLane));
+  cmd->add_option("--stack-registers", o->stackRegisters,
+                  fmt::format("trace.comp's traversal stack in this many uvec4 registers (1 to {}, at least what the "
+                              "BVH needs), or 0 for the general kernel's stack in memory (default: what the BVH needs)",
+                              gpu::kBvhCompactStackVectors))
+      ->check(CLI::Range(0u, gpu::kBvhCompactStackVectors));
   cmd->add_option("--frame-spp", o->frameWork.spp, "--frame: samples per pixel")->check(CLI::Range(1u, 1024u));
   cmd->add_option("--frame-rays", o->frameWork.obscuranceRays, "--frame: obscurance rays per hit")
       ->check(CLI::Range(1u, 256u));

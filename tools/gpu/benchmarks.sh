@@ -6,8 +6,9 @@
 # "quick" shrinks every size so that the script itself can be tried on lavapipe first.
 #
 #   bench-rays, both scenes: closest-hit and shadow rays per second (16M random rays, the best of
-#     5 timed repeats, the first 100k checked against the CPU traversal), and on modern-hall the
-#     paper's budget at 800x600 per pass (--passes)
+#     5 timed repeats, the first 100k checked against the CPU traversal, on Sponza the first 1M),
+#     on modern-hall the paper's budget at 800x600 per pass (--passes), and on Sponza the general
+#     kernel (its stack in memory, --stack-registers 0) beside the compact stack that it takes
 #   render: the paper's budget (8 spp), modern-hall 800x600 and Sponza 1920x1080 under a uniform sky
 #     (Sponza has no lights), --metrics
 #   relight: modern-hall 800x600, 1 spp: a light's scale and colour, add and remove a point light,
@@ -25,8 +26,8 @@ export LD_LIBRARY_PATH=$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-rays=16777216 passes=800x600 hall=(800 600) sponza=(1920 1080) limit=${STEP_LIMIT:-150}
-if [ "$quick" = quick ]; then rays=65536 passes=80x60 hall=(80 60) sponza=(96 54) limit=300; fi
+rays=16777216 verify=1000000 passes=800x600 hall=(800 600) sponza=(1920 1080) limit=${STEP_LIMIT:-150}
+if [ "$quick" = quick ]; then rays=65536 verify=65536 passes=80x60 hall=(80 60) sponza=(96 54) limit=300; fi
 
 step() { # name command...: runs it under a time limit, everything into log.txt
   local name=$1 start rc
@@ -45,7 +46,9 @@ step() { # name command...: runs it under a time limit, everything into log.txt
   step info "$obscura" info
   step bench-hall "$obscura" bench-rays "$scenes/modern-hall/modern-hall.gltf" --rays "$rays" --repeats 5 \
     --verify 100000 --passes "$passes"
-  step bench-sponza "$obscura" bench-rays "$scenes/sponza/sponza.gltf" --rays "$rays" --repeats 5 --verify 100000
+  step bench-sponza "$obscura" bench-rays "$scenes/sponza/sponza.gltf" --rays "$rays" --repeats 5 --verify "$verify"
+  step bench-sponza-general "$obscura" bench-rays "$scenes/sponza/sponza.gltf" --rays "$rays" --repeats 5 \
+    --stack-registers 0
   step render-hall "$obscura" render "$scenes/modern-hall/modern-hall.gltf" --width "${hall[0]}" \
     --height "${hall[1]}" --spp 8 -o "$out/modern-hall.png" --metrics "$out/modern-hall.metrics.json"
   step render-sponza "$obscura" render "$scenes/sponza/sponza.gltf" --width "${sponza[0]}" --height "${sponza[1]}" \
