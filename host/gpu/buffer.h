@@ -74,7 +74,9 @@ public:
               const std::string& name);
   const Buffer& buffer() const { return buffer_; }
   // New contents of the same size; the view stays valid.
-  void upload(const Context& context, const void* data, vk::DeviceSize size) { buffer_.upload(context, data, size); }
+  void upload(const Context& context, const void* data, vk::DeviceSize size, vk::DeviceSize offset = 0) {
+    buffer_.upload(context, data, size, offset);
+  }
   vk::BufferView view() const { return *view_; }
 
 private:

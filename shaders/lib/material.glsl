@@ -8,7 +8,7 @@ vec3 srgbToLinear(vec3 c) {
 
 vec4 fetchTexel(GpuTexture tex, int x, int y) {
   uint width = tex.info.y;
-  vec4 c = unpackUnorm4x8(texels[tex.info.x + uint(y) * width + uint(x)]);
+  vec4 c = texelFetch(texels, int(tex.info.x + uint(y) * width + uint(x)));
   if ((tex.info.w & kTextureSrgb) != 0u) c.rgb = srgbToLinear(c.rgb);
   return c;
 }

@@ -9,7 +9,8 @@ layout(set = 0, binding = kBindingBvhItems) uniform samplerBuffer bvhItems;
 layout(std430, set = 0, binding = kBindingShading) readonly buffer ShadingBuffer { TriangleShading triangleShading[]; };
 layout(std430, set = 0, binding = kBindingMaterials) readonly buffer MaterialBuffer { GpuMaterial materials[]; };
 layout(std430, set = 0, binding = kBindingTextures) readonly buffer TextureBuffer { GpuTexture textures[]; };
-layout(std430, set = 0, binding = kBindingTexels) readonly buffer TexelBuffer { uint texels[]; };
+// RGBA8 texels of every texture, fetched as UNORM (0..1) through the texel view.
+layout(set = 0, binding = kBindingTexels) uniform samplerBuffer texels;
 // status[kStatusTruncated] counts traversals that ran out of steps (never expected; tested).
 layout(std430, set = 0, binding = kBindingStatus) buffer StatusBuffer { uint status[]; };
 

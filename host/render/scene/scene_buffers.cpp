@@ -32,8 +32,8 @@ bvh::TriangleSoup triangleSoup(const scene::Scene& scene) {
 
 std::vector<gpu::BindingKind> sceneBindingKinds() {
   using K = gpu::BindingKind;
-  return {K::UniformTexelBuffer, K::StorageBuffer, K::StorageBuffer,
-          K::StorageBuffer,      K::StorageBuffer, K::StorageBuffer};
+  return {K::UniformTexelBuffer, K::StorageBuffer,      K::StorageBuffer,
+          K::StorageBuffer,      K::UniformTexelBuffer, K::StorageBuffer};
 }
 
 float sceneScale(const scene::Bounds& bounds) {
@@ -142,7 +142,9 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
   }
   textures_ = gpu::Buffer(context, textureTable.size() * sizeof(gpu::GpuTexture), Usage::eStorageBuffer, "scene.textures");
   textures_.upload(context, textureTable);
-  texels_ = gpu::Buffer(context, texelCount * 4, Usage::eStorageBuffer, "scene.texels");
+  checkTexelLimit(context, texelCount, "textures");
+  texels_ = gpu::TexelBuffer(context, std::max<std::size_t>(texelCount, 1) * 4, vk::Format::eR8G8B8A8Unorm, {},
+                             "scene.texels");
   std::size_t offset = 0;
   for (const auto& t : fitted) {
     texels_.upload(context, t.rgba8.data(), t.rgba8.size(), offset);
@@ -151,7 +153,7 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
 
   status_ = StatusCounters(context, "scene.status");
   bytes_ = items_.buffer().size() + shading_.size() + materials_.size() +
-           textures_.size() + texels_.size() + status_.buffer().size();
+           textures_.size() + texels_.buffer().size() + status_.buffer().size();
 }
 
 void SceneBuffers::setSecondaryReflectors(const scene::Scene& scene, std::vector<std::uint8_t> marked) {

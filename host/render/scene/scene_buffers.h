@@ -74,7 +74,7 @@ private:
   gpu::Buffer shading_;
   gpu::Buffer materials_;
   gpu::Buffer textures_;
-  gpu::Buffer texels_;
+  gpu::TexelBuffer texels_;
   StatusCounters status_;
   std::uint64_t bytes_ = 0;
   std::uint32_t compactStackVectors_ = 0;
