@@ -139,7 +139,7 @@ void main() {
       break;
     }
     Surface s = surfaceAt(hit, origin, direction);
-    GpuMaterial m = materials[s.material];
+    GpuMaterial m = materialAt(s.material);
 
     // ---- Emission seen along the ray [SPEC §5: one-sided unless doubleSided].
     vec3 emitted = materialEmission(m, s.uv, s.frontFacing);

@@ -73,7 +73,7 @@ void main() {
   vec3 unitSeen = vec3(0.0);
   if (rayHitValid(hit) && hit.primitive != kInvalidIndex) {
     Surface s = surfaceAt(hit, origin, direction);
-    GpuMaterial m = materials[s.material];
+    GpuMaterial m = materialAt(s.material);
     vec3 albedo = materialBaseColor(m, s.uv).rgb;
     vec3 emission = materialEmission(m, s.uv, s.frontFacing);
     float depth = distance(origin, s.position);

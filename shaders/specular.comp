@@ -173,7 +173,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
   Surface s = surfaceAt(h, origin, wi);
   path.pathLo = min(path.pathLo, s.position);
   path.pathHi = max(path.pathHi, s.position);
-  GpuMaterial m = materials[s.material];
+  GpuMaterial m = materialAt(s.material);
   vec3 baseColor = materialBaseColor(m, s.uv).rgb;
   const bool counted = c.oneLight ? delta && s.lightGroup == c.addedLight : !c.noDirect && (delta || c.glossyMis);
   if (!kProbe && counted && s.lightGroup != kInvalidIndex && s.lightGroup < c.lightCount) {

@@ -18,6 +18,6 @@ void main() {
   uint pixel = bp.index;
   if (skipClean(pixel)) return;
   GBufferTexel g = gbuffer[pixel];
-  if (g.albedo.a == 0.0 || materials[floatBitsToUint(g.shadingNormal.w)].params.w == 0.0) return;
+  if (g.albedo.a == 0.0 || materialAt(floatBitsToUint(g.shadingNormal.w)).params.w == 0.0) return;
   OBS_QUEUE_APPEND(queue, 0u, pixel)
 }

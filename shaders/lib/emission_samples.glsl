@@ -34,11 +34,11 @@ vec2 emissionSampleOffset(uint sampleIndex, uint j, uint count, vec2 shift) {
 SeenEmitter emitterSeen(RayHit hit, vec3 origin, vec3 direction, uint skySlot, uint lightCount) {
   SeenEmitter e = SeenEmitter(kInvalidIndex, vec3(0.0), false);
   if (rayHitValid(hit) && hit.primitive != kInvalidIndex) {
-    uint material = floatBitsToUint(triangleShading[hit.primitive].n0.w);
-    if (all(equal(materials[material].emission.rgb, vec3(0.0)))) return e;
+    uint material = floatBitsToUint(triangleShadingAt(hit.primitive).n0.w);
+    if (all(equal(materialAt(material).emission.rgb, vec3(0.0)))) return e;
     Surface s = surfaceAt(hit, origin, direction);
     e.lightGroup = s.lightGroup;
-    e.radiance = materialEmission(materials[s.material], s.uv, s.frontFacing);
+    e.radiance = materialEmission(materialAt(s.material), s.uv, s.frontFacing);
   } else if (hit.primitive != kTruncatedHit && skySlot < lightCount) { // a miss, not a truncation
     e.lightGroup = skySlot;
     e.radiance = vec3(1.0);

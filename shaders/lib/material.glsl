@@ -16,7 +16,7 @@ vec4 fetchTexel(GpuTexture tex, int x, int y) {
 // Bilinear lookup with repeat wrapping (glTF's default sampler); uv (0,0) is the top-left texel.
 // Texels are decoded to linear before filtering.
 vec4 sampleTexture(int index, vec2 uv) {
-  GpuTexture tex = textures[index];
+  GpuTexture tex = textureInfo(index);
   ivec2 size = ivec2(tex.info.yz);
   vec2 p = fract(uv) * vec2(size) - 0.5;
   vec2 f = fract(p);

@@ -25,7 +25,7 @@ float rho(float d, float dMax, uint kind, float tau) {
 
 // R(Q): the mean albedo a-bar of the surface hit, times its base-colour texture.
 vec3 reflectanceAt(Surface s) {
-  GpuMaterial m = materials[s.material];
+  GpuMaterial m = materialAt(s.material);
   vec3 r = m.meanAlbedo.rgb;
   if (m.textures.x >= 0) r *= sampleTexture(m.textures.x, s.uv).rgb;
   return r;
@@ -39,7 +39,7 @@ void reflectedDirectLight(Surface s, vec3 direction, vec4 u, inout StepBudget bu
                           out uint light) {
   vec3 wo = -direction;
   vec3 ns = dot(s.shadingNormal, wo) < 0.0 ? -s.shadingNormal : s.shadingNormal;
-  GpuMaterial m = materials[s.material];
+  GpuMaterial m = materialAt(s.material);
   ShadingPoint q = shadingPoint(s.position, s.geometricNormal, ns, wo, materialBaseColor(m, s.uv).rgb, s.material);
   directLightSample(q, u, pc.counts.x, 0.0, budget, contribution, light);
 }
@@ -92,7 +92,7 @@ vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, 
       RayHit h = traceWithBudget(budget, origin, direction, 0.0, dMax, false);
       if (rayHitValid(h) && h.primitive != kInvalidIndex) {
         r = rho(h.t, dMax, rhoKind, pc.params.y);
-        bool reflector = reflectors && triangleShading[h.primitive].n2.w != 0.0;
+        bool reflector = reflectors && triangleShadingAt(h.primitive).n2.w != 0.0;
         // An unmarked surface keeps the later bounces and the first scaled by r (the marked
         // ones hold more than the mean direct light, the rest less; secondary_reflectors.h).
         if (reflectors && !reflector && pc.reflectors.w != 1.0) share = pc.reflectors.rgb + pc.reflectors.w * (1.0 - pc.reflectors.rgb);

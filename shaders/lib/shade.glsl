@@ -24,7 +24,7 @@ ShadingPoint shadingPoint(vec3 position, vec3 ng, vec3 ns, vec3 wo, vec3 baseCol
   sp.wo = wo;
   sp.baseColor = baseColor;
   sp.material = material;
-  GpuMaterial m = materials[material];
+  GpuMaterial m = materialAt(material);
   sp.metallic = m.params.x;
   sp.roughness = m.params.y;
   sp.glossy = m.params.w != 0.0;

@@ -26,7 +26,7 @@ Surface surfaceAt(RayHit hit, vec3 origin, vec3 direction) {
   s.frontFacing = dot(ng, direction) < 0.0;
   s.geometricNormal = s.frontFacing ? ng : -ng;
 
-  TriangleShading sh = triangleShading[hit.primitive];
+  TriangleShading sh = triangleShadingAt(hit.primitive);
   vec3 ns = w * sh.n0.xyz + hit.u * sh.n1.xyz + hit.v * sh.n2.xyz;
   float len = length(ns);
   ns = len > 0.0 ? ns / len : s.geometricNormal;

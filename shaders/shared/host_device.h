@@ -101,6 +101,7 @@ struct TriangleShading {
   vec4 uv01; // 48: uv0.xy, uv1.xy
   vec4 uv2;  // 64: uv2.xy, unused
 };           // 80 bytes
+OBS_CONST uint kTexelsPerShading = 5;
 
 // ---- Material: only what the method uses [SPEC §5].
 struct GpuMaterial {
@@ -111,6 +112,7 @@ struct GpuMaterial {
   vec4 meanAlbedo;   // 64: rgb mean albedo a-bar of the BRDF with the base colour factor
                      //     [SPEC §1.2, RTO eqs. 10-13], w = unused
 };                   // 80 bytes
+OBS_CONST uint kTexelsPerMaterial = 5;
 
 // ---- Lights. Each light is one basis buffer D_s [SPEC §3]: an emissive light GROUP (its
 // triangles in GpuEmitter[]) or a punctual light. Buffers hold transport at UNIT emission; the
@@ -282,9 +284,9 @@ struct TracePush {
 
 // ---- Descriptor bindings (set 0) shared by every pass that traces rays.
 OBS_CONST uint kBindingBvhItems = 0;  // samplerBuffer RGBA32F: nodes, then triangles (64-byte items)
-OBS_CONST uint kBindingShading = 1;   // SSBO TriangleShading[]
-OBS_CONST uint kBindingMaterials = 2; // SSBO GpuMaterial[]
-OBS_CONST uint kBindingTextures = 3;  // SSBO GpuTexture[]
+OBS_CONST uint kBindingShading = 1;   // samplerBuffer RGBA32F: TriangleShading[], kTexelsPerShading texels each
+OBS_CONST uint kBindingMaterials = 2; // samplerBuffer RGBA32F: GpuMaterial[], kTexelsPerMaterial texels each
+OBS_CONST uint kBindingTextures = 3;  // usamplerBuffer RGBA32UI: GpuTexture[], one texel each
 OBS_CONST uint kBindingTexels = 4;    // uniform texel buffer, R8G8B8A8_UNORM
 OBS_CONST uint kBindingStatus = 5;    // SSBO uint[kStatusWords]
 OBS_CONST uint kSceneBindingCount = 6;

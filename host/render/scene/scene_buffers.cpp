@@ -30,10 +30,16 @@ bvh::TriangleSoup triangleSoup(const scene::Scene& scene) {
   return soup;
 }
 
+static_assert(sizeof(gpu::TriangleShading) == gpu::kTexelsPerShading * sizeof(gpu::vec4));
+static_assert(sizeof(gpu::GpuMaterial) == gpu::kTexelsPerMaterial * sizeof(gpu::vec4));
+static_assert(sizeof(gpu::GpuTexture) == sizeof(glm::uvec4));
+
 std::vector<gpu::BindingKind> sceneBindingKinds() {
   using K = gpu::BindingKind;
-  return {K::UniformTexelBuffer, K::StorageBuffer,      K::StorageBuffer,
-          K::StorageBuffer,      K::UniformTexelBuffer, K::StorageBuffer};
+  // Texel buffers for everything a ray's hit reads: lavapipe fetches a texel with one vector gather
+  // where an SSBO field whose address differs between lanes is one scalar load per lane per word.
+  return {K::UniformTexelBuffer, K::UniformTexelBuffer, K::UniformTexelBuffer,
+          K::UniformTexelBuffer, K::UniformTexelBuffer, K::StorageBuffer};
 }
 
 float sceneScale(const scene::Bounds& bounds) {
@@ -124,12 +130,13 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
   items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::vec4), "scene.bvhItems");
 
   auto shading = shadingData(scene, reflectors_);
-  shading_ = gpu::Buffer(context, shading.size() * sizeof(gpu::TriangleShading), Usage::eStorageBuffer, "scene.shading");
-  shading_.upload(context, shading);
+  if (shading.empty()) shading.emplace_back(); // Vulkan buffers cannot be empty
+  checkTexelLimit(context, shading.size() * gpu::kTexelsPerShading, "triangles' shading data");
+  shading_ = gpu::TexelBuffer(context, shading.data(), shading.size() * sizeof(gpu::TriangleShading), "scene.shading");
 
   auto materials = materialData(scene);
-  materials_ = gpu::Buffer(context, materials.size() * sizeof(gpu::GpuMaterial), Usage::eStorageBuffer, "scene.materials");
-  materials_.upload(context, materials);
+  if (materials.empty()) materials.emplace_back();
+  materials_ = gpu::TexelBuffer(context, materials.data(), materials.size() * sizeof(gpu::GpuMaterial), "scene.materials");
 
   std::vector<scene::Texture> fitted =
       fitTextures(scene.textures, context.info().maxStorageBufferRange, notes_);
@@ -140,8 +147,10 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
                                                t.srgb ? gpu::kTextureSrgb : 0u)});
     texelCount += static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height);
   }
-  textures_ = gpu::Buffer(context, textureTable.size() * sizeof(gpu::GpuTexture), Usage::eStorageBuffer, "scene.textures");
-  textures_.upload(context, textureTable);
+  if (textureTable.empty()) textureTable.emplace_back(); // Vulkan buffers cannot be empty
+  textures_ = gpu::TexelBuffer(context, textureTable.size() * sizeof(gpu::GpuTexture), vk::Format::eR32G32B32A32Uint,
+                               {}, "scene.textures");
+  textures_.upload(context, textureTable.data(), textureTable.size() * sizeof(gpu::GpuTexture));
   checkTexelLimit(context, texelCount, "textures");
   texels_ = gpu::TexelBuffer(context, std::max<std::size_t>(texelCount, 1) * 4, vk::Format::eR8G8B8A8Unorm, {},
                              "scene.texels");
@@ -152,32 +161,35 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
   }
 
   status_ = StatusCounters(context, "scene.status");
-  bytes_ = items_.buffer().size() + shading_.size() + materials_.size() +
-           textures_.size() + texels_.buffer().size() + status_.buffer().size();
+  bytes_ = items_.buffer().size() + shading_.buffer().size() + materials_.buffer().size() +
+           textures_.buffer().size() + texels_.buffer().size() + status_.buffer().size();
 }
 
 void SceneBuffers::setSecondaryReflectors(const scene::Scene& scene, std::vector<std::uint8_t> marked) {
   reflectors_ = std::move(marked);
-  shading_.upload(*context_, shadingData(scene, reflectors_));
+  auto shading = shadingData(scene, reflectors_);
+  if (shading.empty()) shading.emplace_back();
+  shading_.upload(*context_, shading.data(), shading.size() * sizeof(gpu::TriangleShading));
 }
 
 bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh) {
   auto items = bvhTexels(bvh);
   auto shading = shadingData(scene, reflectors_);
+  if (shading.empty()) shading.emplace_back();
   const std::size_t itemBytes = items.size() * sizeof(gpu::vec4);
   const std::size_t shadingBytes = shading.size() * sizeof(gpu::TriangleShading);
   compactStackVectors_ = bvh::compactStackVectors(bvh);
-  if (itemBytes == items_.buffer().size() && shadingBytes == shading_.size()) {
+  if (itemBytes == items_.buffer().size() && shadingBytes == shading_.buffer().size()) {
     items_.upload(*context_, items.data(), itemBytes);
-    shading_.upload(*context_, shading);
+    shading_.upload(*context_, shading.data(), shadingBytes);
     return false;
   }
   checkTexelLimit(*context_, items.size(), "BVH nodes and triangles");
-  bytes_ -= items_.buffer().size() + shading_.size();
+  checkTexelLimit(*context_, shading.size() * gpu::kTexelsPerShading, "triangles' shading data");
+  bytes_ -= items_.buffer().size() + shading_.buffer().size();
   items_ = gpu::TexelBuffer(*context_, items.data(), itemBytes, "scene.bvhItems");
-  shading_ = gpu::Buffer(*context_, shadingBytes, vk::BufferUsageFlagBits::eStorageBuffer, "scene.shading");
-  shading_.upload(*context_, shading);
-  bytes_ += items_.buffer().size() + shading_.size();
+  shading_ = gpu::TexelBuffer(*context_, shading.data(), shadingBytes, "scene.shading");
+  bytes_ += items_.buffer().size() + shading_.buffer().size();
   return true;
 }
 

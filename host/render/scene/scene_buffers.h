@@ -71,9 +71,9 @@ public:
 private:
   const gpu::Context* context_;
   gpu::TexelBuffer items_;
-  gpu::Buffer shading_;
-  gpu::Buffer materials_;
-  gpu::Buffer textures_;
+  gpu::TexelBuffer shading_;
+  gpu::TexelBuffer materials_;
+  gpu::TexelBuffer textures_;
   gpu::TexelBuffer texels_;
   StatusCounters status_;
   std::uint64_t bytes_ = 0;
