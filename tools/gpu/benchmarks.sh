@@ -5,7 +5,7 @@
 # OUT_DIR gets log.txt (everything printed) and a few images and JSON files, at most 8 files.
 # "quick" shrinks every size so that the script itself can be tried on lavapipe first.
 #
-#   bench-rays, both scenes: closest-hit and shadow rays per second (16M random rays, the best of
+#   bench-rays, both scenes: closest-hit and shadow rays per second (4M random rays, the best of
 #     5 timed repeats, the first 100k checked against the CPU traversal, on Sponza the first 1M),
 #     on modern-hall the paper's budget at 800x600 per pass (--passes), and on Sponza the general
 #     kernel (its stack in memory, --stack-registers 0) beside the compact stack that it takes
@@ -26,7 +26,7 @@ export LD_LIBRARY_PATH=$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-rays=16777216 verify=1000000 passes=800x600 hall=(800 600) sponza=(1920 1080) limit=${STEP_LIMIT:-150}
+rays=4194304 verify=1000000 passes=800x600 hall=(800 600) sponza=(1920 1080) limit=${STEP_LIMIT:-150}
 if [ "$quick" = quick ]; then rays=65536 verify=65536 passes=80x60 hall=(80 60) sponza=(96 54) limit=300; fi
 
 step() { # name command...: runs it under a time limit, everything into log.txt
