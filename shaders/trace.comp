@@ -8,6 +8,7 @@
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"
 #include "lib/intersect.glsl"
+#define OBS_BVH_ITEMS_STORAGE_BINDING (kBindingPassFirst + 3) // --bvh-items storage
 #include "lib/bvh.glsl"
 
 layout(local_size_x = kTraceWorkgroupSize, local_size_x_id = kSpecConstantTraceWorkgroupSize) in;

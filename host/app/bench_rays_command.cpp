@@ -53,6 +53,7 @@ struct BenchOptions {
   std::string lanes;               // WxH: lane utilisation of that frame's rays in several orders
   std::string traceShape;          // WxR: trace.comp's workgroup size and rays per invocation
   std::optional<std::uint32_t> stackRegisters; // the kernel's compact-stack registers (0: the general kernel)
+  std::string bvhItems = "texel";              // how trace.comp reads the BVH: "texel" view or "storage" buffer
   render::ObscuranceFrameWork frameWork; // its spp, rays per hit, dmax, seed
   DeviceOptions device;
 };
@@ -356,6 +357,10 @@ void runBench(const BenchOptions& o) {
   render::SceneBuffers buffers(context, loaded.scene, loaded.bvh);
   std::optional<render::TraceShape> shape;
   if (!o.traceShape.empty()) shape = parseTraceShape(o.traceShape, context);
+  if (o.bvhItems == "storage") {
+    if (!shape) shape = render::TraceShape::forDevice(context);
+    shape->bvhItemsFromStorage = true;
+  }
   if (o.stackRegisters && !bvh::compactStackHolds(*o.stackRegisters, buffers.compactStackVectors()))
     throw InputError(fmt::format("--stack-registers {}: this BVH (depth {}) needs {} (or 0, the general kernel)",
                                  *o.stackRegisters, loaded.bvh.stats.maxDepth, buffers.compactStackVectors()));
@@ -527,6 +532,10 @@ void addBenchRaysCommand(CLI::App& app) {
                               "BVH needs), or 0 for the general kernel's stack in memory (default: what the BVH needs)",
                               gpu::kBvhCompactStackVectors))
       ->check(CLI::Range(0u, gpu::kBvhCompactStackVectors));
+  cmd->add_option("--bvh-items", o->bvhItems,
+                  "how trace.comp reads the BVH's nodes and triangles: through the texel view the passes use "
+                  "(texel, the default) or from the same buffer bound as an SSBO (storage)")
+      ->check(CLI::IsMember({"texel", "storage"}));
   cmd->add_option("--frame-spp", o->frameWork.spp, "--frame: samples per pixel")->check(CLI::Range(1u, 1024u));
   cmd->add_option("--frame-rays", o->frameWork.obscuranceRays, "--frame: obscurance rays per hit")
       ->check(CLI::Range(1u, 256u));

@@ -15,6 +15,7 @@ gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::
   // which lavapipe reads and writes a texel per lane at a time (an SSBO: a word per lane at a time).
   bindings.push_back(gpu::BindingKind::UniformTexelBuffer);
   bindings.insert(bindings.end(), 2, gpu::BindingKind::StorageTexelBuffer);
+  bindings.push_back(gpu::BindingKind::StorageBuffer); // the BVH's items, for bvhItemsFromStorage
   return {.name = "trace",
           .spirv = kSpirv_trace,
           .bindings = bindings,
@@ -22,7 +23,8 @@ gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::
           .specConstants = {{gpu::kSpecConstantTraceSteps, recordSteps ? 1u : 0u},
                             {gpu::kSpecConstantTraceRaysPerLane, shape.raysPerLane},
                             {gpu::kSpecConstantTraceWorkgroupSize, shape.workgroupSize},
-                            {gpu::kSpecConstantCompactStack, compactStackVectors}},
+                            {gpu::kSpecConstantCompactStack, compactStackVectors},
+                            {gpu::kSpecConstantBvhItemsFromStorage, shape.bvhItemsFromStorage ? 1u : 0u}},
           .deferCompile = recordSteps};
 }
 } // namespace
@@ -39,6 +41,8 @@ RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std
       timestamps_(context) {
   scene.bindTo(kernel_);
   scene.bindTo(stepsKernel_);
+  kernel_.bind(gpu::kBindingPassFirst + 3, scene.bvhItemsBuffer());
+  stepsKernel_.bind(gpu::kBindingPassFirst + 3, scene.bvhItemsBuffer());
 }
 
 TraceResult RayTracer::trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps) {

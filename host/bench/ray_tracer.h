@@ -26,6 +26,8 @@ struct TraceResult {
 struct TraceShape {
   std::uint32_t workgroupSize = gpu::kTraceWorkgroupSize;
   std::uint32_t raysPerLane = gpu::kTraceRaysPerLane;
+  // The BVH read from its buffer bound as an SSBO, not through the texel view (the passes' path).
+  bool bvhItemsFromStorage = false;
   static TraceShape forCpu() { return {}; }
   static TraceShape forGpu() { return {gpu::kTraceGpuWorkgroupSize, gpu::kTraceGpuRaysPerLane}; }
   static TraceShape forDevice(const gpu::Context& context); // forCpu() on a CPU device, forGpu() otherwise

@@ -102,8 +102,8 @@ TexelBuffer::TexelBuffer(const Context& context, vk::DeviceSize size, vk::Format
 }
 
 TexelBuffer::TexelBuffer(const Context& context, const void* data, vk::DeviceSize size,
-                         const std::string& name)
-    : buffer_(context, size, vk::BufferUsageFlagBits::eUniformTexelBuffer, name) {
+                         const std::string& name, vk::BufferUsageFlags extraUsage)
+    : buffer_(context, size, vk::BufferUsageFlagBits::eUniformTexelBuffer | extraUsage, name) {
   buffer_.upload(context, data, size);
   view_ = context.device().createBufferView({.buffer = buffer_.handle(),
                                              .format = vk::Format::eR32G32B32A32Sfloat,

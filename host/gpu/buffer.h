@@ -67,7 +67,9 @@ private:
 class TexelBuffer {
 public:
   TexelBuffer() = default;
-  TexelBuffer(const Context& context, const void* data, vk::DeviceSize size, const std::string& name);
+  // RGBA32F texels of `data`; `extraUsage` besides the texel view (e.g. storage, to bind it as an SSBO too).
+  TexelBuffer(const Context& context, const void* data, vk::DeviceSize size, const std::string& name,
+              vk::BufferUsageFlags extraUsage = {});
   // `size` bytes of `format` texels, uninitialised; `extraUsage` (e.g. storage, for a pass that
   // writes them) besides the texel view.
   TexelBuffer(const Context& context, vk::DeviceSize size, vk::Format format, vk::BufferUsageFlags extraUsage,

@@ -14,6 +14,18 @@
 #ifndef OBSCURA_BVH_GLSL
 #define OBSCURA_BVH_GLSL
 
+// Texel i of the BVH's items (scene_bindings.glsl: nodes, then triangles). A kernel that defines
+// OBS_BVH_ITEMS_STORAGE_BINDING (trace.comp) also sees the same buffer as an SSBO there and reads
+// it that way where specialised with kSpecConstantBvhItemsFromStorage: lavapipe gathers a texel
+// per lane as one vector, a GPU may serve the two paths from different caches.
+#ifdef OBS_BVH_ITEMS_STORAGE_BINDING
+layout(std430, set = 0, binding = OBS_BVH_ITEMS_STORAGE_BINDING) readonly buffer BvhItemStorage { vec4 bvhItemStorage[]; };
+layout(constant_id = kSpecConstantBvhItemsFromStorage) const bool kBvhItemsFromStorage = false;
+vec4 bvhItem(int i) { return kBvhItemsFromStorage ? bvhItemStorage[i] : texelFetch(bvhItems, i); }
+#else
+vec4 bvhItem(int i) { return texelFetch(bvhItems, i); }
+#endif
+
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
 #include "probe.glsl"
@@ -155,15 +167,15 @@ PassItems fetchPassItems(inout uint triangleBase, inout uint triangleBits, inout
   it.onNode = (group.y & 0xFFu) != 0u && queuedBits == 0u;
   uint node = groupChild(group, octant, it.bit);
   int tb = it.onTriangle ? int(it.triangle) : 0;
-  it.p0 = texelFetch(bvhItems, tb);
-  it.p1 = texelFetch(bvhItems, tb + 1);
-  it.p2 = texelFetch(bvhItems, tb + 2);
+  it.p0 = bvhItem(tb);
+  it.p1 = bvhItem(tb + 1);
+  it.p2 = bvhItem(tb + 2);
   int nb = it.onNode ? int(node * kTexelsPerNode) : 0;
-  it.n0 = texelFetch(bvhItems, nb);
-  it.n1 = texelFetch(bvhItems, nb + 1);
-  it.n2 = texelFetch(bvhItems, nb + 2);
-  it.n3 = texelFetch(bvhItems, nb + 3);
-  it.n4 = texelFetch(bvhItems, nb + 4);
+  it.n0 = bvhItem(nb);
+  it.n1 = bvhItem(nb + 1);
+  it.n2 = bvhItem(nb + 2);
+  it.n3 = bvhItem(nb + 3);
+  it.n4 = bvhItem(nb + 4);
   return it;
 }
 
@@ -376,9 +388,9 @@ RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool any
 RayHit storedHit(vec3 origin, vec3 direction, float tmin, float t, uint item) {
   RayHit h = RayHit(t, 0.0, 0.0, item == kTruncatedHit ? kTruncatedHit : kInvalidIndex, item, 0u);
   if (item >= kTruncatedHit) return h;
-  vec4 p0 = texelFetch(bvhItems, int(item));
-  vec4 p1 = texelFetch(bvhItems, int(item) + 1);
-  vec4 p2 = texelFetch(bvhItems, int(item) + 2);
+  vec4 p0 = bvhItem(int(item));
+  vec4 p1 = bvhItem(int(item) + 1);
+  vec4 p2 = bvhItem(int(item) + 2);
   float tAgain;
   intersectTriangle(prepareWatertightRay(origin, direction), p0.xyz, p1.xyz, p2.xyz, tmin, t, tAgain, h.u, h.v);
   h.primitive = floatBitsToUint(p0.w);

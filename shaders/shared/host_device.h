@@ -411,6 +411,9 @@ OBS_CONST uint kSpecConstantTraceWorkgroupSize = 10u;
 // even where no lane enters it, so that loop cost every traversal one full (masked) pass, and
 // every live register of the loop counts: spills are a quarter of a pass.
 OBS_CONST uint kSpecConstantCompactStack = 11u;
+// trace.comp reads the BVH's nodes and triangles from the same buffer bound as an SSBO instead of
+// through its texel view (bench-rays --bvh-items storage: which path a GPU fetches faster).
+OBS_CONST uint kSpecConstantBvhItemsFromStorage = 12u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

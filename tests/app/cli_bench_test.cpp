@@ -132,6 +132,19 @@ TEST_F(CliBench, TraceShapeOptionTracesWithThatShapeAndVerifies) {
   EXPECT_GT(j.at("closest_hit_fraction").get<double>(), 0.0);
 }
 
+// --stack-registers 0 traces with the general kernel, --bvh-items storage reads the BVH as an
+// SSBO: the same answers; too few registers for the BVH is refused by name.
+TEST_F(CliBench, StackAndBvhItemOptionsTraceTheSameAnswersAndTooFewRegistersAreRefused) {
+  for (const char* option : {"--stack-registers 0", "--bvh-items storage"}) {
+    const auto r = runObscura("bench-rays " + cornellBox() + " --rays 2048 --repeats 1 --verify 2048 --json " + option);
+    ASSERT_EQ(r.exitCode, 0) << option << r.output;
+    EXPECT_EQ(lastJsonLine(r.output).at("mismatches").get<int>(), 0) << option;
+  }
+  const auto r = runObscura("bench-rays " + sharedScene("modern-hall/modern-hall.gltf") + " --rays 64 --stack-registers 1");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_CONTAINS(r.output, "--stack-registers 1: this BVH (depth 9) needs 2");
+}
+
 TEST_F(CliBench, BadTraceShapeIsRefusedByName) {
   for (const char* shape : {"128", "100x1", "32x65", "1024x64"}) {
     const auto r = runObscura("bench-rays " + cornellBox() + " --rays 64 --trace-shape " + shape);

@@ -116,12 +116,16 @@ TEST_F(GpuTraversal, ModernHallMatchesBruteForce) {
 }
 
 // trace.comp's other shapes, run here on lavapipe: a GPU's (8 rays per invocation, workgroups of
-// 32) and one ray per invocation straight through traverseBvh (kRaysPerLane = 1): the same
-// answers as the brute force, like the lavapipe shape above.
+// 32) and one ray per invocation straight through traverseBvh (kRaysPerLane = 1), and the BVH read
+// from its buffer as an SSBO instead of through the texel view: the same answers as the brute
+// force, like the lavapipe shape above.
 TEST_F(GpuTraversal, GpuAndOneRayPerInvocationShapesMatchBruteForce) {
   scene::Scene soup = soupScene(randomSoup(3000, 1));
   expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape::forGpu()), "random soup, GPU shape");
   expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape{128, 1}), "random soup, one ray per invocation");
+  render::TraceShape fromStorage = render::TraceShape::forGpu();
+  fromStorage.bvhItemsFromStorage = true;
+  expectAgreement(traceAndCompare(soup, 100000, 1, fromStorage), "random soup, GPU shape, BVH from an SSBO");
 }
 
 // Repeats traced back to back in one submission (bench-rays on a GPU) each give a time and the

@@ -127,7 +127,8 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
   using Usage = vk::BufferUsageFlagBits;
   auto items = bvhTexels(bvh);
   checkTexelLimit(context, items.size(), "BVH nodes and triangles");
-  items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::vec4), "scene.bvhItems");
+  items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::vec4), "scene.bvhItems",
+                            vk::BufferUsageFlagBits::eStorageBuffer);
 
   auto shading = shadingData(scene, reflectors_);
   if (shading.empty()) shading.emplace_back(); // Vulkan buffers cannot be empty
@@ -187,7 +188,7 @@ bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh
   checkTexelLimit(*context_, items.size(), "BVH nodes and triangles");
   checkTexelLimit(*context_, shading.size() * gpu::kTexelsPerShading, "triangles' shading data");
   bytes_ -= items_.buffer().size() + shading_.buffer().size();
-  items_ = gpu::TexelBuffer(*context_, items.data(), itemBytes, "scene.bvhItems");
+  items_ = gpu::TexelBuffer(*context_, items.data(), itemBytes, "scene.bvhItems", vk::BufferUsageFlagBits::eStorageBuffer);
   shading_ = gpu::TexelBuffer(*context_, shading.data(), shadingBytes, "scene.shading");
   bytes_ += items_.buffer().size() + shading_.buffer().size();
   return true;

@@ -65,6 +65,8 @@ public:
   void resetStatus();
 
   std::uint64_t bytes() const { return bytes_; }
+  // The BVH's items buffer itself (also a storage buffer), for trace.comp's SSBO path.
+  const gpu::Buffer& bvhItemsBuffer() const { return items_.buffer(); }
   // What the upload had to change (textures reduced to fit a device limit), for the log.
   const std::vector<std::string>& notes() const { return notes_; }
 
