@@ -77,9 +77,11 @@ std::vector<gpu::vec4> bvhTexels(const bvh::Bvh& bvh) {
 
 namespace {
 
-// `reflectors[t]` 1: triangle t is an important secondary reflector (n2.w = 1).
+// `reflectors[t]` 1: triangle t is an important secondary reflector (n2.w = 1). At least one
+// entry: Vulkan buffers cannot be empty.
 std::vector<gpu::TriangleShading> shadingData(const scene::Scene& scene, const std::vector<std::uint8_t>& reflectors) {
-  std::vector<gpu::TriangleShading> out(scene.triangles.size());
+  std::vector<gpu::TriangleShading> out(std::max<std::size_t>(scene.triangles.size(), 1));
+  if (scene.triangles.empty()) return out;
   for (std::size_t i = 0; i < out.size(); ++i) {
     const glm::uvec3& t = scene.triangles[i];
     std::uint32_t material = scene.triangleMaterial[i];
@@ -124,19 +126,17 @@ void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char
 
 SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh)
     : context_(&context), compactStackVectors_(bvh::compactStackVectors(bvh)) {
-  using Usage = vk::BufferUsageFlagBits;
   auto items = bvhTexels(bvh);
   checkTexelLimit(context, items.size(), "BVH nodes and triangles");
   items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::vec4), "scene.bvhItems",
                             vk::BufferUsageFlagBits::eStorageBuffer);
 
   auto shading = shadingData(scene, reflectors_);
-  if (shading.empty()) shading.emplace_back(); // Vulkan buffers cannot be empty
   checkTexelLimit(context, shading.size() * gpu::kTexelsPerShading, "triangles' shading data");
   shading_ = gpu::TexelBuffer(context, shading.data(), shading.size() * sizeof(gpu::TriangleShading), "scene.shading");
 
   auto materials = materialData(scene);
-  if (materials.empty()) materials.emplace_back();
+  if (materials.empty()) materials.emplace_back(); // Vulkan buffers cannot be empty
   materials_ = gpu::TexelBuffer(context, materials.data(), materials.size() * sizeof(gpu::GpuMaterial), "scene.materials");
 
   std::vector<scene::Texture> fitted =
@@ -169,14 +169,12 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
 void SceneBuffers::setSecondaryReflectors(const scene::Scene& scene, std::vector<std::uint8_t> marked) {
   reflectors_ = std::move(marked);
   auto shading = shadingData(scene, reflectors_);
-  if (shading.empty()) shading.emplace_back();
   shading_.upload(*context_, shading.data(), shading.size() * sizeof(gpu::TriangleShading));
 }
 
 bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh) {
   auto items = bvhTexels(bvh);
   auto shading = shadingData(scene, reflectors_);
-  if (shading.empty()) shading.emplace_back();
   const std::size_t itemBytes = items.size() * sizeof(gpu::vec4);
   const std::size_t shadingBytes = shading.size() * sizeof(gpu::TriangleShading);
   compactStackVectors_ = bvh::compactStackVectors(bvh);
