@@ -29,6 +29,7 @@ layout(std430, set = 0, binding = kBindingPrimarySampleCounts) buffer SampleCoun
 // shader, and both sides of a branch run).
 layout(constant_id = kSpecConstantPrimaryAovs) const bool kAovs = false;
 layout(constant_id = kSpecConstantEmissionRays) const bool kEmissionRays = false;
+layout(constant_id = kSpecConstantPrimaryHitBounds) const bool kHitBounds = true;
 
 void accumulate(uint pixel, uint slot, vec4 value, bool first) {
   uint i = pixel * kAovSlots + slot;
@@ -102,20 +103,23 @@ void main() {
   gbuffer[pixel] = g;
   if (!accumulateSums) return;
   // Every sum of the pixel restarts at its sample 0 (a whole frame's, or a dirty pixel's retrace),
-  // and so does its count: compose divides each pixel by its own.
-  sampleCounts[pixel] = first ? 1u : sampleCounts[pixel] + 1u;
+  // and so does its count, which is therefore the sample index + 1 (a store, not a load and a
+  // store): compose divides each pixel by its own.
+  sampleCounts[pixel] = sampleIndex + 1u;
 
   // The box of the pixel's hits over its samples, for the dirty pixels of a geometry edit
   // (specular.comp adds its paths' vertices, and w = 1 when one left the scene).
-  bool hitSomething = g.albedo.a != 0.0;
-  vec4 lo = vec4(hitSomething ? g.position.xyz : vec3(1e30), 0.0);
-  vec4 hi = vec4(hitSomething ? g.position.xyz : vec3(-1e30), hitSomething ? 1.0 : 0.0);
-  if (!first) {
-    lo = vec4(min(lo.xyz, hitBounds[2u * pixel].xyz), max(lo.w, hitBounds[2u * pixel].w));
-    hi = vec4(max(hi.xyz, hitBounds[2u * pixel + 1u].xyz), max(hi.w, hitBounds[2u * pixel + 1u].w));
+  if (kHitBounds) {
+    bool hitSomething = g.albedo.a != 0.0;
+    vec4 lo = vec4(hitSomething ? g.position.xyz : vec3(1e30), 0.0);
+    vec4 hi = vec4(hitSomething ? g.position.xyz : vec3(-1e30), hitSomething ? 1.0 : 0.0);
+    if (!first) {
+      lo = vec4(min(lo.xyz, hitBounds[2u * pixel].xyz), max(lo.w, hitBounds[2u * pixel].w));
+      hi = vec4(max(hi.xyz, hitBounds[2u * pixel + 1u].xyz), max(hi.w, hitBounds[2u * pixel + 1u].w));
+    }
+    hitBounds[2u * pixel] = lo;
+    hitBounds[2u * pixel + 1u] = hi;
   }
-  hitBounds[2u * pixel] = lo;
-  hitBounds[2u * pixel + 1u] = hi;
 
   // M_s: the emission the camera sees, per light at unit emission, so that relighting scales a
   // lamp the camera looks at with its light [SPEC §3]. Sample 0 starts every light's sum. Each

@@ -155,6 +155,7 @@ public:
       statsCopy_ = pathTracer_->stats();
     } else {
       render::ObscuranceSettings s;
+      s.editableGeometry = false;
       s.width = width_;
       s.height = height_;
       s.spp = spp;

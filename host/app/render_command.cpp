@@ -157,6 +157,7 @@ void runRender(RenderOptions& o) {
   fmt::print(stderr, "device: {} ({})\n", context.info().name, context.info().driver);
 
   render::ObscuranceSettings settings = obscuranceSettings(o, camera);
+  settings.editableGeometry = false; // rendered, written out, done
   const bool tty = ::isatty(STDERR_FILENO);
   const std::uint64_t raysPerSample = std::uint64_t(o.width) * o.height *
                                       (1 + settings.shadowRays + settings.obscuranceRays);

@@ -33,6 +33,7 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
   settings.colourBleeding = false;
   settings.maxDepth = 1; // the primary hit only: no specular pass
   settings.primaryAovs = false;
+  settings.editableGeometry = false;
   settings.ambient = AmbientModel::Global; // no light rays for the reach (not timed, not needed)
   ObscuranceRenderer renderer(context, scene, bvh, settings);
   renderer.iterate(1); // warm-up: the first dispatches fault the buffers in
@@ -79,6 +80,7 @@ RenderStats renderPaperBudget(const gpu::Context& context, const scene::Scene& s
   settings.width = width;
   settings.height = height;
   settings.camera = camera;
+  settings.editableGeometry = false; // a render, as `render` makes it (the AOVs are kept, as the defaults do)
   ObscuranceRenderer renderer(context, scene, bvh, settings);
   renderer.iterate(1); // warm-up
   RenderStats best;

@@ -101,7 +101,8 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
                            .keptShadowRays = keptShadowRays(settings)},
              settings.maxBufferBytes),
       compactStackVectors_(sceneBuffers_.compactStackVectors()),
-      primary_(context, frame_.layout().bandCount(), compactStackVectors_), shadow_(context, shadingKernels()),
+      primary_(context, frame_.layout().bandCount(), compactStackVectors_, settings.editableGeometry),
+      shadow_(context, shadingKernels()),
       obscurance_(context, shadingKernels()), specularPass_(context, shadingKernels()),
       compose_(context, frame_.layout().bandCount()), tonemap_(context, frame_.layout().bandCount()),
       resolve_(context, frame_.layout().bandCount()), lightMix_(context, frame_.layout().bandCount()),
@@ -250,7 +251,9 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
                            "renderer with them or with the Reached ambient model");
   const bool remark = settings.secondaryReflectors != settings_.secondaryReflectors;
   const SeenView fittedTo = seenView();
+  const bool editableGeometry = settings_.editableGeometry; // the primary pass's kernels are made for it
   settings_ = settings;
+  settings_.editableGeometry = editableGeometry;
   if (remark) markReflectors();
   dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax_;
   const bool depthChanged = ambient_.depth != (reached_ ? settings.maxDepth : 0u);
@@ -293,7 +296,7 @@ void ObscuranceRenderer::reset() {
 
 void ObscuranceRenderer::makeTracingPasses(std::uint32_t compactStackVectors) {
   compactStackVectors_ = compactStackVectors;
-  primary_ = PrimaryPass(*context_, frame_.layout().bandCount(), compactStackVectors_);
+  primary_ = PrimaryPass(*context_, frame_.layout().bandCount(), compactStackVectors_, settings_.editableGeometry);
   shadow_ = ShadowPass(*context_, shadingKernels());
   obscurance_ = ObscurancePass(*context_, shadingKernels());
   specularPass_ = SpecularPass(*context_, shadingKernels());
@@ -478,6 +481,9 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
 
 bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh& bvh,
                                       const std::vector<scene::Bounds>* changed) {
+  if (!settings_.editableGeometry)
+    throw std::logic_error("ObscuranceRenderer: a geometry edit of a renderer made with editableGeometry = false "
+                           "(its frame keeps no hit bounds to find the pixels to retrace)");
   // Same lights: only an emitter that moved changes them, and then every pixel may change.
   LightSet moved = buildLightSet(edited);
   bool emittersMoved = moved.emitters.size() != lights_.emitters.size();

@@ -115,6 +115,10 @@ struct ObscuranceSettings {
   // replay (light selection above all) costs what their retrace would (docs/BENCHMARKS.md,
   // "Geometry edits: probing").
   DirtyTest dirtyTest = DirtyTest::Auto;
+  // Whether the scene may be edited (updateGeometry, addEmitter): only then does the primary pass
+  // keep each pixel's box of hits that the edits' dirty test reads. A render that is written out
+  // and done (`render`, the benchmarks) sets it false; fixed when the renderer is made.
+  bool editableGeometry = true;
 };
 
 // The most device memory the kept rays may take (ObscuranceSettings::keptRaySamples), and at

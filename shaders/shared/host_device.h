@@ -414,6 +414,9 @@ OBS_CONST uint kSpecConstantCompactStack = 11u;
 // trace.comp reads the BVH's nodes and triangles from the same buffer bound as an SSBO instead of
 // through its texel view (bench-rays --bvh-items storage: which path a GPU fetches faster).
 OBS_CONST uint kSpecConstantBvhItemsFromStorage = 12u;
+// primary.comp keeps each pixel's box of hits for geometry edits (dirty.comp); a renderer that
+// will never edit its scene (ObscuranceSettings::editableGeometry) compiles it out.
+OBS_CONST uint kSpecConstantPrimaryHitBounds = 13u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

@@ -137,6 +137,33 @@ protected:
   bool secondLamp_ = false; // and its second lamp
 };
 
+// A renderer that will never edit its scene (editableGeometry = false, as `render` makes it)
+// leaves the hit bounds out of its primary pass: the same frame, bit for bit in every AOV, and a
+// geometry edit is refused instead of retracing from bounds it never kept.
+TEST_F(GeometryEdit, ARendererMadeWithoutHitBoundsRendersTheSameFrameAndRefusesAnEdit) {
+  render::ObscuranceSettings settings = editSettings();
+  settings.keptRaySamples = 0;
+  const scene::Scene room = roomWithObject({0.3f, 0.8f, 0.0f}, 0.5f, true, true);
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(room));
+  render::ObscuranceRenderer editable(context(), room, tree, settings);
+  editable.render();
+  settings.editableGeometry = false;
+  render::ObscuranceRenderer renderOnly(context(), room, tree, settings);
+  renderOnly.render();
+  const io::Image a = editable.image(), b = renderOnly.image();
+  ASSERT_EQ(a.channels.size(), b.channels.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i)
+    if (std::bit_cast<std::uint32_t>(a.pixels[i]) != std::bit_cast<std::uint32_t>(b.pixels[i])) ++differ;
+  EXPECT_EQ(differ, 0u);
+  const std::vector<scene::Bounds> changed = {objectBox({0.3f, 0.8f, 0.0f}, 0.5f)};
+  EXPECT_THROW(renderOnly.updateGeometry(room, tree, changed), std::logic_error);
+  // configure() keeps what the renderer was made for.
+  settings.editableGeometry = true;
+  renderOnly.configure(settings);
+  EXPECT_THROW(renderOnly.updateGeometry(room, tree, changed), std::logic_error);
+}
+
 // A BVH that outgrows the compact traversal stack in an edit (a rebuild may deepen the tree) is
 // traced by kernels made again for it: a deeper compact stack, or the general one. The edit keeps
 // the scene and swaps its BVH for a comb (test_scenes.h) as deep as the scene has triangles,

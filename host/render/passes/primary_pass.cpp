@@ -22,7 +22,8 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 namespace {
 // Variant `v`: bit 0 the AOV accumulators, bit 1 the emission rays. Compiled on first use (a render
 // dispatches one or two of the four; each is an LLVM compile of the shader on lavapipe).
-gpu::KernelDesc primaryKernelDesc(std::uint32_t bands, std::uint32_t v, std::uint32_t compactStackVectors) {
+gpu::KernelDesc primaryKernelDesc(std::uint32_t bands, std::uint32_t v, std::uint32_t compactStackVectors,
+                                  bool hitBounds) {
   auto bindings = sceneBindingKinds();
   bindings.insert(bindings.end(), gpu::kPrimaryBindingCount - gpu::kSceneBindingCount,
                   gpu::BindingKind::StorageBuffer);
@@ -30,16 +31,18 @@ gpu::KernelDesc primaryKernelDesc(std::uint32_t bands, std::uint32_t v, std::uin
           .pushConstantBytes = sizeof(gpu::PrimaryPush),
           .specConstants = {{gpu::kSpecConstantPrimaryAovs, v & 1u},
                             {gpu::kSpecConstantEmissionRays, (v >> 1) & 1u},
-                            {gpu::kSpecConstantCompactStack, compactStackVectors}},
+                            {gpu::kSpecConstantCompactStack, compactStackVectors},
+                            {gpu::kSpecConstantPrimaryHitBounds, hitBounds ? 1u : 0u}},
           .setCount = bands, .deferCompile = true};
 }
 } // namespace
 
-PrimaryPass::PrimaryPass(const gpu::Context& context, std::uint32_t bands, std::uint32_t compactStackVectors)
-    : kernels_{gpu::Kernel(context, primaryKernelDesc(bands, 0u, compactStackVectors)),
-               gpu::Kernel(context, primaryKernelDesc(bands, 1u, compactStackVectors)),
-               gpu::Kernel(context, primaryKernelDesc(bands, 2u, compactStackVectors)),
-               gpu::Kernel(context, primaryKernelDesc(bands, 3u, compactStackVectors))} {}
+PrimaryPass::PrimaryPass(const gpu::Context& context, std::uint32_t bands, std::uint32_t compactStackVectors,
+                         bool hitBounds)
+    : kernels_{gpu::Kernel(context, primaryKernelDesc(bands, 0u, compactStackVectors, hitBounds)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 1u, compactStackVectors, hitBounds)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 2u, compactStackVectors, hitBounds)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 3u, compactStackVectors, hitBounds))} {}
 
 const gpu::Kernel& PrimaryPass::kernelFor(std::uint32_t flags) const {
   const bool sums = (flags & gpu::kPrimaryFlagGBufferOnly) == 0;

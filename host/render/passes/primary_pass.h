@@ -20,8 +20,10 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 class PrimaryPass {
 public:
   // `compactStackVectors`: the kernels' compact traversal stack (SceneBuffers::compactStackVectors;
-  // 0: the general stack).
-  PrimaryPass(const gpu::Context& context, std::uint32_t bands, std::uint32_t compactStackVectors);
+  // 0: the general stack). `hitBounds`: keep each pixel's box of hits (kSpecConstantPrimaryHitBounds),
+  // which only geometry edits read.
+  PrimaryPass(const gpu::Context& context, std::uint32_t bands, std::uint32_t compactStackVectors,
+              bool hitBounds = true);
 
   // Binds band `band`'s descriptor set: the scene, the frame's status counters and band buffers,
   // and the lights' render-time emission scales (which make M_s unit).
