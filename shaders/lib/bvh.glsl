@@ -14,6 +14,10 @@
 #ifndef OBSCURA_BVH_GLSL
 #define OBSCURA_BVH_GLSL
 
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
+#include "probe.glsl"
+
 // Texel i of the BVH's items (scene_bindings.glsl: nodes, then triangles). A kernel that defines
 // OBS_BVH_ITEMS_STORAGE_BINDING (trace.comp) also sees the same buffer as an SSBO there and reads
 // it that way where specialised with kSpecConstantBvhItemsFromStorage: lavapipe gathers a texel
@@ -25,10 +29,6 @@ vec4 bvhItem(int i) { return kBvhItemsFromStorage ? bvhItemStorage[i] : texelFet
 #else
 vec4 bvhItem(int i) { return texelFetch(bvhItems, i); }
 #endif
-
-#extension GL_KHR_shader_subgroup_arithmetic : require
-
-#include "probe.glsl"
 
 struct RayHit {
   float t;

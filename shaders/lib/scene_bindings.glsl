@@ -13,6 +13,7 @@ layout(set = 0, binding = kBindingMaterials) uniform samplerBuffer materialTexel
 layout(set = 0, binding = kBindingTextures) uniform usamplerBuffer textureTexels;
 // RGBA8 texels of every texture, fetched as UNORM (0..1) through the texel view.
 layout(set = 0, binding = kBindingTexels) uniform samplerBuffer texels;
+
 // The shading data of triangle `primitive` (its original index).
 TriangleShading triangleShadingAt(uint primitive) {
   const int at = int(primitive * kTexelsPerShading);
