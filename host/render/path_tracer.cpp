@@ -52,7 +52,8 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
       layout_(FrameLayout::split(settings.width, settings.height, kAccumulator,
                                  maxBufferBytes ? maxBufferBytes : context.info().maxStorageBufferRange,
                                  "the radiance accumulator")),
-      kernel_(context, pathKernelDesc(layout_.bandCount(), sceneBuffers_.compactStackVectors())), stream_(context), timestamps_(context) {
+      kernel_(context, pathKernelDesc(layout_.bandCount(), sceneBuffers_.compactStackVectors())), stream_(context),
+      timestamps_(context) {
   if (pathTraceBytesNeeded(settings.width, settings.height) > context.info().deviceLocalBytes)
     throw InputError(fmt::format("{}x{}: path tracing needs {:.1f} MiB, more than the device offers", settings.width,
                                  settings.height,

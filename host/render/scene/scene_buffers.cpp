@@ -137,7 +137,8 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
 
   auto materials = materialData(scene);
   if (materials.empty()) materials.emplace_back(); // Vulkan buffers cannot be empty
-  materials_ = gpu::TexelBuffer(context, materials.data(), materials.size() * sizeof(gpu::GpuMaterial), "scene.materials");
+  materials_ =
+      gpu::TexelBuffer(context, materials.data(), materials.size() * sizeof(gpu::GpuMaterial), "scene.materials");
 
   std::vector<scene::Texture> fitted =
       fitTextures(scene.textures, context.info().maxStorageBufferRange, notes_);
@@ -186,7 +187,8 @@ bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh
   checkTexelLimit(*context_, items.size(), "BVH nodes and triangles");
   checkTexelLimit(*context_, shading.size() * gpu::kTexelsPerShading, "triangles' shading data");
   bytes_ -= items_.buffer().size() + shading_.buffer().size();
-  items_ = gpu::TexelBuffer(*context_, items.data(), itemBytes, "scene.bvhItems", vk::BufferUsageFlagBits::eStorageBuffer);
+  items_ =
+      gpu::TexelBuffer(*context_, items.data(), itemBytes, "scene.bvhItems", vk::BufferUsageFlagBits::eStorageBuffer);
   shading_ = gpu::TexelBuffer(*context_, shading.data(), shadingBytes, "scene.shading");
   bytes_ += items_.buffer().size() + shading_.buffer().size();
   return true;
