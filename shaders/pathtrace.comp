@@ -43,8 +43,7 @@
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 layout(push_constant) uniform Push { PathPush pc; };
 layout(std430, set = 0, binding = kBindingPathRadiance) buffer RadianceBuffer { vec4 radiance[]; };
-layout(std430, set = 0, binding = kBindingPathLights) readonly buffer LightBuffer { GpuLight lights[]; };
-layout(std430, set = 0, binding = kBindingPathEmitters) readonly buffer EmitterBuffer { GpuEmitter emitters[]; };
+#include "lib/light_bindings.glsl" // at kBindingPathLights and kBindingPathEmitters
 layout(std430, set = 0, binding = kBindingPathLightTree) readonly buffer LightTreeBuffer { GpuLightNode lightTree[]; };
 layout(std430, set = 0, binding = kBindingPathScales) readonly buffer ScaleBuffer { vec4 emissionScale[]; };
 

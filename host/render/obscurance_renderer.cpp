@@ -303,8 +303,8 @@ void ObscuranceRenderer::makeTracingPasses(std::uint32_t compactStackVectors) {
 }
 
 void ObscuranceRenderer::uploadLights() {
-  lightBuffers_.lights = gpu::uploadArray(*context_, lights_.lights, "lights.lights");
-  lightBuffers_.emitters = gpu::uploadArray(*context_, lights_.emitters, "lights.emitters");
+  lightBuffers_.lights = tableTexels(*context_, lights_.lights, "lights", "lights.lights");
+  lightBuffers_.emitters = tableTexels(*context_, lights_.emitters, "emissive triangles", "lights.emitters");
   lightBuffers_.tree = gpu::uploadArray(*context_, buildLightTree(lights_.lights), "lights.tree");
   lightBuffers_.scales = gpu::uploadArray(*context_, emissionRows(lights_.emission), "lights.render_scales");
   emissionBuffer_ = gpu::uploadArray(*context_, emissionRows(emissions_), "compose.emissions");
@@ -997,7 +997,7 @@ RenderStats ObscuranceRenderer::stats() const {
 }
 
 std::uint64_t ObscuranceRenderer::deviceBytes() const {
-  return sceneBuffers_.bytes() + frame_.bytes() + lightBuffers_.lights.size() + lightBuffers_.emitters.size() +
+  return sceneBuffers_.bytes() + frame_.bytes() + lightBuffers_.lights.buffer().size() + lightBuffers_.emitters.buffer().size() +
          lightBuffers_.tree.size() + lightBuffers_.scales.size() + emissionBuffer_.size();
 }
 

@@ -22,6 +22,7 @@ constexpr std::uint64_t kAccumulator = gpu::kAccumulatorVec4s * sizeof(glm::vec4
 gpu::KernelDesc pathKernelDesc(std::uint32_t bands, std::uint32_t compactStackVectors) {
   auto bindings = sceneBindingKinds();
   bindings.insert(bindings.end(), gpu::kPathBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
+  bindings[gpu::kBindingPathLights] = bindings[gpu::kBindingPathEmitters] = gpu::BindingKind::UniformTexelBuffer;
   return {.name = "pathtrace", .spirv = kSpirv_pathtrace, .bindings = bindings,
           .pushConstantBytes = sizeof(gpu::PathPush),
           .specConstants = {{gpu::kSpecConstantCompactStack, compactStackVectors}},
@@ -58,8 +59,8 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
     throw InputError(fmt::format("{}x{}: path tracing needs {:.1f} MiB, more than the device offers", settings.width,
                                  settings.height,
                                  static_cast<double>(pathTraceBytesNeeded(settings.width, settings.height)) / 1048576.0));
-  lightBuffer_ = gpu::uploadArray(context, lights_.lights, "pathtrace.lights");
-  emitterBuffer_ = gpu::uploadArray(context, lights_.emitters, "pathtrace.emitters");
+  lightBuffer_ = tableTexels(context, lights_.lights, "lights", "pathtrace.lights");
+  emitterBuffer_ = tableTexels(context, lights_.emitters, "emissive triangles", "pathtrace.emitters");
   treeBuffer_ = gpu::uploadArray(context, buildLightTree(lights_.lights), "pathtrace.light_tree");
   scaleBuffer_ = gpu::uploadArray(context, emissionRows(lights_.emission), "pathtrace.emission");
   status_ = StatusCounters(context, "pathtrace.status");
@@ -175,7 +176,7 @@ RenderStats PathTracer::stats() const {
   st.passes["pathtrace"] = {.gpuMs = timestamps_.totalsMs().contains("pathtrace") ? timestamps_.totalsMs().at("pathtrace")
                                                                                    : 0.0,
                             .rays = status[gpu::kStatusPathRays]};
-  std::uint64_t bytes = sceneBuffers_.bytes() + lightBuffer_.size() + emitterBuffer_.size() + scaleBuffer_.size() +
+  std::uint64_t bytes = sceneBuffers_.bytes() + lightBuffer_.buffer().size() + emitterBuffer_.buffer().size() + scaleBuffer_.size() +
                         status_.buffer().size();
   for (const auto& r : radiance_) bytes += r.size();
   st.deviceBytes = bytes;

@@ -76,7 +76,8 @@ private:
   PathTraceSettings settings_;
   SceneBuffers sceneBuffers_;
   LightSet lights_;
-  gpu::Buffer lightBuffer_, emitterBuffer_, treeBuffer_, scaleBuffer_;
+  gpu::TexelBuffer lightBuffer_, emitterBuffer_; // RGBA32F texels (shaders/lib/light_bindings.glsl)
+  gpu::Buffer treeBuffer_, scaleBuffer_;
   FrameLayout layout_;
   std::vector<gpu::Buffer> radiance_; // per band
   StatusCounters status_;

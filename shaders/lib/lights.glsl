@@ -1,7 +1,7 @@
 // lights.glsl — the one direct-light estimator's sampling half: choosing a light and a point on it
 // for a shadow ray [RTO §4.1 step 2, SPEC §1.3], and the density of that choice (for MIS).
-// Needs the light bindings (kBindingLights, kBindingEmitters, kBindingLightTree) declared by the
-// including shader as `lights[]`, `emitters[]` and `lightTree[]`, and sampling.glsl.
+// Needs light_bindings.glsl (lightAt, emitterAt), the light tree (kBindingLightTree) declared by
+// the including shader as `lightTree[]`, and sampling.glsl.
 //
 // Two estimators (kLightSampling* in host_device.h), chosen per dispatch through gLightSampling:
 // - Spatial (default): light i with probability importance_i(P, n) / sum_j importance_j(P, n)
@@ -44,7 +44,7 @@ uint selectLightByPower(float u, uint count) {
   uint lo = 0u, hi = count - 1u;
   while (lo < hi) {
     uint mid = (lo + hi) / 2u;
-    if (u < lights[mid].params.x) hi = mid; else lo = mid + 1u;
+    if (u < lightAt(mid).params.x) hi = mid; else lo = mid + 1u;
   }
   return lo;
 }
@@ -53,7 +53,7 @@ uint selectEmitter(float u, uint first, uint count) {
   uint lo = first, hi = first + count - 1u;
   while (lo < hi) {
     uint mid = (lo + hi) / 2u;
-    if (u < emitters[mid].v0.w) hi = mid; else lo = mid + 1u;
+    if (u < emitterAt(mid).v0.w) hi = mid; else lo = mid + 1u;
   }
   return lo;
 }
@@ -114,7 +114,7 @@ float boundsImportance(float power, vec4 sphere, vec4 cone, float cosE, bool uni
 // position and outer cone). Directional lights are not bounded here (lightSelection gives them
 // their own share).
 float lightImportance(uint i, vec3 p, vec3 n) {
-  GpuLight light = lights[i];
+  GpuLight light = lightAt(i);
   uint type = light.info.x;
   bool area = type == kLightArea, spot = type == kLightSpot;
   vec4 sphere = vec4(light.position.xyz, area ? light.position.w : 0.0);
@@ -203,7 +203,7 @@ float lightTreePdf(uint chosen, vec3 p, vec3 n) {
   bool lit;
   float shares = lightTreeShares(p, n, lit);
   if (shares == 0.0) return 0.0;
-  if (isUnbounded(lights[chosen].info.x)) return lights[chosen].params.y > 0.0 ? 1.0 / shares : 0.0;
+  if (isUnbounded(lightAt(chosen).info.x)) return lightAt(chosen).params.y > 0.0 ? 1.0 / shares : 0.0;
   uvec4 leaf = lightTree[1u + chosen].refs;
   if (!lit || leaf.w == kInvalidIndex) return 0.0;
   float probability = 1.0 / shares;
@@ -249,7 +249,7 @@ void prepareLightImportances(vec3 p, vec3 n, uint count) {
   gImportanceDirectional = 0u;
   for (uint i = 0u; i < count; ++i) {
     float w = 0.0;
-    if (isUnbounded(lights[i].info.x)) gImportanceDirectional += lights[i].params.y > 0.0 ? 1u : 0u;
+    if (isUnbounded(lightAt(i).info.x)) gImportanceDirectional += lightAt(i).params.y > 0.0 ? 1u : 0u;
     else w = lightImportance(i, p, n);
     gImportance[i] = w;
     gImportanceTotal += w;
@@ -261,12 +261,12 @@ void prepareLightImportances(vec3 p, vec3 n, uint count) {
 // The probability that the estimator picks light `chosen` at p with normal n.
 float lightSelectionPdf(uint chosen, vec3 p, vec3 n, uint count) {
   if (useLightTree(count)) return lightTreePdf(chosen, p, n);
-  if (!useSpatialSelection(count)) return lights[chosen].params.y;
+  if (!useSpatialSelection(count)) return lightAt(chosen).params.y;
   prepareLightImportances(p, n, count);
   float total = gImportanceTotal;
   float shares = float(gImportanceDirectional) + (total > 0.0 ? 1.0 : 0.0);
   if (shares == 0.0) return 0.0;
-  if (isUnbounded(lights[chosen].info.x)) return lights[chosen].params.y > 0.0 ? 1.0 / shares : 0.0;
+  if (isUnbounded(lightAt(chosen).info.x)) return lightAt(chosen).params.y > 0.0 ? 1.0 / shares : 0.0;
   return total > 0.0 ? gImportance[chosen] / total / shares : 0.0;
 }
 
@@ -275,7 +275,7 @@ uint selectLight(float u, vec3 p, vec3 n, uint count, out float selection) {
   if (useLightTree(count)) return selectLightFromTree(u, p, n, selection);
   if (!useSpatialSelection(count)) {
     uint chosen = selectLightByPower(u, count);
-    selection = lights[chosen].params.y;
+    selection = lightAt(chosen).params.y;
     return chosen;
   }
   prepareLightImportances(p, n, count);
@@ -289,7 +289,7 @@ uint selectLight(float u, vec3 p, vec3 n, uint count, out float selection) {
   if (scaled < float(directional)) {
     uint k = min(uint(scaled), directional - 1u);
     for (uint i = 0u; i < count; ++i) {
-      if (!isUnbounded(lights[i].info.x) || !(lights[i].params.y > 0.0)) continue;
+      if (!isUnbounded(lightAt(i).info.x) || !(lightAt(i).params.y > 0.0)) continue;
       if (k == 0u) {
         selection = 1.0 / shares;
         return i;
@@ -349,7 +349,7 @@ bool sampleBySolidAngle(vec3 p, vec3 v0, vec3 v1, vec3 v2, out vec3 a, out vec3 
 LightSample sampleChosenLight(vec3 p, vec3 n, vec4 u, uint chosen, float selection) {
   LightSample s;
   s.light = chosen;
-  GpuLight light = lights[s.light];
+  GpuLight light = lightAt(s.light);
   s.weight = vec3(0.0);
   s.pdf = 0.0;
   s.infinite = false;
@@ -373,7 +373,7 @@ LightSample sampleChosenLight(vec3 p, vec3 n, vec4 u, uint chosen, float selecti
   }
   if (type == kLightArea) {
     uint e = selectEmitter(u.y, light.info.y, light.info.z);
-    GpuEmitter em = emitters[e];
+    GpuEmitter em = emitterAt(e);
     float groupArea = uintBitsToFloat(light.info.w);
     float triangleShare = em.v1.w / groupArea; // probability of this triangle
     vec3 ny = normalize(cross(em.v1.xyz - em.v0.xyz, em.v2.xyz - em.v0.xyz));
@@ -436,7 +436,7 @@ LightSample sampleLight(vec3 p, vec3 n, vec4 u, uint lightCount) {
 // selection x (A_tri / A_group) x (1 / solid angle, or r^2 / (cos A_tri) where area sampling).
 // For MIS with BSDF sampling; 0 for a light that is never sampled, or not an area light.
 float areaLightPdf(uint light, vec3 p, vec3 n, uint count, vec3 v0, vec3 v1, vec3 v2, float dist2, float cosL) {
-  GpuLight l = lights[light];
+  GpuLight l = lightAt(light);
   float groupArea = uintBitsToFloat(l.info.w);
   if (l.info.x != kLightArea || !(groupArea > 0.0) || !(cosL > 0.0)) return 0.0;
   float selection = lightSelectionPdf(light, p, n, count);
@@ -451,7 +451,7 @@ float areaLightPdf(uint light, vec3 p, vec3 n, uint count, vec3 v0, vec3 v1, vec
 // The background's slot among the first `count` lights, or kInvalidIndex.
 uint findBackgroundLight(uint count) {
   for (uint i = 0u; i < count; ++i)
-    if (lights[i].info.x == kLightBackground) return i;
+    if (lightAt(i).info.x == kLightBackground) return i;
   return kInvalidIndex;
 }
 

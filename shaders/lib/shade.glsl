@@ -100,7 +100,7 @@ vec3 directLightFromOne(ShadingPoint sp, uint light, vec4 lightShift, inout Step
   vec3 sum = vec3(0.0);
   uint seen = 0u;
   rays = 0u;
-  const uint type = lights[light].info.x;
+  const uint type = lightAt(light).info.x;
   const uint first = type == kLightArea || type == kLightBackground ? kPerLightRays : 1u;
   for (uint k = 0u; k < kPerLightMaxRays; ++k) {
     // A probe (lib/probe.glsl) sees every ray reach the light: it tests all the rays a penumbra

@@ -6,10 +6,9 @@
 #include "band.glsl"
 #include "probe.glsl"
 #include "shaft.glsl"
+#include "light_bindings.glsl"
 
 layout(std430, set = 0, binding = kBindingGBuffer) readonly buffer GBuffer { GBufferTexel gbuffer[]; };
-layout(std430, set = 0, binding = kBindingLights) readonly buffer LightBuffer { GpuLight lights[]; };
-layout(std430, set = 0, binding = kBindingEmitters) readonly buffer EmitterBuffer { GpuEmitter emitters[]; };
 layout(std430, set = 0, binding = kBindingLightTree) readonly buffer LightTreeBuffer { GpuLightNode lightTree[]; };
 // basis[light * pixelCount + pixel] += D_s contributions (unit emission), summed over samples.
 layout(std430, set = 0, binding = kBindingBasis) buffer BasisBuffer { vec4 basis[]; };

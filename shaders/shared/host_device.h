@@ -157,6 +157,7 @@ struct GpuLight {
   vec4 params;    // 48: x = selection CDF (up to and including this light), y = selection
                   //     probability, z = cos inner cone, w = cos outer cone
 };                // 64 bytes
+OBS_CONST uint kTexelsPerLight = 4;
 
 // One emissive triangle of an area light. Radiance is the material's emission divided by the
 // group's E_s (so a uniform group has unit radiance).
@@ -166,6 +167,7 @@ struct GpuEmitter {
   vec4 v2;        // 32: xyz, w = 1 if it emits from both sides
   vec4 radiance;  // 48: rgb unit-emission radiance, w = unused
 };                // 64 bytes
+OBS_CONST uint kTexelsPerEmitter = 4;
 
 // ---- Light tree: a binary BVH over the bounded lights (area, point, spot) for spatial selection
 // with more than kMaxSpatialLights lights (Conty Estevez & Kulla, "Importance Sampling of Many
@@ -422,8 +424,8 @@ OBS_CONST uint kPerLightMaxRays = 64u;
 
 // ---- Bindings of the shading passes (after the scene's 0..5).
 OBS_CONST uint kBindingGBuffer = 6;   // GBufferTexel[pixels] of the current sample
-OBS_CONST uint kBindingLights = 7;    // GpuLight[lights]
-OBS_CONST uint kBindingEmitters = 8;  // GpuEmitter[]
+OBS_CONST uint kBindingLights = 7;    // samplerBuffer RGBA32F: GpuLight[lights], kTexelsPerLight texels each
+OBS_CONST uint kBindingEmitters = 8;  // samplerBuffer RGBA32F: GpuEmitter[], kTexelsPerEmitter texels each
 OBS_CONST uint kBindingBasis = 9;     // vec4[lights * pixels]: sums of D_s (unit emission)
 OBS_CONST uint kBindingAmbient = 10;  // vec4[pixels]: rgb sums of A = R(P) W_c (or R(P) W), w = W
 OBS_CONST uint kBindingSpecularBasis = 11;   // vec4[lights * pixels]: D_s gathered along specular paths
@@ -482,8 +484,8 @@ OBS_CONST uint kPathStrategyMis = 0u;       // MIS of light and BSDF sampling (t
 OBS_CONST uint kPathStrategyLightOnly = 1u; // area lights by light sampling only (tests)
 OBS_CONST uint kPathStrategyBsdfOnly = 2u;  // area lights by BSDF sampling only (tests)
 OBS_CONST uint kBindingPathRadiance = 6u;   // vec4[pixels]: rgb sums, w = dropped samples
-OBS_CONST uint kBindingPathLights = 7u;     // GpuLight[] (= kBindingLights)
-OBS_CONST uint kBindingPathEmitters = 8u;   // GpuEmitter[] (= kBindingEmitters)
+OBS_CONST uint kBindingPathLights = 7u;     // as kBindingLights (lib/light_bindings.glsl)
+OBS_CONST uint kBindingPathEmitters = 8u;   // as kBindingEmitters
 OBS_CONST uint kBindingPathScales = 9u;     // vec4[lights]: E_s, each light's emission scale
 OBS_CONST uint kBindingPathLightTree = 10u; // GpuLightNode[] (= kBindingLightTree's contents)
 OBS_CONST uint kPathBindingCount = 11u;

@@ -19,6 +19,9 @@ layout(std430, binding = 1) writeonly buffer Results { vec4 results[]; };
 layout(std430, binding = 2) readonly buffer LightBuffer { GpuLight lights[]; };
 layout(std430, binding = 3) readonly buffer EmitterBuffer { GpuEmitter emitters[]; };
 layout(std430, binding = 4) readonly buffer LightTreeBuffer { GpuLightNode lightTree[]; };
+// The accessors lights.glsl reads through (the renderer's are texel fetches: lib/light_bindings.glsl).
+GpuLight lightAt(uint i) { return lights[i]; }
+GpuEmitter emitterAt(uint i) { return emitters[i]; }
 
 #include "lib/lights.glsl"
 

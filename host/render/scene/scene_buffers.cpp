@@ -115,14 +115,14 @@ std::vector<gpu::GpuMaterial> materialData(const scene::Scene& scene) {
   return out;
 }
 
+} // namespace
+
 void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char* what) {
   if (texels > context.info().maxTexelBufferElements)
     throw DeviceError(fmt::format("the scene's {} need {} texels, more than the device's "
                                   "maxTexelBufferElements ({})", what, texels,
                                   context.info().maxTexelBufferElements));
 }
-
-} // namespace
 
 SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh)
     : context_(&context), compactStackVectors_(bvh::compactStackVectors(bvh)) {

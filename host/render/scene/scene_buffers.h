@@ -34,6 +34,21 @@ void widenBox(glm::vec4& lo, glm::vec4& hi);
 // triangle index to a texel index.
 std::vector<gpu::vec4> bvhTexels(const bvh::Bvh& bvh);
 
+// Throws DeviceError when the device's texel buffers cannot hold `texels` of the scene's `what`.
+void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char* what);
+
+// A table of the scene as an RGBA32F texel buffer (whole texels per row), at least one row long
+// (Vulkan has no empty buffers; a scene without lights still binds its light tables).
+template <typename Row>
+gpu::TexelBuffer tableTexels(const gpu::Context& context, const std::vector<Row>& rows, const char* what,
+                             const std::string& name) {
+  static_assert(sizeof(Row) % sizeof(gpu::vec4) == 0, "a row is whole RGBA32F texels");
+  checkTexelLimit(context, rows.size() * (sizeof(Row) / sizeof(gpu::vec4)), what);
+  const Row empty{};
+  return rows.empty() ? gpu::TexelBuffer(context, &empty, sizeof(Row), name)
+                      : gpu::TexelBuffer(context, rows.data(), rows.size() * sizeof(Row), name);
+}
+
 class SceneBuffers {
 public:
   SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh);
