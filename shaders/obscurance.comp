@@ -30,7 +30,7 @@ void main() {
   uvec2 p = bp.frame;
   uint pixel = bp.index;
   if (beginProbe() && skipClean(pixel)) return; // a probe: this candidate is dirty already
-  GBufferTexel g = gbuffer[pixel];
+  GBufferTexel g = gbufferAt(pixel);
   if (g.albedo.a == 0.0) return;
 
   ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);

@@ -35,7 +35,7 @@ void main() {
   uint pixel = bp.index;
   uint pixelCount = bp.count;
   if (beginProbe() && skipClean(pixel)) return; // a probe: this candidate is dirty already
-  GBufferTexel g = gbuffer[pixel];
+  GBufferTexel g = gbufferAt(pixel);
   if (g.albedo.a == 0.0) return; // no hit: nothing to light
 
   ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);

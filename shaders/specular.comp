@@ -116,7 +116,7 @@ SpecularConstants specularConstants() {
 PathState startPath(uint pixel) {
   BandPixel bp = bandPixelFromIndex(pixel, pc.frame.xy, pc.band.xy);
   PathState path;
-  path.sp = shadingPointFromGBuffer(gbuffer[pixel], pc.eye.xyz);
+  path.sp = shadingPointFromGBuffer(gbufferAt(pixel), pc.eye.xyz);
   path.throughput = vec3(1.0);
   path.pathRng = rngSeed(bp.frame, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu);
   path.rng = rngSeed(bp.frame, pc.frame.z, pc.frame.w ^ 0x6c8e9cf5u);

@@ -17,7 +17,7 @@ void main() {
   uvec2 p = bp.frame;
   uint pixel = bp.index;
   if (skipClean(pixel)) return;
-  GBufferTexel g = gbuffer[pixel];
+  GBufferTexel g = gbufferAt(pixel);
   if (g.albedo.a == 0.0 || materialAt(floatBitsToUint(g.shadingNormal.w)).params.w == 0.0) return;
   OBS_QUEUE_APPEND(queue, 0u, pixel)
 }

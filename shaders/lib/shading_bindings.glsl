@@ -8,7 +8,14 @@
 #include "shaft.glsl"
 #include "light_bindings.glsl"
 
-layout(std430, set = 0, binding = kBindingGBuffer) readonly buffer GBuffer { GBufferTexel gbuffer[]; };
+// The G-buffer of the current sample (primary.comp writes it as an SSBO), read through a texel view:
+// one vector gather per texel, where an SSBO read is a scalar load per lane per word on lavapipe.
+layout(set = 0, binding = kBindingGBuffer) uniform samplerBuffer gbufferTexels;
+GBufferTexel gbufferAt(uint pixel) {
+  const int at = int(pixel * kTexelsPerGBuffer);
+  return GBufferTexel(texelFetch(gbufferTexels, at), texelFetch(gbufferTexels, at + 1), texelFetch(gbufferTexels, at + 2),
+                      texelFetch(gbufferTexels, at + 3), texelFetch(gbufferTexels, at + 4));
+}
 layout(std430, set = 0, binding = kBindingLightTree) readonly buffer LightTreeBuffer { GpuLightNode lightTree[]; };
 // basis[light * pixelCount + pixel] += D_s contributions (unit emission), summed over samples.
 layout(std430, set = 0, binding = kBindingBasis) buffer BasisBuffer { vec4 basis[]; };

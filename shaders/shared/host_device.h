@@ -232,6 +232,7 @@ struct GBufferTexel {
   vec4 albedo;          // 48: rgb base colour x texture, a = 1 on hit, 0 on miss
   vec4 emission;        // 64: rgb emitted radiance toward the camera, w = unused
 };                      // 80 bytes
+OBS_CONST uint kTexelsPerGBuffer = 5;
 
 // ---- Frame bands. Frame-lifetime storage is split into bands of whole rows so that no buffer
 // exceeds the device's per-buffer limit (lavapipe: 128 MiB): a band owns its own G-buffer, AOV,
@@ -423,7 +424,8 @@ OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 
 // ---- Bindings of the shading passes (after the scene's 0..5).
-OBS_CONST uint kBindingGBuffer = 6;   // GBufferTexel[pixels] of the current sample
+OBS_CONST uint kBindingGBuffer = 6;   // samplerBuffer RGBA32F: GBufferTexel[pixels] of the current sample
+                                      // (kTexelsPerGBuffer texels each)
 OBS_CONST uint kBindingLights = 7;    // samplerBuffer RGBA32F: GpuLight[lights], kTexelsPerLight texels each
 OBS_CONST uint kBindingEmitters = 8;  // samplerBuffer RGBA32F: GpuEmitter[], kTexelsPerEmitter texels each
 OBS_CONST uint kBindingBasis = 9;     // vec4[lights * pixels]: sums of D_s (unit emission)

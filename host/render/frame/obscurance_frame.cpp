@@ -87,7 +87,12 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.rows = layout_.bands[i];
     const std::uint64_t px = layout_.bandPixels(i);
     const std::string tag = layout_.bands.size() > 1 ? fmt::format("[band {}]", i) : "";
-    b.gbuffer = gpu::Buffer(context, px * sizeof(gpu::GBufferTexel), kStorage, "frame.gbuffer" + tag);
+    if (px * gpu::kTexelsPerGBuffer > context.info().maxTexelBufferElements)
+      throw DeviceError(fmt::format("a band's G-buffer needs {} texels, more than the device's "
+                                    "maxTexelBufferElements ({})", px * gpu::kTexelsPerGBuffer,
+                                    context.info().maxTexelBufferElements));
+    b.gbuffer = gpu::TexelBuffer(context, atLeastOne(px * sizeof(gpu::GBufferTexel)), vk::Format::eR32G32B32A32Sfloat,
+                                 kStorage, "frame.gbuffer" + tag);
     b.aovs = gpu::Buffer(context, contents.primaryAovs ? px * gpu::kAovSlots * kAccumulator : kVec4, kStorage,
                          "frame.aovs" + tag);
     b.ambient = gpu::Buffer(context, px * kAccumulator, kStorage, "frame.ambient" + tag);
@@ -127,7 +132,7 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
 std::uint64_t ObscuranceFrame::bytes() const {
   std::uint64_t total = status_.buffer().size();
   for (const auto& b : bands_)
-    for (const gpu::Buffer* buffer : {&b.gbuffer, &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
+    for (const gpu::Buffer* buffer : {&b.gbuffer.buffer(), &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
                                       &b.specularAmbient, &b.queue, &b.specularPaths, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty,
                                       &b.sampleCounts, &b.pathHits, &b.shadowRays})
       total += buffer->size();

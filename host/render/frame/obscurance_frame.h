@@ -54,7 +54,10 @@ class ObscuranceFrame {
 public:
   struct Band {
     FrameBand rows;
-    gpu::Buffer gbuffer, aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, specularPaths, composed,
+    // The G-buffer: written by primary.comp as an SSBO, read by the shading passes through an
+    // RGBA32F texel view (kTexelsPerGBuffer texels a pixel, lib/shading_bindings.glsl).
+    gpu::TexelBuffer gbuffer;
+    gpu::Buffer aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, specularPaths, composed,
         display;
     gpu::TexelBuffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits:
                                // lightmix.comp reads four pixels at a time as RGBA32UI texels

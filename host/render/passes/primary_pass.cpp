@@ -56,7 +56,7 @@ void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const Obsc
   const auto& b = frame.band(band);
   for (gpu::Kernel& kernel : kernels_) {
     scene.bindTo(kernel, band, &frame.status());
-    kernel.bind(gpu::kBindingPrimaryGBuffer, b.gbuffer, band);
+    kernel.bind(gpu::kBindingPrimaryGBuffer, b.gbuffer.buffer(), band);
     kernel.bind(gpu::kBindingPrimaryAovs, b.aovs, band);
     kernel.bind(gpu::kBindingPrimaryLightScales, lightScales, band);
     kernel.bind(gpu::kBindingPrimaryEmissionBasis, b.emissionBasis, band);

@@ -12,7 +12,8 @@ ShadingSpecialisation shadingSpecialisation(std::uint32_t bands, bool spatialSam
 gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
   auto bindings = sceneBindingKinds();
   bindings.insert(bindings.end(), gpu::kShadingBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
-  bindings[gpu::kBindingLights] = bindings[gpu::kBindingEmitters] = gpu::BindingKind::UniformTexelBuffer;
+  bindings[gpu::kBindingGBuffer] = bindings[gpu::kBindingLights] = bindings[gpu::kBindingEmitters] =
+      gpu::BindingKind::UniformTexelBuffer;
   gpu::KernelDesc desc{.name = name, .spirv = spirv, .bindings = bindings, .pushConstantBytes = sizeof(gpu::ShadePush),
                        .setCount = s.bands};
   if (s.flatLightSelection) desc.specConstants.push_back({.id = gpu::kSpecConstantFlatLightSelection, .value = 1u});
