@@ -100,8 +100,8 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
                            .keptRaySamples = keptRaySamples(context, settings, runSpecular_),
                            .keptShadowRays = keptShadowRays(settings)},
              settings.maxBufferBytes),
-      compactStackVectors_(sceneBuffers_.compactStackVectors()),
-      primary_(context, frame_.layout().bandCount(), compactStackVectors_, settings.editableGeometry),
+      sceneKernels_(sceneBuffers_.specialisation()),
+      primary_(context, frame_.layout().bandCount(), sceneKernels_, settings.editableGeometry),
       shadow_(context, shadingKernels()),
       obscurance_(context, shadingKernels()), specularPass_(context, shadingKernels()),
       compose_(context, frame_.layout().bandCount()), tonemap_(context, frame_.layout().bandCount()),
@@ -294,9 +294,9 @@ void ObscuranceRenderer::reset() {
   });
 }
 
-void ObscuranceRenderer::makeTracingPasses(std::uint32_t compactStackVectors) {
-  compactStackVectors_ = compactStackVectors;
-  primary_ = PrimaryPass(*context_, frame_.layout().bandCount(), compactStackVectors_, settings_.editableGeometry);
+void ObscuranceRenderer::makeTracingPasses(const SceneSpecialisation& scene) {
+  sceneKernels_ = scene;
+  primary_ = PrimaryPass(*context_, frame_.layout().bandCount(), sceneKernels_, settings_.editableGeometry);
   shadow_ = ShadowPass(*context_, shadingKernels());
   obscurance_ = ObscurancePass(*context_, shadingKernels());
   specularPass_ = SpecularPass(*context_, shadingKernels());
@@ -529,9 +529,10 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
   if (sameSurfaces) rebind = sceneBuffers_.updateGeometry(edited, bvh);
   else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
   // Compact-stack kernels could overflow their stack on a deeper BVH (and would miss hits
-  // unnoticed): the passes are made again for what this one needs (0: the general stack).
-  if (!bvh::compactStackHolds(compactStackVectors_, sceneBuffers_.compactStackVectors())) {
-    makeTracingPasses(sceneBuffers_.compactStackVectors());
+  // unnoticed), and kernels without a kind of texture lookup would not see new textures: the
+  // passes are made again for what the edited scene needs.
+  if (!sceneKernels_.holds(sceneBuffers_.specialisation())) {
+    makeTracingPasses(sceneBuffers_.specialisation());
     rebind = true;
   }
   if (reflectorsOn()) markReflectors();

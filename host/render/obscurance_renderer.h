@@ -235,19 +235,19 @@ public:
   // Bytes of device memory held: scene, lights and frame (the real allocations).
   std::uint64_t deviceBytes() const;
   // The compact traversal stack the tracing passes' kernels keep (0: the general stack).
-  std::uint32_t compactStackVectors() const { return compactStackVectors_; }
+  std::uint32_t compactStackVectors() const { return sceneKernels_.compactStackVectors; }
 
 private:
   // What the shading passes' kernels are specialised for: the frame's bands, the flat light
-  // selection where this render can take no other, and the compact stack (settings_, frame_ and
-  // compactStackVectors_ are made first).
+  // selection where this render can take no other, and the scene (settings_, frame_ and
+  // sceneKernels_ are made first).
   ShadingSpecialisation shadingKernels() const {
     return shadingSpecialisation(frame_.layout().bandCount(), settings_.lightSampling == LightSampling::Spatial,
-                                 frame_.lightCapacity(), compactStackVectors_);
+                                 frame_.lightCapacity(), sceneKernels_);
   }
-  // Makes the tracing passes again for a compact stack of that many vectors, or the general one
-  // (0); bind them after.
-  void makeTracingPasses(std::uint32_t compactStackVectors);
+  // Makes the tracing passes again for what a scene needs (SceneBuffers::specialisation); bind
+  // them after.
+  void makeTracingPasses(const SceneSpecialisation& scene);
   void uploadLights();
   // The Reached ambient model: what every light reaches in `scene`. After a geometry edit that
   // kept the lights, `changed` (the edited objects' old and new boxes) lets each light re-trace
@@ -339,10 +339,10 @@ private:
   std::vector<std::uint32_t> bvhOrder_; // the layout the hits refer to: triangle order...
   std::size_t bvhNodes_ = 0;            // ...after this many nodes
 
-  // Passes. Those that trace (primary to specular) are specialised for the compact traversal stack
-  // the scene's BVH needs (compactStackVectors_; 0: the general stack); an edit whose BVH
-  // outgrows it makes them again (makeTracingPasses).
-  std::uint32_t compactStackVectors_ = 0;
+  // Passes. Those that trace (primary to specular) are specialised for the scene
+  // (sceneKernels_: the compact traversal stack its BVH needs, the texture kinds its materials
+  // use); an edit whose scene needs more makes them again (makeTracingPasses).
+  SceneSpecialisation sceneKernels_;
   PrimaryPass primary_;
   ShadowPass shadow_;
   ObscurancePass obscurance_;

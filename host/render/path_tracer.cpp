@@ -19,14 +19,14 @@ using Usage = vk::BufferUsageFlagBits;
 using Clock = std::chrono::steady_clock;
 constexpr std::uint64_t kAccumulator = gpu::kAccumulatorVec4s * sizeof(glm::vec4);
 
-gpu::KernelDesc pathKernelDesc(std::uint32_t bands, std::uint32_t compactStackVectors) {
+gpu::KernelDesc pathKernelDesc(std::uint32_t bands, const SceneSpecialisation& scene) {
   auto bindings = sceneBindingKinds();
   bindings.insert(bindings.end(), gpu::kPathBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
   bindings[gpu::kBindingPathLights] = bindings[gpu::kBindingPathEmitters] = gpu::BindingKind::UniformTexelBuffer;
-  return {.name = "pathtrace", .spirv = kSpirv_pathtrace, .bindings = bindings,
-          .pushConstantBytes = sizeof(gpu::PathPush),
-          .specConstants = {{gpu::kSpecConstantCompactStack, compactStackVectors}},
-          .setCount = bands};
+  gpu::KernelDesc desc{.name = "pathtrace", .spirv = kSpirv_pathtrace, .bindings = bindings,
+                       .pushConstantBytes = sizeof(gpu::PathPush), .setCount = bands};
+  scene.addTo(desc);
+  return desc;
 }
 
 const PathTraceSettings& checked(const PathTraceSettings& settings) {
@@ -53,7 +53,7 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
       layout_(FrameLayout::split(settings.width, settings.height, kAccumulator,
                                  maxBufferBytes ? maxBufferBytes : context.info().maxStorageBufferRange,
                                  "the radiance accumulator")),
-      kernel_(context, pathKernelDesc(layout_.bandCount(), sceneBuffers_.compactStackVectors())), stream_(context),
+      kernel_(context, pathKernelDesc(layout_.bandCount(), sceneBuffers_.specialisation())), stream_(context),
       timestamps_(context) {
   if (pathTraceBytesNeeded(settings.width, settings.height) > context.info().deviceLocalBytes)
     throw InputError(fmt::format("{}x{}: path tracing needs {:.1f} MiB, more than the device offers", settings.width,

@@ -2,6 +2,12 @@
 #ifndef OBSCURA_MATERIAL_GLSL
 #define OBSCURA_MATERIAL_GLSL
 
+// A kernel specialised for its scene (SceneSpecialisation on the host) leaves out the lookups of
+// the texture kinds no material uses (kSpecConstantTexturesAbsent).
+layout(constant_id = kSpecConstantTexturesAbsent) const uint kTexturesAbsent = 0u;
+const bool kBaseColorTextures = (kTexturesAbsent & kTexturesAbsentBaseColor) == 0u;
+const bool kEmissiveTextures = (kTexturesAbsent & kTexturesAbsentEmissive) == 0u;
+
 vec3 srgbToLinear(vec3 c) {
   return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
 }
@@ -35,7 +41,7 @@ vec4 sampleTexture(int index, vec2 uv) {
 // Base colour (albedo) = baseColorFactor x baseColorTexture.
 vec4 materialBaseColor(GpuMaterial m, vec2 uv) {
   vec4 c = m.baseColor;
-  if (m.textures.x >= 0) c *= sampleTexture(m.textures.x, uv);
+  if (kBaseColorTextures && m.textures.x >= 0) c *= sampleTexture(m.textures.x, uv);
   return c;
 }
 
@@ -45,7 +51,7 @@ vec4 materialBaseColor(GpuMaterial m, vec2 uv) {
 vec3 materialEmission(GpuMaterial m, vec2 uv, bool frontFacing) {
   if (!frontFacing && m.emission.w == 0.0) return vec3(0.0);
   vec3 e = m.emission.rgb;
-  if (m.textures.z >= 0 && any(greaterThan(e, vec3(0.0)))) e *= sampleTexture(m.textures.z, uv).rgb;
+  if (kEmissiveTextures && m.textures.z >= 0 && any(greaterThan(e, vec3(0.0)))) e *= sampleTexture(m.textures.z, uv).rgb;
   return e;
 }
 

@@ -27,7 +27,7 @@ float rho(float d, float dMax, uint kind, float tau) {
 vec3 reflectanceAt(Surface s) {
   GpuMaterial m = materialAt(s.material);
   vec3 r = m.meanAlbedo.rgb;
-  if (m.textures.x >= 0) r *= sampleTexture(m.textures.x, s.uv).rgb;
+  if (kBaseColorTextures && m.textures.x >= 0) r *= sampleTexture(m.textures.x, s.uv).rgb;
   return r;
 }
 

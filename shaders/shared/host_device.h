@@ -420,6 +420,12 @@ OBS_CONST uint kSpecConstantBvhItemsFromStorage = 12u;
 // primary.comp keeps each pixel's box of hits for geometry edits (dirty.comp); a renderer that
 // will never edit its scene (ObscuranceSettings::editableGeometry) compiles it out.
 OBS_CONST uint kSpecConstantPrimaryHitBounds = 13u;
+// The kinds of texture no material of the scene uses (kTexturesAbsent* bits): lib/material.glsl
+// compiles their lookups out (four texel fetches and twelve sRGB decodes each, which lavapipe runs
+// masked at every hit even where the material has no texture). 0, the default: the general kernel.
+OBS_CONST uint kSpecConstantTexturesAbsent = 14u;
+OBS_CONST uint kTexturesAbsentBaseColor = 1u;
+OBS_CONST uint kTexturesAbsentEmissive = 2u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

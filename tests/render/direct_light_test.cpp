@@ -204,9 +204,9 @@ TEST_F(DirectLight, FlatLightSelectionKernelsRenderTheGeneralKernelsImage) {
   // The shading kernels leave the light tree and the selection by power out
   // (kSpecConstantFlatLightSelection) exactly where a render can take no other selection: spatial
   // sampling and at most kMaxSpatialLights lights, the frame's spare light slots included.
-  EXPECT_TRUE(render::shadingSpecialisation(1, true, gpu::kMaxSpatialLights, false).flatLightSelection);
-  EXPECT_FALSE(render::shadingSpecialisation(1, true, gpu::kMaxSpatialLights + 1, false).flatLightSelection);
-  EXPECT_FALSE(render::shadingSpecialisation(1, false, 3, false).flatLightSelection);
+  EXPECT_TRUE(render::shadingSpecialisation(1, true, gpu::kMaxSpatialLights, {}).flatLightSelection);
+  EXPECT_FALSE(render::shadingSpecialisation(1, true, gpu::kMaxSpatialLights + 1, {}).flatLightSelection);
+  EXPECT_FALSE(render::shadingSpecialisation(1, false, 3, {}).flatLightSelection);
   // Three lamps over a glossy floor (shadow rays with MIS, specular paths, obscurance): spare
   // light slots past kMaxSpatialLights make the same render use the general kernels, whose
   // dispatches still select among the three lamps spatially. Same estimator, same image.

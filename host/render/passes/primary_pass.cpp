@@ -22,27 +22,28 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 namespace {
 // Variant `v`: bit 0 the AOV accumulators, bit 1 the emission rays. Compiled on first use (a render
 // dispatches one or two of the four; each is an LLVM compile of the shader on lavapipe).
-gpu::KernelDesc primaryKernelDesc(std::uint32_t bands, std::uint32_t v, std::uint32_t compactStackVectors,
+gpu::KernelDesc primaryKernelDesc(std::uint32_t bands, std::uint32_t v, const SceneSpecialisation& scene,
                                   bool hitBounds) {
   auto bindings = sceneBindingKinds();
   bindings.insert(bindings.end(), gpu::kPrimaryBindingCount - gpu::kSceneBindingCount,
                   gpu::BindingKind::StorageBuffer);
-  return {.name = "primary", .spirv = kSpirv_primary, .bindings = bindings,
-          .pushConstantBytes = sizeof(gpu::PrimaryPush),
-          .specConstants = {{gpu::kSpecConstantPrimaryAovs, v & 1u},
-                            {gpu::kSpecConstantEmissionRays, (v >> 1) & 1u},
-                            {gpu::kSpecConstantCompactStack, compactStackVectors},
-                            {gpu::kSpecConstantPrimaryHitBounds, hitBounds ? 1u : 0u}},
-          .setCount = bands, .deferCompile = true};
+  gpu::KernelDesc desc{.name = "primary", .spirv = kSpirv_primary, .bindings = bindings,
+                       .pushConstantBytes = sizeof(gpu::PrimaryPush),
+                       .specConstants = {{gpu::kSpecConstantPrimaryAovs, v & 1u},
+                                         {gpu::kSpecConstantEmissionRays, (v >> 1) & 1u},
+                                         {gpu::kSpecConstantPrimaryHitBounds, hitBounds ? 1u : 0u}},
+                       .setCount = bands, .deferCompile = true};
+  scene.addTo(desc);
+  return desc;
 }
 } // namespace
 
-PrimaryPass::PrimaryPass(const gpu::Context& context, std::uint32_t bands, std::uint32_t compactStackVectors,
+PrimaryPass::PrimaryPass(const gpu::Context& context, std::uint32_t bands, const SceneSpecialisation& scene,
                          bool hitBounds)
-    : kernels_{gpu::Kernel(context, primaryKernelDesc(bands, 0u, compactStackVectors, hitBounds)),
-               gpu::Kernel(context, primaryKernelDesc(bands, 1u, compactStackVectors, hitBounds)),
-               gpu::Kernel(context, primaryKernelDesc(bands, 2u, compactStackVectors, hitBounds)),
-               gpu::Kernel(context, primaryKernelDesc(bands, 3u, compactStackVectors, hitBounds))} {}
+    : kernels_{gpu::Kernel(context, primaryKernelDesc(bands, 0u, scene, hitBounds)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 1u, scene, hitBounds)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 2u, scene, hitBounds)),
+               gpu::Kernel(context, primaryKernelDesc(bands, 3u, scene, hitBounds))} {}
 
 const gpu::Kernel& PrimaryPass::kernelFor(std::uint32_t flags) const {
   const bool sums = (flags & gpu::kPrimaryFlagGBufferOnly) == 0;

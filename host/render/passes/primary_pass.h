@@ -19,10 +19,10 @@ gpu::GpuCamera gpuCamera(const scene::Camera& camera, std::uint32_t width, std::
 
 class PrimaryPass {
 public:
-  // `compactStackVectors`: the kernels' compact traversal stack (SceneBuffers::compactStackVectors;
-  // 0: the general stack). `hitBounds`: keep each pixel's box of hits (kSpecConstantPrimaryHitBounds),
-  // which only geometry edits read.
-  PrimaryPass(const gpu::Context& context, std::uint32_t bands, std::uint32_t compactStackVectors,
+  // `scene`: what the kernels are specialised for by the scene (SceneBuffers::specialisation: the
+  // compact traversal stack, the texture kinds). `hitBounds`: keep each pixel's box of hits
+  // (kSpecConstantPrimaryHitBounds), which only geometry edits read.
+  PrimaryPass(const gpu::Context& context, std::uint32_t bands, const SceneSpecialisation& scene,
               bool hitBounds = true);
 
   // Binds band `band`'s descriptor set: the scene, the frame's status counters and band buffers,

@@ -3,10 +3,8 @@
 namespace obscura::render {
 
 ShadingSpecialisation shadingSpecialisation(std::uint32_t bands, bool spatialSampling, std::uint32_t lightCapacity,
-                                            std::uint32_t compactStackVectors) {
-  return {.bands = bands,
-          .flatLightSelection = spatialSampling && lightCapacity <= gpu::kMaxSpatialLights,
-          .compactStackVectors = compactStackVectors};
+                                            const SceneSpecialisation& scene) {
+  return {.bands = bands, .flatLightSelection = spatialSampling && lightCapacity <= gpu::kMaxSpatialLights, .scene = scene};
 }
 
 gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
@@ -17,8 +15,7 @@ gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_
   gpu::KernelDesc desc{.name = name, .spirv = spirv, .bindings = bindings, .pushConstantBytes = sizeof(gpu::ShadePush),
                        .setCount = s.bands};
   if (s.flatLightSelection) desc.specConstants.push_back({.id = gpu::kSpecConstantFlatLightSelection, .value = 1u});
-  if (s.compactStackVectors != 0)
-    desc.specConstants.push_back({.id = gpu::kSpecConstantCompactStack, .value = s.compactStackVectors});
+  s.scene.addTo(desc);
   return desc;
 }
 

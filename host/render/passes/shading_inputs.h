@@ -28,16 +28,15 @@ struct ShadingSpecialisation {
   // Lights chosen by the flat spatial selection alone (kSpecConstantFlatLightSelection): the
   // render samples lights spatially and its frame holds at most kMaxSpatialLights lights.
   bool flatLightSelection = false;
-  // The compact traversal stack's uvec4 registers (kSpecConstantCompactStack,
-  // SceneBuffers::compactStackVectors; 0: the general stack with its second loop).
-  std::uint32_t compactStackVectors = 0;
+  // The scene's: its compact traversal stack and the texture kinds it has (SceneBuffers::specialisation).
+  SceneSpecialisation scene;
 };
 
 // The shading specialisation of a render: flat selection where it is the only one its dispatches
-// can take (spatial sampling, no more lights than kMaxSpatialLights, spare slots included), the
-// compact stack where the scene's BVH fits it.
+// can take (spatial sampling, no more lights than kMaxSpatialLights, spare slots included), and
+// the scene's own (the compact stack where its BVH fits it, the texture kinds it uses).
 ShadingSpecialisation shadingSpecialisation(std::uint32_t bands, bool spatialSampling, std::uint32_t lightCapacity,
-                                            std::uint32_t compactStackVectors);
+                                            const SceneSpecialisation& scene);
 
 // The kernel description every shading pass shares: scene bindings, then the shading bindings,
 // ShadePush, one descriptor set per band.

@@ -115,7 +115,22 @@ std::vector<gpu::GpuMaterial> materialData(const scene::Scene& scene) {
   return out;
 }
 
+// The kinds of texture (gpu::kTexturesAbsent* bits) that no material of `scene` uses.
+std::uint32_t texturesAbsent(const scene::Scene& scene) {
+  std::uint32_t absent = gpu::kTexturesAbsentBaseColor | gpu::kTexturesAbsentEmissive;
+  for (const auto& m : scene.materials) {
+    if (m.baseColorTexture >= 0) absent &= ~gpu::kTexturesAbsentBaseColor;
+    if (m.emissiveTexture >= 0) absent &= ~gpu::kTexturesAbsentEmissive;
+  }
+  return absent;
+}
+
 } // namespace
+
+void SceneSpecialisation::addTo(gpu::KernelDesc& desc) const {
+  if (compactStackVectors != 0) desc.specConstants.push_back({gpu::kSpecConstantCompactStack, compactStackVectors});
+  if (texturesAbsent != 0) desc.specConstants.push_back({gpu::kSpecConstantTexturesAbsent, texturesAbsent});
+}
 
 void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char* what) {
   if (texels > context.info().maxTexelBufferElements)
@@ -125,7 +140,7 @@ void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char
 }
 
 SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh)
-    : context_(&context), compactStackVectors_(bvh::compactStackVectors(bvh)) {
+    : context_(&context), compactStackVectors_(bvh::compactStackVectors(bvh)), texturesAbsent_(texturesAbsent(scene)) {
   auto items = bvhTexels(bvh);
   checkTexelLimit(context, items.size(), "BVH nodes and triangles");
   items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::vec4), "scene.bvhItems",
@@ -202,6 +217,12 @@ void SceneBuffers::bindTo(gpu::Kernel& kernel, std::uint32_t set, const gpu::Buf
                                        kernel.name(), kernelVectors,
                                        compactStackVectors_ == 0 ? "the general stack"
                                                                  : std::to_string(compactStackVectors_)));
+  const std::uint32_t kernelAbsent = kernel.specConstant(gpu::kSpecConstantTexturesAbsent);
+  if ((kernelAbsent & ~texturesAbsent_) != 0)
+    throw std::logic_error(fmt::format("kernel '{}' is specialised for a scene without {} textures, which this "
+                                       "scene's materials use", kernel.name(),
+                                       (kernelAbsent & ~texturesAbsent_ & gpu::kTexturesAbsentBaseColor) != 0
+                                           ? "base-colour" : "emissive"));
   kernel.bind(gpu::kBindingBvhItems, items_, set);
   kernel.bind(gpu::kBindingShading, shading_, set);
   kernel.bind(gpu::kBindingMaterials, materials_, set);

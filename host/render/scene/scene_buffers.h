@@ -49,18 +49,37 @@ gpu::TexelBuffer tableTexels(const gpu::Context& context, const std::vector<Row>
                       : gpu::TexelBuffer(context, rows.data(), rows.size() * sizeof(Row), name);
 }
 
+// What the kernels that trace and shade a scene are specialised for, as the scene needs: the
+// compact traversal stack of its BVH (kSpecConstantCompactStack; 0: the general stack with its
+// second loop) and the kinds of texture none of its materials uses (kSpecConstantTexturesAbsent:
+// their lookups compiled out). On lavapipe both cost every ray or hit even where unused.
+struct SceneSpecialisation {
+  std::uint32_t compactStackVectors = 0;
+  std::uint32_t texturesAbsent = 0; // gpu::kTexturesAbsent* bits
+  // Whether kernels made for this specialisation trace and shade a scene that needs `scene` right.
+  bool holds(const SceneSpecialisation& scene) const {
+    return bvh::compactStackHolds(compactStackVectors, scene.compactStackVectors) &&
+           (texturesAbsent & ~scene.texturesAbsent) == 0;
+  }
+  // Appends its specialisation constants to `desc` (none where the general kernel's).
+  void addTo(gpu::KernelDesc& desc) const;
+};
+
 class SceneBuffers {
 public:
   SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh);
 
   // Binds bindings 0..5 of descriptor set `set` of `kernel`. Binding 5 (status counters) is the
   // scene's own unless `status` is given: a renderer counts its frame's rays in its own buffer.
-  // Throws std::logic_error for a compact-stack kernel whose stack this BVH could overflow.
+  // Throws std::logic_error for a compact-stack kernel whose stack this BVH could overflow, or a
+  // kernel without the lookups of a kind of texture this scene's materials use.
   void bindTo(gpu::Kernel& kernel, std::uint32_t set = 0, const gpu::Buffer* status = nullptr) const;
 
   // The compact register stack this BVH needs (bvh::compactStackVectors; 0: beyond it), kept up to
   // date by updateGeometry: the specialisation of the kernels that trace it.
   std::uint32_t compactStackVectors() const { return compactStackVectors_; }
+  // The specialisation of the kernels that trace and shade this scene.
+  SceneSpecialisation specialisation() const { return {compactStackVectors_, texturesAbsent_}; }
 
   // After an edit that kept the materials and textures (a move or a removal): uploads the BVH items
   // and the triangles' shading data again, in place when their sizes stayed (the texel buffer's
@@ -95,6 +114,7 @@ private:
   StatusCounters status_;
   std::uint64_t bytes_ = 0;
   std::uint32_t compactStackVectors_ = 0;
+  std::uint32_t texturesAbsent_ = 0; // gpu::kTexturesAbsent* bits: the texture kinds no material uses
   std::vector<std::string> notes_;
   std::vector<std::uint8_t> reflectors_; // per triangle (empty: none marked)
 };
