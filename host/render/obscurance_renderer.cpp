@@ -998,8 +998,8 @@ RenderStats ObscuranceRenderer::stats() const {
 }
 
 std::uint64_t ObscuranceRenderer::deviceBytes() const {
-  return sceneBuffers_.bytes() + frame_.bytes() + lightBuffers_.lights.buffer().size() + lightBuffers_.emitters.buffer().size() +
-         lightBuffers_.tree.size() + lightBuffers_.scales.size() + emissionBuffer_.size();
+  return sceneBuffers_.bytes() + frame_.bytes() + lightBuffers_.lights.buffer().size() +
+         lightBuffers_.emitters.buffer().size() + lightBuffers_.tree.size() + lightBuffers_.scales.size() + emissionBuffer_.size();
 }
 
 } // namespace obscura::render

@@ -176,8 +176,8 @@ RenderStats PathTracer::stats() const {
   st.passes["pathtrace"] = {.gpuMs = timestamps_.totalsMs().contains("pathtrace") ? timestamps_.totalsMs().at("pathtrace")
                                                                                    : 0.0,
                             .rays = status[gpu::kStatusPathRays]};
-  std::uint64_t bytes = sceneBuffers_.bytes() + lightBuffer_.buffer().size() + emitterBuffer_.buffer().size() + scaleBuffer_.size() +
-                        status_.buffer().size();
+  std::uint64_t bytes = sceneBuffers_.bytes() + lightBuffer_.buffer().size() + emitterBuffer_.buffer().size() +
+                        scaleBuffer_.size() + status_.buffer().size();
   for (const auto& r : radiance_) bytes += r.size();
   st.deviceBytes = bytes;
   if (const auto n = nonFiniteSamples(); n > 0)

@@ -51,7 +51,8 @@ vec4 materialBaseColor(GpuMaterial m, vec2 uv) {
 vec3 materialEmission(GpuMaterial m, vec2 uv, bool frontFacing) {
   if (!frontFacing && m.emission.w == 0.0) return vec3(0.0);
   vec3 e = m.emission.rgb;
-  if (kEmissiveTextures && m.textures.z >= 0 && any(greaterThan(e, vec3(0.0)))) e *= sampleTexture(m.textures.z, uv).rgb;
+  if (kEmissiveTextures && m.textures.z >= 0 && any(greaterThan(e, vec3(0.0))))
+    e *= sampleTexture(m.textures.z, uv).rgb;
   return e;
 }
 

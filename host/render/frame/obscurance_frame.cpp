@@ -132,7 +132,8 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
 std::uint64_t ObscuranceFrame::bytes() const {
   std::uint64_t total = status_.buffer().size();
   for (const auto& b : bands_)
-    for (const gpu::Buffer* buffer : {&b.gbuffer.buffer(), &b.aovs, &b.basis, &b.emissionBasis, &b.ambient, &b.specularBasis,
+    for (const gpu::Buffer* buffer : {&b.gbuffer.buffer(), &b.aovs, &b.basis, &b.emissionBasis, &b.ambient,
+                                      &b.specularBasis,
                                       &b.specularAmbient, &b.queue, &b.specularPaths, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty,
                                       &b.sampleCounts, &b.pathHits, &b.shadowRays})
       total += buffer->size();

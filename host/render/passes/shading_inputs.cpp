@@ -4,7 +4,9 @@ namespace obscura::render {
 
 ShadingSpecialisation shadingSpecialisation(std::uint32_t bands, bool spatialSampling, std::uint32_t lightCapacity,
                                             const SceneSpecialisation& scene) {
-  return {.bands = bands, .flatLightSelection = spatialSampling && lightCapacity <= gpu::kMaxSpatialLights, .scene = scene};
+  return {.bands = bands,
+          .flatLightSelection = spatialSampling && lightCapacity <= gpu::kMaxSpatialLights,
+          .scene = scene};
 }
 
 gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {

@@ -12,8 +12,8 @@ namespace obscura::render {
 struct LightBuffers {
   gpu::TexelBuffer lights;   // GpuLight[] (RGBA32F texels: shaders/lib/light_bindings.glsl)
   gpu::TexelBuffer emitters; // GpuEmitter[] (the same)
-  gpu::Buffer scales;      // vec4[]: the render-time E_s, which makes seen emission unit
-  gpu::Buffer tree;        // GpuLightNode[]: the light tree (light_tree.h)
+  gpu::Buffer scales;        // vec4[]: the render-time E_s, which makes seen emission unit
+  gpu::Buffer tree;          // GpuLightNode[]: the light tree (light_tree.h)
 };
 
 struct ShadingInputs {
