@@ -122,10 +122,12 @@ void main() {
   }
 
   // M_s: the emission the camera sees, per light at unit emission, so that relighting scales a
-  // lamp the camera looks at with its light [SPEC §3]. Sample 0 starts every light's sum. Each
-  // sample adds the mean over its emission rays (the camera ray itself when K <= 1) of their unit
-  // emission to the light each one sees; consecutive rays on the same light are summed first.
-  if (first)
+  // lamp the camera looks at with its light [SPEC §3]. Each sample adds the mean over its emission
+  // rays (the camera ray itself when K <= 1) of their unit emission to the light each one sees;
+  // consecutive rays on the same light are summed first.
+  // A whole frame's sample 0 follows ObscuranceRenderer::reset(), which has zeroed every light's
+  // sum; a dirty pixel's retrace restarts its own here (a store per light per pixel).
+  if (first && (pc.band.w & kPrimaryFlagDirtyOnly) != 0u)
     for (uint s = 0u; s < lightCount; ++s) OBS_ACCUMULATE_FIRST(emissionBasis, s * bp.count + pixel, vec4(0.0))
   const bool ownRays = kEmissionRays && emissionSamples > 1u;
   const uint rays = ownRays ? emissionSamples : 1u;
