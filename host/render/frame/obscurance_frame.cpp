@@ -19,6 +19,7 @@ const auto kStorage = Usage::eStorageBuffer | Usage::eTransferSrc | Usage::eTran
 
 // Vulkan has no empty buffers: a kind a frame does not use still gets 16 bytes to bind.
 std::uint64_t atLeastOne(std::uint64_t bytes) { return std::max<std::uint64_t>(bytes, kVec4); }
+static_assert(sizeof(gpu::GBufferTexel) == gpu::kTexelsPerGBuffer * sizeof(gpu::vec4)); // gbufferAt's view
 
 } // namespace
 

@@ -32,6 +32,8 @@ bvh::TriangleSoup triangleSoup(const scene::Scene& scene) {
 
 static_assert(sizeof(gpu::TriangleShading) == gpu::kTexelsPerShading * sizeof(gpu::vec4));
 static_assert(sizeof(gpu::GpuMaterial) == gpu::kTexelsPerMaterial * sizeof(gpu::vec4));
+static_assert(sizeof(gpu::GpuLight) == gpu::kTexelsPerLight * sizeof(gpu::vec4));
+static_assert(sizeof(gpu::GpuEmitter) == gpu::kTexelsPerEmitter * sizeof(gpu::vec4));
 static_assert(sizeof(gpu::GpuTexture) == sizeof(glm::uvec4));
 
 std::vector<gpu::BindingKind> sceneBindingKinds() {
@@ -146,14 +148,8 @@ SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scen
   items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::vec4), "scene.bvhItems",
                             vk::BufferUsageFlagBits::eStorageBuffer);
 
-  auto shading = shadingData(scene, reflectors_);
-  checkTexelLimit(context, shading.size() * gpu::kTexelsPerShading, "triangles' shading data");
-  shading_ = gpu::TexelBuffer(context, shading.data(), shading.size() * sizeof(gpu::TriangleShading), "scene.shading");
-
-  auto materials = materialData(scene);
-  if (materials.empty()) materials.emplace_back(); // Vulkan buffers cannot be empty
-  materials_ =
-      gpu::TexelBuffer(context, materials.data(), materials.size() * sizeof(gpu::GpuMaterial), "scene.materials");
+  shading_ = tableTexels(context, shadingData(scene, reflectors_), "triangles' shading data", "scene.shading");
+  materials_ = tableTexels(context, materialData(scene), "materials", "scene.materials");
 
   std::vector<scene::Texture> fitted =
       fitTextures(scene.textures, context.info().maxStorageBufferRange, notes_);
@@ -200,11 +196,10 @@ bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh
     return false;
   }
   checkTexelLimit(*context_, items.size(), "BVH nodes and triangles");
-  checkTexelLimit(*context_, shading.size() * gpu::kTexelsPerShading, "triangles' shading data");
   bytes_ -= items_.buffer().size() + shading_.buffer().size();
   items_ =
       gpu::TexelBuffer(*context_, items.data(), itemBytes, "scene.bvhItems", vk::BufferUsageFlagBits::eStorageBuffer);
-  shading_ = gpu::TexelBuffer(*context_, shading.data(), shadingBytes, "scene.shading");
+  shading_ = tableTexels(*context_, shading, "triangles' shading data", "scene.shading");
   bytes_ += items_.buffer().size() + shading_.buffer().size();
   return true;
 }
