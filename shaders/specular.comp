@@ -16,6 +16,11 @@
 // without it (the paper's estimator, per-light shadow rays) not at all, since the shadow rays
 // then take all of that light.
 //
+// Every vertex gathers with N_s shadow and N_obs obscurance rays, or with kFlagVertexRaysByThroughput
+// (the default) with those counts scaled by the path's throughput there (raysAtVertex): a vertex
+// seen through a dielectric's Fresnel reflection (a few per cent) adds little to its pixel, and
+// one ray of each kind does for it.
+//
 // With kShadeFlagPerLight (a light just added, band.w) the same paths are followed again: the
 // lobe samples draw from a generator of their own, so the path of a sample does not depend on
 // what is gathered along it. Only that light is gathered, alone as in shadow.comp (no MIS, its
@@ -78,6 +83,7 @@ struct PathState {
   uint rng;       // what is gathered
   vec3 pathLo;    // the box of the path's vertices (dirty.comp)
   vec3 pathHi;
+  uint lightSamples; // the light samples drawn at the vertex the next lobe ray leaves (its MIS)
   bool escaped;   // a ray of the path left the scene
   bool truncated; // a traversal of the path ran out of loop passes
   uint pixel;     // band-local
@@ -93,6 +99,7 @@ struct SpecularConstants {
   uint addedLight;
   bool noDirect;
   bool glossyMis;
+  bool raysByThroughput; // kFlagVertexRaysByThroughput
   // The frame keeps this sample's rays (the host checks that the depth and N_s fit): the plain
   // kernel writes the lobe hits and the vertices' shadow rays; the variants that follow the paths
   // again (an added light, a probe) take them when specialised with kReplayRays (lib/kept_rays.glsl).
@@ -109,11 +116,25 @@ SpecularConstants specularConstants() {
   c.addedLight = pc.band.w;
   c.noDirect = (pc.band.z & kShadeFlagNoDirect) != 0u;
   c.glossyMis = (pc.counts.w & kFlagGlossyMis) != 0u;
+  c.raysByThroughput = (pc.counts.w & kFlagVertexRaysByThroughput) != 0u;
   c.keepRays = !kProbe && !kPerLight && !kReplayRays && (pc.band.z & kShadeFlagKeptRays) != 0u;
   return c;
 }
 
-PathState startPath(uint pixel) {
+// The rays of one kind a vertex gathers with, of `perHit` at a primary hit. By throughput: the
+// vertex's estimate reaches its pixel weighted by the path throughput t, so its n rays add
+// t^2 sigma^2 / n to the pixel's variance at a cost of n rays; over the vertices, the allocation
+// n ~ t (times sigma, alike here) minimises the variance for the rays spent (Neyman allocation
+// of a stratified estimator). OURS: n = ceil(perHit max(t)), at least 1, at most perHit; a
+// dielectric's Fresnel reflection (t of a few per cent) takes one ray, a metal's nearly all.
+// Any n >= 1 leaves the estimate's mean as it is.
+uint raysAtVertex(SpecularConstants c, uint perHit, vec3 throughput) {
+  if (!c.raysByThroughput || perHit == 0u) return perHit;
+  const float share = max(throughput.x, max(throughput.y, throughput.z));
+  return clamp(uint(ceil(float(perHit) * share)), 1u, perHit);
+}
+
+PathState startPath(SpecularConstants c, uint pixel) {
   BandPixel bp = bandPixelFromIndex(pixel, pc.frame.xy, pc.band.xy);
   PathState path;
   path.sp = shadingPointFromGBuffer(gbufferAt(pixel), pc.eye.xyz);
@@ -122,6 +143,7 @@ PathState startPath(uint pixel) {
   path.rng = rngSeed(bp.frame, pc.frame.z, pc.frame.w ^ 0x6c8e9cf5u);
   path.pathLo = path.sp.position;
   path.pathHi = path.sp.position;
+  path.lightSamples = c.shadowRays; // shadow.comp's at the primary hit
   path.escaped = false;
   path.truncated = false;
   path.pixel = pixel;
@@ -165,7 +187,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
     uint sky = findBackgroundLight(c.lightCount);
     if ((c.oneLight && sky != c.addedLight) || c.noDirect) sky = kInvalidIndex;
     if (!kProbe && h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || (c.glossyMis && !c.oneLight))) { // a miss, not a truncation
-      float w = delta ? 1.0 : powerHeuristic(lobePdf, float(c.shadowRays) * backgroundLightPdf(sky, previous, previousNormal, c.lightCount, wi));
+      float w = delta ? 1.0 : powerHeuristic(lobePdf, float(path.lightSamples) * backgroundLightPdf(sky, previous, previousNormal, c.lightCount, wi));
       OBS_ACCUMULATE(specularBasis, sky * c.pixelCount + pixel, vec4(w * throughput, 0.0))
     }
     return false;
@@ -180,7 +202,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
     float w = 1.0;
     if (!delta) {
       float lightPdf = emitterHitLightPdf(s.lightGroup, previous, previousNormal, c.lightCount, h, s.position, wi);
-      w = powerHeuristic(lobePdf, float(c.shadowRays) * lightPdf);
+      w = powerHeuristic(lobePdf, float(path.lightSamples) * lightPdf);
     }
     // Seen emission in unit-emission terms: divided by the group's E_s (1 where E_s is 0).
     vec3 unit = unitEmission(materialEmission(m, s.uv, s.frontFacing), lightScales[s.lightGroup].rgb);
@@ -189,13 +211,16 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
   sp = shadingPoint(s.position, s.geometricNormal, s.shadingNormal, -wi, baseColor, s.material);
   path.sp = sp;
   // Gather as at P [RTO §4.1 step 4]: direct light, then obscurance.
+  const uint shadowRays = raysAtVertex(c, c.shadowRays, throughput);
+  const uint obscuranceRays = raysAtVertex(c, pc.counts.z, throughput);
+  path.lightSamples = shadowRays;
   // MIS only where a lobe sample follows from this vertex (the path goes on past it).
-  float misSamples = c.glossyMis && depth + 1u < c.maxDepth ? float(c.shadowRays) : 0.0;
+  float misSamples = c.glossyMis && depth + 1u < c.maxDepth ? float(shadowRays) : 0.0;
   const vec4 lightShift = rngNext4(path.rng); // this vertex's light samples: one shifted low-discrepancy set
   if (kProbe && kReplayRays) {
     // The vertex's kept shadow rays (never kept for one light alone, nor without direct light:
     // the host keeps no rays with per-light shadow sampling).
-    probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.frame.z, pixel, c.pixelCount, depth, c.shadowRays);
+    probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.frame.z, pixel, c.pixelCount, depth, shadowRays);
   } else {
     // A probe whose shafts from the vertex to the lights all miss the boxes draws no light sample.
     const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, c.lightCount);
@@ -207,19 +232,19 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
       rays += taken;
       return true; // one light's rays alone: no obscurance
     }
-    for (uint k = 0u; k < (c.noDirect || !drawn ? 0u : c.shadowRays); ++k) {
+    for (uint k = 0u; k < (c.noDirect || !drawn ? 0u : shadowRays); ++k) {
       vec4 u = kroneckerPoint4(k, lightShift);
       vec3 contribution;
       uint light;
       directLightSample(sp, u, c.lightCount, misSamples, budget, contribution, light);
       if (c.keepRays) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, c.pixelCount, depth, k)] = gShadowRay;
-      OBS_ACCUMULATE(specularBasis, light * c.pixelCount + pixel, vec4(throughput * contribution / float(c.shadowRays), 0.0))
+      OBS_ACCUMULATE(specularBasis, light * c.pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
     }
   }
   // Secondary reflectors only at primary hits: here the ambient keeps its whole I_a.
-  vec4 aw = gatherObscurance(sp, path.rng, budget, kInvalidIndex, c.pixelCount);
+  vec4 aw = gatherObscurance(sp, path.rng, budget, kInvalidIndex, c.pixelCount, obscuranceRays);
   OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
-  rays += (c.noDirect ? 0u : c.shadowRays) + pc.counts.z;
+  rays += (c.noDirect ? 0u : shadowRays) + obscuranceRays;
   return true;
 }
 
@@ -239,7 +264,7 @@ void finishPath(SpecularConstants c, PathState path) {
 // shading point's material parameters are read again, as shadingPoint reads them).
 void storePath(PathState path) {
   const uint at = kSpecularPathTexels * path.pixel;
-  const uint flags = (path.escaped ? 1u : 0u) | (path.truncated ? 2u : 0u);
+  const uint flags = (path.escaped ? 1u : 0u) | (path.truncated ? 2u : 0u) | (path.lightSamples << 2u);
   specularPaths[at] = vec4(path.sp.position, path.throughput.x);
   specularPaths[at + 1u] = vec4(path.sp.ng, path.throughput.y);
   specularPaths[at + 2u] = vec4(path.sp.ns, path.throughput.z);
@@ -263,6 +288,7 @@ PathState loadPath(uint pixel) {
   path.pathHi = t6.xyz;
   path.escaped = (flags & 1u) != 0u;
   path.truncated = (flags & 2u) != 0u;
+  path.lightSamples = flags >> 2u;
   path.pixel = pixel;
   return path;
 }
@@ -279,7 +305,7 @@ void main() {
   const uint pixel = queue[queued + kQueueHeader + entry];
   beginProbe(); // the queue holds only the candidates not yet found dirty (skipClean)
   StepBudget budget = newStepBudget();
-  PathState path = depth == 1u ? startPath(pixel) : loadPath(pixel);
+  PathState path = depth == 1u ? startPath(c, pixel) : loadPath(pixel);
   uint rays = 0u;
   bool goesOn = false;
   if (depth < c.maxDepth && path.sp.glossy) {

@@ -296,10 +296,11 @@ nlohmann::json frameJson(const BenchOptions& o, const FrameRun& f) {
 
 void printPasses(const PassesRun& p, double closestMrays, double shadowMrays) {
   const render::ObscuranceSettings budget; // the paper's budget is the defaults
-  fmt::print("passes: the paper's budget at {}x{} ({} spp, {} shadow + {} obscurance rays per hit), best repeat by GPU "
-             "time: wall {:.2f} s, GPU {:.0f} ms\n",
-             p.size.x, p.size.y, budget.spp, budget.shadowRays, budget.obscuranceRays, p.stats.wallSeconds,
-             render::totalGpuMs(p.stats));
+  fmt::print("passes: the paper's budget at {}x{} ({} spp, {} shadow + {} obscurance rays per hit{}), best repeat by "
+             "GPU time: wall {:.2f} s, GPU {:.0f} ms\n",
+             p.size.x, p.size.y, budget.spp, budget.shadowRays, budget.obscuranceRays,
+             budget.vertexRaysByThroughput ? ", at specular path vertices scaled by throughput" : "",
+             p.stats.wallSeconds, render::totalGpuMs(p.stats));
   fmt::print("  {:<12} {:>10} {:>12} {:>9}   {}\n", "pass", "GPU ms", "rays", "Mrays/s",
              "/ bench-rays rate of its kind (goal >= 0.77, i.e. within 1.3x)");
   for (const auto& [name, pass] : p.stats.passes) {

@@ -236,6 +236,7 @@ void runRender(RenderOptions& o) {
   writeOutputs(o, image, stats, context, loaded,
                {{"method", o.method}, {"dmax", renderer.dMax()}, {"rho", o.rho}, {"tau", settings.tau},
                 {"sampling", o.sampling}, {"colour_bleeding", !o.noBleed}, {"max_depth", settings.maxDepth},
+                {"vertex_rays", o.vertexRays},
                 {"light_sampling", o.lightSampling}, {"ambient", o.ambient},
                 {"secondary_reflectors", settings.secondaryReflectors},
                 {"secondary_reflector_triangles", renderer.secondaryReflectors()},

@@ -52,6 +52,11 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
       ->check(CLI::Range(0u, 1024u));
   cmd.add_option("--obs-rays", o.obscurance.obscuranceRays, "obscurance rays per hit (N_obs)")
       ->check(CLI::Range(0u, 1024u));
+  cmd.add_option("--vertex-rays", o.vertexRays,
+                 "shadow and obscurance rays at a specular path's vertices: throughput (default: N_s and N_obs scaled "
+                 "by the path's throughput there, at least one each; the same mean for fewer rays) or per-hit (N_s and "
+                 "N_obs at every vertex)")
+      ->check(CLI::IsMember({"throughput", "per-hit"}));
   cmd.add_option("--rho", o.rho, "rho(d): sqrt (the paper's), exp, ao")->check(CLI::IsMember({"sqrt", "exp", "ao"}));
   cmd.add_option("--tau", o.obscurance.tau, "tau of --rho exp")->check(CLI::PositiveNumber);
   cmd.add_option("--dmax", o.dMax, "dmax in scene units (default: half the median distance between the surfaces the camera sees and "
@@ -128,6 +133,7 @@ render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scen
   settings.rho = render::rhoKindNamed(o.rho);
   settings.systematic = o.sampling == "systematic";
   settings.colourBleeding = !o.noBleed;
+  settings.vertexRaysByThroughput = o.vertexRays == "throughput";
   settings.shadowSampling = o.shadowSampling == "per-light" ? render::ShadowSampling::PerLight
                                                             : render::ShadowSampling::Selection;
   settings.lightSampling = lightSampling(o);

@@ -29,6 +29,7 @@ struct RenderOptions {
   render::ObscuranceSettings obscurance;
   std::string rho = "sqrt";
   std::string sampling = "systematic";
+  std::string vertexRays = "throughput";
   bool noBleed = false;
   float dMax = 0.0f;
   bool dMaxGiven = false;

@@ -77,6 +77,7 @@ void saveState(const std::string& dir, const render::ObscuranceRenderer& rendere
       {"settings", {{"seed", s.seed}, {"shadow_rays", s.shadowRays}, {"obscurance_rays", s.obscuranceRays},
                     {"dmax", renderer.dMax()}, {"rho", static_cast<int>(s.rho)}, {"systematic", s.systematic},
                     {"colour_bleeding", s.colourBleeding}, {"max_depth", s.maxDepth},
+                    {"vertex_rays_by_throughput", s.vertexRaysByThroughput},
                     {"emission_samples", s.emissionSamples}}},
       {"average_reflectance", vec3Json(renderer.ambient().averageReflectance)},
       {"lights", nlohmann::json::array()}};

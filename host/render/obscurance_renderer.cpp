@@ -355,7 +355,8 @@ gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
                               (settings_.colourBleeding ? gpu::kFlagBleed : 0u) |
                               (settings_.lightSampling == LightSampling::Area ? gpu::kFlagAreaLightSampling : 0u) |
                               (glossyMis ? gpu::kFlagGlossyMis : 0u) |
-                              (reflectorsOn() ? gpu::kFlagSecondaryReflectors : 0u);
+                              (reflectorsOn() ? gpu::kFlagSecondaryReflectors : 0u) |
+                              (settings_.vertexRaysByThroughput ? gpu::kFlagVertexRaysByThroughput : 0u);
   return {.frame = glm::uvec4(settings_.width, settings_.height, sample, settings_.seed),
           .counts = glm::uvec4(static_cast<std::uint32_t>(lights_.size()), settings_.shadowRays,
                                settings_.obscuranceRays, flags),

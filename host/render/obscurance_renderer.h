@@ -81,6 +81,10 @@ struct ObscuranceSettings {
   bool systematic = true;            // [RTO §4.2]
   bool colourBleeding = true;        // W_c [RTO eq. 6]; false: grey W [RTO eq. 2]
   std::uint32_t maxDepth = 6;        // specular paths: scattering vertices, the primary hit is 1
+  // A specular path's vertices gather with N_s and N_obs scaled by the path's throughput there
+  // (at least one ray of each kind; the mean is the same, the rays go where they count:
+  // specular.comp, raysAtVertex); false: N_s and N_obs at every vertex, as at a primary hit.
+  bool vertexRaysByThroughput = true;
   std::uint64_t maxBufferBytes = 0;  // per-buffer limit for frame bands; 0 = the device's
   // What the frame keeps (only what is asked for is allocated): the primary pass's AOVs (albedo,
   // normal, depth, ...), and all composed AOVs or `combined` alone.

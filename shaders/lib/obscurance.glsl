@@ -44,8 +44,9 @@ void reflectedDirectLight(Surface s, vec3 direction, vec4 u, inout StepBudget bu
   directLightSample(q, u, pc.counts.x, 0.0, budget, contribution, light);
 }
 
-// N_obs cosine-distributed rays around the shading normal with tmax = dMax, by systematic
-// [RTO §4.2] or independent sampling:
+// n cosine-distributed rays (N_obs at a primary hit; a specular path's vertex may take fewer,
+// specular.comp) around the shading normal with tmax = dMax, by systematic [RTO §4.2] or
+// independent sampling:
 //   W   = 1/pi  int rho(d) cos dw      ~ mean of rho(d_i)              [RTO eq. 2]
 //   W_c = 1/pi  int R(Q) rho(d) cos dw ~ mean of R(Q_i) rho(d_i)        [RTO eq. 6]
 // (the cosine pdf cancels the 1/pi cos factor), R(Q) := R_ave on a miss [SPEC §1.2].
@@ -58,8 +59,7 @@ void reflectedDirectLight(Surface s, vec3 direction, vec4 u, inout StepBudget bu
 // kappa + r (1 - kappa) (OURS: the paper adds a ray to the light without saying how the two
 // combine; these shares keep the first bounce from being counted twice and are constants of the
 // render, so I_a stays linear in every emission; secondary_reflectors.h).
-vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, uint reflectorPixel, uint pixelCount) {
-  const uint n = pc.counts.z;
+vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, uint reflectorPixel, uint pixelCount, uint n) {
   const bool systematic = (pc.counts.w & kFlagSystematic) != 0u;
   const bool bleed = !kGreyObscurance && (pc.counts.w & kFlagBleed) != 0u;
   const bool reflectors = kReflectors && reflectorPixel != kInvalidIndex && (pc.counts.w & kFlagSecondaryReflectors) != 0u;

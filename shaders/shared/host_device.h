@@ -316,6 +316,10 @@ OBS_CONST uint kFlagGlossyMis = 8u;
 // on a marked triangle (TriangleShading.n2.w) traces that point's direct light too, into D_s, and
 // keeps only the share kappa (ShadePush.reflectors) of the ambient there.
 OBS_CONST uint kFlagSecondaryReflectors = 16u;
+// A specular path's vertices gather with N_s and N_obs scaled by the path's throughput there, at
+// least one ray each (specular.comp, raysAtVertex); without it, N_s and N_obs at every vertex.
+OBS_CONST uint kFlagVertexRaysByThroughput = 32u;
+
 OBS_CONST uint kRhoSqrt = 0u;        // rho(d) = sqrt(d / dmax)          [RTO §3, SPEC §1.1]
 OBS_CONST uint kRhoExp = 1u;         // rho(d) = (1 - e^(-tau d/dmax)) / (1 - e^(-tau))
 OBS_CONST uint kRhoAo = 2u;          // rho(d) = 0 below dmax (ambient occlusion)

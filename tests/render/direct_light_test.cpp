@@ -142,6 +142,53 @@ TEST_F(DirectLight, GlossyHighlightIsTheSameWithMisWithoutItAndInThePathTracer) 
   EXPECT_GT(byMethod[0].mean, 0.01);
 }
 
+// The mean of the per-pixel differences of two renders of the same scene, with its standard error
+// from their spread (the pixels' own expectations cancel; each pixel is one independent sample).
+Estimate meanDifference(const io::Image& a, const io::Image& b, const std::vector<std::string>& channels) {
+  io::Image d = a;
+  for (const auto& c : channels) {
+    const int i = a.channelIndex(c);
+    for (int y = 0; y < a.height; ++y)
+      for (int x = 0; x < a.width; ++x) d.at(x, y, i) = a.at(x, y, i) - b.at(x, y, i);
+  }
+  return estimate(d, channels);
+}
+
+TEST_F(DirectLight, SpecularPathVerticesGatherTheSameMeanWithRaysScaledByThroughput) {
+  // A rough dielectric floor (a few per cent of Fresnel reflection: one ray of each kind at the
+  // next vertex instead of N_s and N_obs) reflects a dark rough metal wall, whose lobe reflects a
+  // small lamp above the floor: the wall's vertex weighs its lobe sample against its own light
+  // samples, one here, by MIS. Scaled or not, the specular light has the same mean, for fewer rays.
+  SceneBuilder b;
+  auto floor = b.glossy(glm::vec3(0.6f, 0.5f, 0.4f), 0.0f, 0.2f);
+  auto wall = b.glossy(glm::vec3(0.3f, 0.25f, 0.2f), 1.0f, 0.25f);
+  auto back = b.lambertian(glm::vec3(0.5f));
+  auto emitter = b.lambertian(glm::vec3(0.0f), glm::vec3(20.0f, 15.0f, 10.0f));
+  b.quad({-2, 0, -1}, {0, 0, 3}, {4, 0, 0}, floor);   // faces +y
+  b.quad({-2, 0, -1}, {4, 0, 0}, {0, 2, 0}, wall);    // faces +z
+  b.quad({-2, 0, 2}, {0, 2, 0}, {4, 0, 0}, back);     // faces -z, behind the camera
+  b.quad({-0.3f, 1.2f, 0.2f}, {0.6f, 0, 0}, {0, 0, 0.3f}, emitter, "lamp"); // faces -y
+  scene::Scene s = b.build();
+  render::ObscuranceSettings settings;
+  settings.width = settings.height = 32;
+  settings.spp = 48;
+  settings.maxDepth = 3;
+  settings.camera = lookCamera({0, 0.4f, 1.5f}, {0, -0.35f, -1}, {0, 1, 0}, 0.5f);
+  settings.vertexRaysByThroughput = false;
+  auto perHit = render(s, settings);
+  settings.vertexRaysByThroughput = true;
+  auto scaled = render(s, settings);
+  ASSERT_TRUE(perHit.stats.passes.contains("specular"));
+  const std::vector<std::string> specular = {"specular.R", "specular.G", "specular.B"};
+  const Estimate difference = meanDifference(scaled.image, perHit.image, specular);
+  const double mean = estimate(perHit.image, specular).mean;
+  EXPECT_GT(mean, 0.02) << "the camera sees light along the specular paths";
+  EXPECT_NEAR(difference.mean, 0.0, 4.0 * difference.stdError + 1e-5 * mean)
+      << "scaled minus per-hit " << difference.mean << " of " << mean;
+  // Most vertices lie on the wall, seen through the floor's Fresnel reflection.
+  EXPECT_LT(scaled.stats.passes.at("specular").rays, perHit.stats.passes.at("specular").rays / 2);
+}
+
 TEST_F(DirectLight, DimLampNearbyAndBrightLampFarAwayAgreeAndSpatialSelectionIsLessNoisy) {
   // A lamp of power 1 at 0.3 above the origin and one of 10^4 times its power 30 away to the side:
   // by power the near lamp, which gives most of the light, is picked once in 10^4 samples (the
