@@ -76,6 +76,7 @@ struct Method {
   bool denoise = false;             // the frame denoised (render/denoise/), its GPU time counted
   std::uint32_t obscuranceRays = 0; // obscurance rays per hit; 0: raysPerHit
   std::uint32_t emissionSamples = 0; // camera rays per sample for the seen emission; 0: the study's
+  bool vertexRaysByThroughput = true; // specular path vertices: rays scaled by throughput, or N per hit
 };
 
 // The paper's budget [RTO §4.1]: 8 primary samples x (5 obscurance + 5 shadow rays) per hit.
@@ -92,6 +93,10 @@ const std::vector<Method> kMethods = {
     // holds 2/3 of the variance at 5 + 5, the obscurance 2 % (docs/BENCHMARKS.md).
     {"obscurance-split", false, render::LightSampling::Spatial, 8, kPaperSpp,
      "spatial light sampling, 8 shadow + 2 obscurance rays per hit, 8 spp", 0.0f, false, 2},
+    // What scaling a specular path vertex's rays by its throughput (the default) saves and costs.
+    {"obscurance-per-hit-vertices", false, render::LightSampling::Spatial, kPaperRays, kPaperSpp,
+     "as obscurance, 5+5 rays at every specular path vertex too (render --vertex-rays per-hit)", 0.0f, false, 0, 0,
+     false},
     {"obscurance-realtime", false, render::LightSampling::Spatial, 1, 1, "spatial, 1+1 rays per hit, 1 spp"},
     // The window's frames: the same, denoised (one frame alone, no history), error measured.
     {"obscurance-denoised", false, render::LightSampling::Spatial, kPaperRays, 1,
@@ -168,6 +173,7 @@ public:
       s.ambient = render::AmbientModel::Seen; // the least biased I_a; Reached and Global composed beside it
       s.dMax = o_.dMax;
       s.secondaryReflectors = m.secondaryReflectors;
+      s.vertexRaysByThroughput = m.vertexRaysByThroughput;
       if (!obscurance_)
         obscurance_ = std::make_unique<render::ObscuranceRenderer>(context_, loaded_.scene, loaded_.bvh, s);
       obscurance_->configure(s);
