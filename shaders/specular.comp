@@ -212,7 +212,9 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
   path.sp = sp;
   // Gather as at P [RTO §4.1 step 4]: direct light, then obscurance.
   const uint shadowRays = raysAtVertex(c, c.shadowRays, throughput);
-  const uint obscuranceRays = raysAtVertex(c, pc.counts.z, throughput);
+  // A metal vertex reflects none of the ambient (R(P) = 0, lib/shade.glsl): no obscurance ray.
+  const bool reflectsAmbient = any(greaterThan(obscuranceReflectance(sp), vec3(0.0)));
+  const uint obscuranceRays = reflectsAmbient ? raysAtVertex(c, pc.counts.z, throughput) : 0u;
   path.lightSamples = shadowRays;
   // MIS only where a lobe sample follows from this vertex (the path goes on past it).
   float misSamples = c.glossyMis && depth + 1u < c.maxDepth ? float(shadowRays) : 0.0;

@@ -250,6 +250,36 @@ TEST_F(Obscurance, FacingMirrorsReflectAnEmittingMirrorOncePerRoundTripUpToTheMa
   }
 }
 
+TEST_F(Obscurance, AMetalPathVertexTracesNoObscuranceRays) {
+  // A white mirror floor under a ceiling at height 2: the camera's paths meet the ceiling at their
+  // first vertex (depth 2 is the last). A metal ceiling reflects none of the ambient (R(P) = 0), so
+  // its vertices trace the same rays with 5 obscurance rays per hit as with none; a Lambertian
+  // one traces 5 more at each. A lamp beside them gives the shadow rays a light.
+  for (bool metalCeiling : {true, false}) {
+    SCOPED_TRACE(metalCeiling ? "metal ceiling" : "Lambertian ceiling");
+    SceneBuilder b;
+    auto floorMirror = b.glossy(glm::vec3(1.0f), 1.0f, 0.0f);
+    auto ceiling = metalCeiling ? b.glossy(glm::vec3(0.5f), 1.0f, 0.3f) : b.lambertian(glm::vec3(0.5f));
+    auto lamp = b.lambertian(glm::vec3(0.0f), glm::vec3(1.0f));
+    b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, floorMirror);
+    b.quad({-kHalfSize, 2, -kHalfSize}, {2 * kHalfSize, 0, 0}, {0, 0, 2 * kHalfSize}, ceiling); // faces -y
+    b.quad({-0.1f, 1.5f, 3.0f}, {0.2f, 0, 0}, {0, 0.2f, 0}, lamp, "lamp");
+    scene::Scene s = b.build();
+    std::uint64_t specularRays[2] = {0, 0};
+    for (std::uint32_t obscuranceRays : {0u, 5u}) {
+      auto settings = lookDown(1.0f, 0.2f, 8, 1);
+      settings.maxDepth = 2;
+      settings.obscuranceRays = obscuranceRays;
+      auto r = render(s, settings);
+      ASSERT_TRUE(r.stats.passes.contains("specular"));
+      specularRays[obscuranceRays ? 1 : 0] = r.stats.passes.at("specular").rays;
+    }
+    EXPECT_GT(specularRays[0], 0u);
+    if (metalCeiling) EXPECT_EQ(specularRays[1], specularRays[0]);
+    else EXPECT_EQ(specularRays[1], specularRays[0] + 5u * 64u) << "one path a pixel, 64 pixels";
+  }
+}
+
 TEST_F(Obscurance, SameSeedSameImageNoNaNAndOnlyNeededPasses) {
   scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
   render::ObscuranceSettings settings;
