@@ -69,6 +69,7 @@ void main() {
   if (hit.primitive == kTruncatedHit) atomicAdd(status[kStatusTruncated], 1u);
 
   GBufferTexel g;
+  vec3 seenEmission = vec3(0.0); // the AOV's; the G-buffer does not keep it
   vec3 preview = vec3(0.0);
   uint lightGroup = kInvalidIndex;
   vec3 unitSeen = vec3(0.0);
@@ -82,7 +83,7 @@ void main() {
     g.geometricNormal = vec4(s.geometricNormal, uintBitsToFloat(hit.primitive));
     g.shadingNormal = vec4(s.shadingNormal, uintBitsToFloat(s.material));
     g.albedo = vec4(albedo, 1.0);
-    g.emission = vec4(emission, 0.0);
+    seenEmission = emission;
     lightGroup = s.lightGroup;
     if (lightGroup != kInvalidIndex) unitSeen = unitEmission(emission, lightScales[lightGroup].rgb);
     // A light at the eye: enough to see shapes before any lighting pass runs.
@@ -98,7 +99,6 @@ void main() {
     g.geometricNormal = vec4(0.0, 0.0, 0.0, uintBitsToFloat(kInvalidIndex));
     g.shadingNormal = vec4(0.0, 0.0, 0.0, uintBitsToFloat(kInvalidIndex));
     g.albedo = vec4(0.0);
-    g.emission = vec4(0.0);
   }
   gbuffer[pixel] = g;
   if (!accumulateSums) return;
@@ -163,7 +163,7 @@ void main() {
   accumulate(pixel, kAovAlbedo, g.albedo, first);
   accumulate(pixel, kAovNormal, vec4(g.shadingNormal.xyz, g.position.w), first);
   accumulate(pixel, kAovPosition, vec4(g.position.xyz, 0.0), first);
-  accumulate(pixel, kAovEmission, g.emission, first);
+  accumulate(pixel, kAovEmission, vec4(seenEmission, 0.0), first);
   accumulate(pixel, kAovPreview, vec4(preview, 0.0), first);
   if (first) OBS_ACCUMULATE_FIRST(aov, pixel * kAovSlots + kAovIds, vec4(g.geometricNormal.w, g.shadingNormal.w, 0.0, 0.0))
 }

@@ -14,8 +14,7 @@ layout(set = 0, binding = kBindingGBuffer) uniform samplerBuffer gbufferTexels;
 GBufferTexel gbufferAt(uint pixel) {
   const int at = int(pixel * kTexelsPerGBuffer);
   return GBufferTexel(texelFetch(gbufferTexels, at), texelFetch(gbufferTexels, at + 1),
-                      texelFetch(gbufferTexels, at + 2), texelFetch(gbufferTexels, at + 3),
-                      texelFetch(gbufferTexels, at + 4));
+                      texelFetch(gbufferTexels, at + 2), texelFetch(gbufferTexels, at + 3));
 }
 layout(std430, set = 0, binding = kBindingLightTree) readonly buffer LightTreeBuffer { GpuLightNode lightTree[]; };
 // basis[light * pixelCount + pixel] += D_s contributions (unit emission), summed over samples.

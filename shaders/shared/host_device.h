@@ -230,9 +230,9 @@ struct GBufferTexel {
   vec4 geometricNormal; // 16: xyz (unit, faces the camera ray), w = primitive id (uintBitsToFloat)
   vec4 shadingNormal;   // 32: xyz (unit, interpolated, same side as geometric), w = material (bits)
   vec4 albedo;          // 48: rgb base colour x texture, a = 1 on hit, 0 on miss
-  vec4 emission;        // 64: rgb emitted radiance toward the camera, w = unused
-};                      // 80 bytes
-OBS_CONST uint kTexelsPerGBuffer = 5;
+};                      // 64 bytes: one cache line a pixel (the seen emission goes to the AOVs and
+                        // M_s from primary.comp itself; no later pass reads it)
+OBS_CONST uint kTexelsPerGBuffer = 4;
 
 // ---- Frame bands. Frame-lifetime storage is split into bands of whole rows so that no buffer
 // exceeds the device's per-buffer limit (lavapipe: 128 MiB): a band owns its own G-buffer, AOV,

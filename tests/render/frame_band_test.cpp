@@ -126,10 +126,11 @@ TEST_F(FrameBands, BandedPathTracingIsBitIdenticalToTheWholeFrame) {
   EXPECT_TRUE(bitIdentical(whole.image, banded.image(), &where)) << where;
 }
 
-// 1080p and 4K Cornell boxes do not fit one 128 MiB buffer of lavapipe; they render in bands, and
-// a different split (a quarter of the device's limit) gives the same bits.
+// Large frames render in as many bands as lavapipe's 128 MiB buffers need (at least `minBands`),
+// and a different split (a quarter of the device's limit) gives the same bits. A 4K Cornell box
+// needs 4 (its 64-byte G-buffer alone is 531 MB); a 1080p one fits one (133 MB), and splits.
 void expectLargeFrameRenders(const gpu::Context& context, const scene::Scene& s, const bvh::Bvh& tree,
-                             render::ObscuranceSettings settings) {
+                             render::ObscuranceSettings settings, std::uint32_t minBands) {
   settings.spp = 1;
   settings.shadowRays = 1;
   settings.obscuranceRays = 1;
@@ -140,7 +141,7 @@ void expectLargeFrameRenders(const gpu::Context& context, const scene::Scene& s,
   {
     render::ObscuranceRenderer renderer(context, s, tree, settings);
     bands = renderer.layout().bandCount();
-    EXPECT_GE(bands, 2u);
+    EXPECT_GE(bands, minBands);
     renderer.render();
     EXPECT_EQ(renderer.stats().truncatedTraversals, 0u);
     image = renderer.image();
@@ -160,11 +161,11 @@ void expectLargeFrameRenders(const gpu::Context& context, const scene::Scene& s,
 }
 
 TEST_F(FrameBands, CornellBoxRendersAt1920x1080) {
-  expectLargeFrameRenders(context(), cornell_, cornellBvh_, cornellSettings(1920, 1080));
+  expectLargeFrameRenders(context(), cornell_, cornellBvh_, cornellSettings(1920, 1080), 1u);
 }
 
 TEST_F(FrameBands, CornellBoxRendersAt3840x2160) {
-  expectLargeFrameRenders(context(), cornell_, cornellBvh_, cornellSettings(3840, 2160));
+  expectLargeFrameRenders(context(), cornell_, cornellBvh_, cornellSettings(3840, 2160), 4u);
 }
 
 TEST_F(FrameBands, ModernHallRendersAtThePapers800x600WithAllItsLights) {
@@ -181,7 +182,7 @@ TEST_F(FrameBands, ModernHallRendersAtThePapers800x600WithAllItsLights) {
     return small;
   }());
   EXPECT_EQ(probe.lights().size(), 13u);
-  expectLargeFrameRenders(context(), s, tree, settings);
+  expectLargeFrameRenders(context(), s, tree, settings, 2u); // 13 lights' sums: 200 MB
 }
 
 } // namespace
