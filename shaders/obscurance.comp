@@ -37,7 +37,8 @@ void main() {
   uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x9e3779b9u);
   gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
   StepBudget budget = newStepBudget();
-  const vec4 gathered = gatherObscurance(sp, rng, budget, pixel, bp.count, pc.counts.z); // a probe too: not in the macro
+  // A probe too (not in the macro): N_obs rays at every primary hit.
+  const vec4 gathered = gatherObscurance(sp, rng, budget, pixel, bp.count, pc.counts.z);
   OBS_ACCUMULATE(ambient, pixel, gathered)
   if (kProbe) endProbe(pixel);
   else atomicAdd(status[kStatusObscuranceRays], pc.counts.z);

@@ -16,10 +16,11 @@
 // without it (the paper's estimator, per-light shadow rays) not at all, since the shadow rays
 // then take all of that light.
 //
-// Every vertex gathers with N_s shadow and N_obs obscurance rays, or with kFlagVertexRaysByThroughput
-// (the default) with those counts scaled by the path's throughput there (raysAtVertex): a vertex
-// seen through a dielectric's Fresnel reflection (a few per cent) adds little to its pixel, and
-// one ray of each kind does for it.
+// Every vertex gathers with N_s shadow and N_obs obscurance rays, or with
+// kFlagVertexRaysByThroughput (the default) with those counts scaled by the path's throughput
+// there (raysAtVertex): a vertex seen through a dielectric's Fresnel reflection (a few per cent)
+// adds little to its pixel, and one ray of each kind does for it. A metal vertex reflects none of
+// the ambient and traces no obscurance ray.
 //
 // With kShadeFlagPerLight (a light just added, band.w) the same paths are followed again: the
 // lobe samples draw from a generator of their own, so the path of a sample does not depend on

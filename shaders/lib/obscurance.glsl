@@ -59,7 +59,8 @@ void reflectedDirectLight(Surface s, vec3 direction, vec4 u, inout StepBudget bu
 // kappa + r (1 - kappa) (OURS: the paper adds a ray to the light without saying how the two
 // combine; these shares keep the first bounce from being counted twice and are constants of the
 // render, so I_a stays linear in every emission; secondary_reflectors.h).
-vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, uint reflectorPixel, uint pixelCount, uint n) {
+vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, uint reflectorPixel, uint pixelCount,
+                      uint n) {
   const bool systematic = (pc.counts.w & kFlagSystematic) != 0u;
   const bool bleed = !kGreyObscurance && (pc.counts.w & kFlagBleed) != 0u;
   const bool reflectors = kReflectors && reflectorPixel != kInvalidIndex && (pc.counts.w & kFlagSecondaryReflectors) != 0u;
