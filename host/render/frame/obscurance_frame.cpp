@@ -67,7 +67,16 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
   std::uint64_t largest = 0;
   for (const auto& k : bufferKinds(contents))
     if (k.splitsBands) largest = std::max(largest, k.bytesPerPixel * (k.perLight ? maxLights_ : 1u));
-  layout_ = FrameLayout::split(width, height, largest, limit, "the per-light basis buffers");
+  // A band's texel views hold at most maxTexelBufferElements texels each: the G-buffer
+  // (kTexelsPerGBuffer a pixel, read by the shading passes) and the resolved transport (a word per
+  // light and pixel, each light's row padded to whole texels, resolvedStride). That bounds a band's
+  // pixels too, as a byte limit of the largest buffer.
+  const std::uint64_t maxTexels = context.info().maxTexelBufferElements;
+  const std::uint64_t byGBuffer = maxTexels / gpu::kTexelsPerGBuffer;
+  const std::uint64_t resolvedRowWords = 4 * maxTexels / (std::uint64_t(maxLights_) + 1);
+  const std::uint64_t byResolved = resolvedRowWords > gpu::kResolvedPixelAlign ? resolvedRowWords - gpu::kResolvedPixelAlign : 1;
+  const std::uint64_t pixelBound = std::max<std::uint64_t>(std::min(byGBuffer, byResolved), 1);
+  layout_ = FrameLayout::split(width, height, largest, std::min(limit, pixelBound * largest), "the per-light basis buffers");
   // The kept rays: as many samples as fit in one buffer of the largest band.
   std::uint64_t bandPixels = 1;
   for (std::size_t i = 0; i < layout_.bands.size(); ++i) bandPixels = std::max<std::uint64_t>(bandPixels, layout_.bandPixels(i));
@@ -88,10 +97,6 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.rows = layout_.bands[i];
     const std::uint64_t px = layout_.bandPixels(i);
     const std::string tag = layout_.bands.size() > 1 ? fmt::format("[band {}]", i) : "";
-    if (px * gpu::kTexelsPerGBuffer > context.info().maxTexelBufferElements)
-      throw DeviceError(fmt::format("a band's G-buffer needs {} texels, more than the device's "
-                                    "maxTexelBufferElements ({})", px * gpu::kTexelsPerGBuffer,
-                                    context.info().maxTexelBufferElements));
     b.gbuffer = gpu::TexelBuffer(context, atLeastOne(px * sizeof(gpu::GBufferTexel)), vk::Format::eR32G32B32A32Sfloat,
                                  kStorage, "frame.gbuffer" + tag);
     b.aovs = gpu::Buffer(context, contents.primaryAovs ? px * gpu::kAovSlots * kAccumulator : kVec4, kStorage,
@@ -112,9 +117,6 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
                                   "frame.specular_basis" + tag);
     // One word per light and pixel, each light's row padded to whole RGBA32UI texels.
     const std::uint64_t resolvedWords = std::uint64_t(gpu::resolvedStride(static_cast<std::uint32_t>(px))) * (slots + 1);
-    if (resolvedWords / 4 > context.info().maxTexelBufferElements)
-      throw DeviceError(fmt::format("a band's resolved transport needs {} texels, more than the device's "
-                                    "maxTexelBufferElements ({})", resolvedWords / 4, context.info().maxTexelBufferElements));
     b.resolved = gpu::TexelBuffer(context, resolvedWords * 4, vk::Format::eR32G32B32A32Uint, kStorage,
                                   "frame.resolved" + tag);
     b.hitBounds = gpu::Buffer(context, px * 2 * kVec4, kStorage, "frame.hit_bounds" + tag);
