@@ -99,7 +99,7 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
                            .spareLightSlots = settings.spareLightSlots,
                            .keptRaySamples = keptRaySamples(context, settings, runSpecular_),
                            .keptShadowRays = keptShadowRays(settings)},
-             settings.maxBufferBytes),
+             settings.maxBufferBytes, settings.maxTexelElements),
       sceneKernels_(sceneBuffers_.specialisation()),
       primary_(context, frame_.layout().bandCount(), sceneKernels_, settings.editableGeometry),
       shadow_(context, shadingKernels()),

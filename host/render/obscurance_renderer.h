@@ -86,6 +86,7 @@ struct ObscuranceSettings {
   // specular.comp, raysAtVertex); false: N_s and N_obs at every vertex, as at a primary hit.
   bool vertexRaysByThroughput = true;
   std::uint64_t maxBufferBytes = 0;  // per-buffer limit for frame bands; 0 = the device's
+  std::uint64_t maxTexelElements = 0; // per texel view (maxTexelBufferElements); 0 = the device's
   // What the frame keeps (only what is asked for is allocated): the primary pass's AOVs (albedo,
   // normal, depth, ...), and all composed AOVs or `combined` alone.
   bool primaryAovs = true;

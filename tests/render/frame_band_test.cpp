@@ -91,6 +91,42 @@ TEST_F(FrameBands, BandedFrameIsBitIdenticalToTheWholeFrame) {
   EXPECT_TRUE(bitIdentical(whole.image, banded.image(), &where)) << where;
 }
 
+// Every band's texel views within `maxTexels`: its G-buffer (kTexelsPerGBuffer a pixel) and its
+// resolved transport (a word per light slot and pixel, plus A_t, rows padded to whole texels).
+void expectTexelViewsWithin(const render::ObscuranceFrame& frame, std::uint64_t maxTexels) {
+  const auto& layout = frame.layout();
+  for (std::size_t i = 0; i < layout.bands.size(); ++i) {
+    const std::uint64_t px = layout.bandPixels(i);
+    EXPECT_LE(px * gpu::kTexelsPerGBuffer, maxTexels) << "band " << i;
+    const std::uint64_t resolvedWords =
+        std::uint64_t(gpu::resolvedStride(static_cast<std::uint32_t>(px))) * (frame.lightCapacity() + 1);
+    EXPECT_LE(resolvedWords / 4, maxTexels) << "band " << i;
+  }
+}
+
+TEST_F(FrameBands, AFrameSplitByItsTexelViewLimitIsBitIdenticalToTheWholeFrame) {
+  auto settings = cornellSettings(48, 40);
+  const auto whole = renderObscurances(context(), cornell_, cornellBvh_, settings);
+  // The G-buffer's 4 texels a pixel bind: 9 rows of 48 pixels a band, 5 bands.
+  const std::uint64_t byGBuffer = 48ull * gpu::kTexelsPerGBuffer * 9;
+  settings.maxTexelElements = byGBuffer;
+  render::ObscuranceRenderer gbufferBound(context(), cornell_, cornellBvh_, settings);
+  EXPECT_EQ(gbufferBound.layout().bandCount(), 5u);
+  expectTexelViewsWithin(gbufferBound.frame(), byGBuffer);
+  gbufferBound.render();
+  std::string where;
+  EXPECT_TRUE(bitIdentical(whole.image, gbufferBound.image(), &where)) << where;
+  // With 31 light slots (spares for lights added later) the resolved transport binds instead:
+  // 1728 texels hold 6912 words, 216 a slot, so 212 pixels (4 rows) a band after the padding.
+  settings.spareLightSlots = 30;
+  render::ObscuranceRenderer resolvedBound(context(), cornell_, cornellBvh_, settings);
+  ASSERT_EQ(resolvedBound.frame().lightCapacity(), 31u);
+  EXPECT_EQ(resolvedBound.layout().bandCount(), 10u);
+  expectTexelViewsWithin(resolvedBound.frame(), byGBuffer);
+  resolvedBound.render();
+  EXPECT_TRUE(bitIdentical(whole.image, resolvedBound.image(), &where)) << where;
+}
+
 TEST_F(FrameBands, BandedGlossyFrameIsBitIdenticalToTheWholeFrame) {
   // Specular paths read pixel indices from a per-band queue.
   SceneBuilder b;

@@ -60,7 +60,8 @@ std::uint64_t ObscuranceFrame::bytesNeeded(std::uint32_t width, std::uint32_t he
 }
 
 ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t width, std::uint32_t height,
-                                 std::uint32_t lights, const FrameContents& contents, std::uint64_t maxBufferBytes)
+                                 std::uint32_t lights, const FrameContents& contents, std::uint64_t maxBufferBytes,
+                                 std::uint64_t maxTexelElements)
     : context_(&context), lights_(lights), maxLights_(lights + contents.spareLightSlots), contents_(contents) {
   const bool specular = contents.specular;
   const std::uint64_t limit = maxBufferBytes > 0 ? maxBufferBytes : context.info().maxStorageBufferRange;
@@ -71,7 +72,8 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
   // (kTexelsPerGBuffer a pixel, read by the shading passes) and the resolved transport (a word per
   // light and pixel, each light's row padded to whole texels, resolvedStride). That bounds a band's
   // pixels too, as a byte limit of the largest buffer.
-  const std::uint64_t maxTexels = context.info().maxTexelBufferElements;
+  const std::uint64_t maxTexels = maxTexelElements > 0 ? std::min<std::uint64_t>(maxTexelElements, context.info().maxTexelBufferElements)
+                                                       : context.info().maxTexelBufferElements;
   const std::uint64_t byGBuffer = maxTexels / gpu::kTexelsPerGBuffer;
   const std::uint64_t resolvedRowWords = 4 * maxTexels / (std::uint64_t(maxLights_) + 1);
   const std::uint64_t byResolved = resolvedRowWords > gpu::kResolvedPixelAlign ? resolvedRowWords - gpu::kResolvedPixelAlign : 1;

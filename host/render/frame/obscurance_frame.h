@@ -70,9 +70,11 @@ public:
     gpu::Buffer shadowRays;   // per kept sample and pixel, the shadow rays at its primary hit and path vertices
   };
 
-  // `maxBufferBytes` 0 = the device's per-buffer limit (a smaller one tests banding).
+  // `maxBufferBytes` 0 = the device's per-buffer limit, `maxTexelElements` 0 = its per-texel-view
+  // limit (smaller ones test banding).
   ObscuranceFrame(const gpu::Context& context, std::uint32_t width, std::uint32_t height, std::uint32_t lights,
-                  const FrameContents& contents, std::uint64_t maxBufferBytes = 0);
+                  const FrameContents& contents, std::uint64_t maxBufferBytes = 0,
+                  std::uint64_t maxTexelElements = 0);
 
   // The buffer kinds a frame allocates, from which both the allocation and the memory figures
   // are computed.
