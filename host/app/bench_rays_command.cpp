@@ -54,6 +54,7 @@ struct BenchOptions {
   std::string traceShape;          // WxR: trace.comp's workgroup size and rays per invocation
   std::optional<std::uint32_t> stackRegisters; // the kernel's compact-stack registers (0: the general kernel)
   std::string bvhItems = "texel";              // how trace.comp reads the BVH: "texel" view or "storage" buffer
+  float spatialSplits = 0.0f;                  // the tree built with spatial splits (bvh::BuildOptions::spatialSplitBudget)
   render::ObscuranceFrameWork frameWork; // its spp, rays per hit, dmax, seed
   DeviceOptions device;
 };
@@ -85,6 +86,12 @@ render::TraceShape parseTraceShape(const std::string& text, const gpu::Context& 
   return {w, r};
 }
 
+bvh::BuildOptions treeOptions(const BenchOptions& o) {
+  bvh::BuildOptions options;
+  options.spatialSplitBudget = o.spatialSplits;
+  return options;
+}
+
 // Applies --move to the loaded scene and updates its BVH by refit or rebuild (traversal cost
 // after an edit: a refit keeps the old topology, docs/BENCHMARKS.md).
 void applyMove(const BenchOptions& o, LoadedScene& loaded) {
@@ -95,7 +102,7 @@ void applyMove(const BenchOptions& o, LoadedScene& loaded) {
   const std::size_t object = scene::objectIndex(loaded.scene, o.move.substr(0, eq), "--move");
   scene::moveObject(loaded.scene, object, d, glm::vec3(0.0f));
   if (o.refit) bvh::refit(loaded.bvh, render::triangleSoup(loaded.scene));
-  else loaded.bvh = bvh::build(render::triangleSoup(loaded.scene));
+  else loaded.bvh = bvh::build(render::triangleSoup(loaded.scene), treeOptions(o));
 }
 
 struct SetResult {
@@ -351,6 +358,7 @@ void runBench(const BenchOptions& o) {
   if (!(std::isfinite(o.frameWork.dMax) && o.frameWork.dMax > 0.0f))
     throw InputError(fmt::format("--frame-dmax {}: must be a finite positive distance in scene units", o.frameWork.dMax));
   LoadedScene loaded = loadScene(o.scenePath);
+  if (o.spatialSplits > 0.0f) loaded.bvh = bvh::build(render::triangleSoup(loaded.scene), treeOptions(o));
   if (!o.move.empty()) applyMove(o, loaded);
   gpu::Context context(o.device.contextOptions());
   if (!o.json) fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
@@ -537,6 +545,10 @@ void addBenchRaysCommand(CLI::App& app) {
                   "how trace.comp reads the BVH's nodes and triangles: through the texel view the passes use "
                   "(texel, the default) or from the same buffer bound as an SSBO (storage)")
       ->check(CLI::IsMember({"texel", "storage"}));
+  cmd->add_option("--spatial-splits", o->spatialSplits,
+                  "SHARE: build the BVH with spatial splits (SBVH), adding at most this share of the triangle "
+                  "count as clipped references (default 0: none, as the renderer builds)")
+      ->check(CLI::Range(0.0f, 4.0f));
   cmd->add_option("--frame-spp", o->frameWork.spp, "--frame: samples per pixel")->check(CLI::Range(1u, 1024u));
   cmd->add_option("--frame-rays", o->frameWork.obscuranceRays, "--frame: obscurance rays per hit")
       ->check(CLI::Range(1u, 256u));

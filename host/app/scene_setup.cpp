@@ -47,6 +47,8 @@ nlohmann::json sceneJson(const LoadedScene& loaded) {
             {"sah_cost", b.sahCost},
             {"wide_sah_cost", b.wideSahCost},
             {"median_fallbacks", b.medianFallbacks},
+            {"spatial_splits", b.spatialSplits},
+            {"triangle_references", b.references},
             {"bytes", loaded.bvh.nodes.size() * sizeof(gpu::BvhNode) +
                           loaded.bvh.triangles.size() * sizeof(gpu::BvhTriangle)}}}};
 }
@@ -54,12 +56,15 @@ nlohmann::json sceneJson(const LoadedScene& loaded) {
 std::string sceneSummary(const LoadedScene& loaded) {
   const auto& s = loaded.scene;
   const auto& b = loaded.bvh.stats;
+  const std::string spatial = b.spatialSplits == 0 ? std::string()
+                                                   : fmt::format(", {} spatial splits storing {} triangle references",
+                                                                 b.spatialSplits, b.references);
   return fmt::format("scene: {} triangles ({} degenerate dropped), {} materials, {} textures, {} light "
                      "groups, {} punctual lights; loaded in {:.3f} s\n"
-                     "bvh: built in {:.3f} s, {} nodes, {} leaves, depth {}, SAH cost {:.2f} (binary), {:.2f} (8-wide)",
+                     "bvh: built in {:.3f} s, {} nodes, {} leaves, depth {}, SAH cost {:.2f} (binary), {:.2f} (8-wide){}",
                      s.triangles.size(), s.stats.degenerateTrianglesDropped, s.materials.size(),
                      s.textures.size(), s.lightGroups.size(), s.punctualLights.size(), loaded.loadSeconds,
-                     b.buildSeconds, b.nodeCount, b.leafCount, b.maxDepth, b.sahCost, b.wideSahCost);
+                     b.buildSeconds, b.nodeCount, b.leafCount, b.maxDepth, b.sahCost, b.wideSahCost, spatial);
 }
 
 } // namespace obscura::app

@@ -8,8 +8,10 @@
 // Shape of the code, top to bottom:
 //   1. PrimRef per triangle (box, centroid), in parallel.
 //   2. buildRange(): per node, decide leaf / SAH split / median split (depth bound) / index split
-//      (no valid SAH split), partition the refs, recurse; big subtrees run on their own thread.
-//      Nodes go into a scratch array at indices that depend only on the range (no locks).
+//      (no valid SAH split), or, with BuildOptions::spatialSplitBudget, a spatial split that clips
+//      the triangles crossing its plane (SBVH); partition the refs, recurse; big subtrees run on
+//      their own thread. Nodes go into a scratch array at indices that depend only on the range
+//      and the room it owns for clipped references (no locks, the same tree on any thread count).
 //   3. writeWide(): collapse into 8-wide compressed nodes (gpu::BvhNode, wide_node.h) by the
 //      SAH-optimal programme of wide_collapse.h, the triangles in the order the wide leaves need
 //      them, and the statistics.
@@ -136,11 +138,19 @@ public:
     } else {
       Aabb box, centroids;
       makeRefs(box, centroids);
-      nodes_.resize(2 * static_cast<std::size_t>(n) - 1);
-      buildRange(0, 0, n, 0, box, centroids, 0);
+      // Room for the references spatial splits add (SBVH): the root range owns them all.
+      const double extraShare = std::clamp(double{options_.spatialSplitBudget}, 0.0, 4.0);
+      const auto extra = static_cast<std::uint32_t>(
+          std::min<double>(extraShare * n, double{0x1FFFFFFFu} - n));
+      refs_.resize(std::size_t{n} + extra);
+      nodes_.resize(2 * (std::size_t{n} + extra) - 1);
+      rootArea_ = box.area();
+      buildRange(0, 0, n, extra, 0, box, centroids, 0);
       writeWide(bvh);
     }
     bvh.stats.medianFallbacks = medianFallbacks_.load();
+    bvh.stats.spatialSplits = spatialSplits_.load();
+    bvh.stats.references = static_cast<std::uint32_t>(bvh.triangles.size());
     bvh.stats.buildSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
@@ -193,17 +203,22 @@ private:
     }
   }
 
-  // ---- 2. Recursive build of refs [begin, end) into scratch node `slot`.
+  // ---- 2. Recursive build of the `count` refs at refs_[begin, begin + count) into scratch node
+  // `slot`.
   //
   // `depth` is the depth of the leaves this range would produce if it became a leaf now: the
   // number of GPU interior nodes above it (the root range is 0, but a root leaf still gets a root
-  // node above it, so it ends up at depth 1). Scratch slots: a range of n refs owns 2n - 1 slots
-  // starting at `slot`; its left child of nl refs gets slot + 1, its right child slot + 2 nl.
-  void buildRange(std::uint32_t slot, std::uint32_t begin, std::uint32_t end, std::uint32_t depth,
-                  const Aabb& box, const Aabb& centroids, unsigned taskDepth) {
+  // node above it, so it ends up at depth 1). A range owns the refs_ entries
+  // [begin, begin + count + extra): `extra` is room for the references its spatial splits may
+  // add, shared between its children in proportion to their refs (so the tree does not depend
+  // on which thread splits first). Scratch slots: a range owning m = count + extra entries owns
+  // 2m - 1 slots from `slot`; its left child, owning ml, gets slot + 1, its right slot + 2 ml.
+  // Without spatial splits extra is 0 everywhere and the children are the two halves in place.
+  void buildRange(std::uint32_t slot, std::uint32_t begin, std::uint32_t count, std::uint32_t extra,
+                  std::uint32_t depth, const Aabb& box, const Aabb& centroids, unsigned taskDepth) {
     TempNode& node = nodes_[slot];
     node.box = box;
-    const std::uint32_t count = end - begin;
+    const std::uint32_t end = begin + count;
 
     auto makeLeaf = [&] {
       node.first = begin;
@@ -214,55 +229,276 @@ private:
     // Depth guarantee. A SAH split may peel off a single triangle, leaving count - 1 refs one
     // level down; it is allowed only while the median splits could still finish that worst
     // case within kBvhMaxDepth. Otherwise split at the median (or make a leaf if it fits).
+    // A spatial split keeps each side below count refs too.
     const bool sahAllowed = depth + 1 + medianLevels(count - 1, maxLeaf_) <= gpu::kBvhMaxDepth;
 
-    std::uint32_t mid = 0;
+    std::uint32_t leftCount = 0;
+    std::uint32_t leftExtra = 0;
     Aabb leftBox, rightBox, leftCentroids, rightCentroids;
     if (!sahAllowed) {
       if (count <= maxLeaf_) return makeLeaf();
       ++medianFallbacks_;
-      mid = medianSplit(begin, end, centroids);
-      bounds(begin, mid, leftBox, leftCentroids);
-      bounds(mid, end, rightBox, rightCentroids);
+      leftCount = medianSplit(begin, end, centroids) - begin;
+      bounds(begin, begin + leftCount, leftBox, leftCentroids);
+      bounds(begin + leftCount, end, rightBox, rightCentroids);
     } else {
       // Bin, sweep, and compare the best split with a leaf.
       const Binning binning = makeBinning(centroids, count);
       const SplitChoice split = binning.axis >= 0 ? bestSplit(begin, end, binning, box)
                                                   : SplitChoice{};
+      // A spatial split is tried where the object split's children overlap (Stich et al. 2009,
+      // §4.3: overlap area > alpha * root area), and taken where the SAH says it is cheaper.
+      SpatialChoice spatial;
+      if (extra > 0 && (!split.valid || overlapArea(split.leftBox, split.rightBox) >
+                                            options_.spatialSplitOverlap * rootArea_))
+        spatial = bestSpatialSplit(begin, count, extra, box);
+      const float bestCost = std::min(split.valid ? split.cost : kInf, spatial.valid ? spatial.cost : kInf);
       const float leafCost = options_.intersectionCost * static_cast<float>(count) * box.area();
-      if (count <= binaryLeaf_ && (!split.valid || leafCost <= split.cost)) return makeLeaf();
+      if (count <= binaryLeaf_ && (bestCost == kInf || leafCost <= bestCost)) return makeLeaf();
 
+      if (spatial.valid && spatial.cost < (split.valid ? split.cost : kInf)) {
+        std::vector<PrimRef> left, right;
+        spatialPartition(begin, count, spatial, left, right);
+        // Unsplitting may have emptied a side; then the object split (or the index split) does.
+        if (!left.empty() && !right.empty() && left.size() < count && right.size() < count) {
+          ++spatialSplits_;
+          leftCount = static_cast<std::uint32_t>(left.size());
+          const auto rightCount = static_cast<std::uint32_t>(right.size());
+          const std::uint32_t room = extra - (leftCount + rightCount - count); // for the children's splits
+          leftExtra = static_cast<std::uint32_t>(std::uint64_t{room} * leftCount / (leftCount + rightCount));
+          const std::uint32_t rightBegin = begin + leftCount + leftExtra;
+          std::copy(left.begin(), left.end(), refs_.begin() + begin);
+          std::copy(right.begin(), right.end(), refs_.begin() + rightBegin);
+          bounds(begin, begin + leftCount, leftBox, leftCentroids);
+          bounds(rightBegin, rightBegin + rightCount, rightBox, rightCentroids);
+          return buildChildren(slot, begin, leftCount, leftExtra, rightCount, room - leftExtra, depth,
+                               leftBox, leftCentroids, rightBox, rightCentroids, taskDepth);
+        }
+      }
       if (split.valid) {
-        mid = partition(begin, end, binning, split, leftCentroids, rightCentroids);
+        leftCount = partition(begin, end, binning, split, leftCentroids, rightCentroids) - begin;
         leftBox = split.leftBox;
         rightBox = split.rightBox;
       } else {
         // No SAH split exists (every centroid in one bin, e.g. all centroids equal): any
         // partition is as good as another, so cut the index range in the middle.
-        mid = begin + count / 2;
-        bounds(begin, mid, leftBox, leftCentroids);
-        bounds(mid, end, rightBox, rightCentroids);
+        leftCount = count / 2;
+        bounds(begin, begin + leftCount, leftBox, leftCentroids);
+        bounds(begin + leftCount, end, rightBox, rightCentroids);
       }
     }
+    // An object split: the right refs move up past the left child's share of the room.
+    const std::uint32_t rightCount = count - leftCount;
+    leftExtra = static_cast<std::uint32_t>(std::uint64_t{extra} * leftCount / count);
+    if (leftExtra > 0)
+      std::move_backward(refs_.begin() + begin + leftCount, refs_.begin() + end,
+                         refs_.begin() + end + leftExtra);
+    buildChildren(slot, begin, leftCount, leftExtra, rightCount, extra - leftExtra, depth, leftBox,
+                  leftCentroids, rightBox, rightCentroids, taskDepth);
+  }
 
+  // The two children of interior `slot`: the left owning refs_[begin, begin + leftCount +
+  // leftExtra), the right the rightCount + rightExtra entries after it.
+  void buildChildren(std::uint32_t slot, std::uint32_t begin, std::uint32_t leftCount, std::uint32_t leftExtra,
+                     std::uint32_t rightCount, std::uint32_t rightExtra, std::uint32_t depth,
+                     const Aabb& leftBox, const Aabb& leftCentroids, const Aabb& rightBox,
+                     const Aabb& rightCentroids, unsigned taskDepth) {
+    TempNode& node = nodes_[slot];
+    const std::uint32_t leftOwned = leftCount + leftExtra;
     const std::uint32_t leftSlot = slot + 1;
-    const std::uint32_t rightSlot = slot + 2 * (mid - begin);
+    const std::uint32_t rightSlot = slot + 2 * leftOwned;
+    const std::uint32_t rightBegin = begin + leftOwned;
     node.count = 0;
     node.child[0] = leftSlot;
     node.child[1] = rightSlot;
 
     // Subtrees: the right one on a new thread while the task tree is shallow and both are big.
-    const bool spawn = taskDepth < maxTaskDepth_ && mid - begin >= kParallelSubtreeMin &&
-                       end - mid >= kParallelSubtreeMin;
+    const bool spawn = taskDepth < maxTaskDepth_ && leftCount >= kParallelSubtreeMin &&
+                       rightCount >= kParallelSubtreeMin;
     if (spawn) {
-      auto right = std::async(std::launch::async, [&, rightSlot, mid, end, depth, taskDepth] {
-        buildRange(rightSlot, mid, end, depth + 1, rightBox, rightCentroids, taskDepth + 1);
+      auto right = std::async(std::launch::async, [&, rightSlot, rightBegin, rightCount, rightExtra, depth, taskDepth] {
+        buildRange(rightSlot, rightBegin, rightCount, rightExtra, depth + 1, rightBox, rightCentroids, taskDepth + 1);
       });
-      buildRange(leftSlot, begin, mid, depth + 1, leftBox, leftCentroids, taskDepth + 1);
+      buildRange(leftSlot, begin, leftCount, leftExtra, depth + 1, leftBox, leftCentroids, taskDepth + 1);
       right.get();
     } else {
-      buildRange(leftSlot, begin, mid, depth + 1, leftBox, leftCentroids, taskDepth);
-      buildRange(rightSlot, mid, end, depth + 1, rightBox, rightCentroids, taskDepth);
+      buildRange(leftSlot, begin, leftCount, leftExtra, depth + 1, leftBox, leftCentroids, taskDepth);
+      buildRange(rightSlot, rightBegin, rightCount, rightExtra, depth + 1, rightBox, rightCentroids, taskDepth);
+    }
+  }
+
+  static float overlapArea(const Aabb& a, const Aabb& b) {
+    Aabb both;
+    both.lo = glm::max(a.lo, b.lo);
+    both.hi = glm::min(a.hi, b.hi);
+    return both.area();
+  }
+
+  // ---- Spatial splits (Stich, Friedrich & Dietrich, "Spatial Splits in Bounding Volume
+  // Hierarchies", HPG 2009, §4): the node's box is cut into equal slabs along each axis; a
+  // reference spanning several slabs is clipped into each (the box of the part of its triangle
+  // inside the slab and inside its own, possibly already clipped, box), counted where it enters
+  // and where it leaves. The sweep prices every slab boundary as a split plane; a reference that
+  // straddles the chosen plane goes to both sides, clipped, or whole to one side where that is
+  // cheaper (reference unsplitting, §4.4).
+
+  // The box of the part of triangle `id` inside `box` on either side of the plane x_axis = pos.
+  void clipReference(std::uint32_t id, const Aabb& box, int axis, float pos, Aabb& left, Aabb& right) const {
+    const glm::vec3 v[3] = {soup_.v0[id], soup_.v1[id], soup_.v2[id]};
+    left = Aabb{};
+    right = Aabb{};
+    for (int i = 0; i < 3; ++i) {
+      const glm::vec3& a = v[i];
+      const glm::vec3& b = v[(i + 1) % 3];
+      if (a[axis] <= pos) left.grow(a);
+      if (a[axis] >= pos) right.grow(a);
+      if ((a[axis] < pos && b[axis] > pos) || (a[axis] > pos && b[axis] < pos)) {
+        // Where the edge crosses the plane, computed with a few ulps of error (of the larger
+        // end): padded by that, so that the piece's box holds the exact crossing (a clipped box
+        // must not lose a sliver of the triangle that a ray could hit).
+        const float t = (pos - a[axis]) / (b[axis] - a[axis]);
+        glm::vec3 p = a + (b - a) * std::clamp(t, 0.0f, 1.0f);
+        p[axis] = pos;
+        const glm::vec3 pad = 4.0f * std::numeric_limits<float>::epsilon() * glm::max(glm::abs(a), glm::abs(b)) +
+                              glm::vec3(std::numeric_limits<float>::denorm_min());
+        for (const glm::vec3& q : {p - pad, p + pad}) {
+          left.grow(q);
+          right.grow(q);
+        }
+      }
+    }
+    left.lo = glm::max(left.lo, box.lo);
+    left.hi = glm::min(left.hi, box.hi);
+    left.hi[axis] = std::min(left.hi[axis], pos);
+    right.lo = glm::max(right.lo, box.lo);
+    right.hi = glm::min(right.hi, box.hi);
+    right.lo[axis] = std::max(right.lo[axis], pos);
+  }
+  static bool empty(const Aabb& b) { return !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z); }
+
+  struct SpatialBin {
+    Aabb box;
+    std::uint32_t enter = 0, exit = 0;
+  };
+  struct SpatialSlabs {
+    float lo = 0.0f, width = 0.0f, scale = 0.0f;
+    int bins = 0;
+    int binOf(float x) const { return std::clamp(static_cast<int>((x - lo) * scale), 0, bins - 1); }
+    float plane(int bin) const { return lo + width * static_cast<float>(bin + 1); } // after `bin`
+  };
+  struct SpatialChoice {
+    bool valid = false;
+    int axis = 0;
+    int bin = 0; // the plane after this slab
+    float cost = kInf;
+    SpatialSlabs slabs;
+    Aabb leftBox, rightBox;
+    std::uint32_t leftCount = 0, rightCount = 0;
+  };
+
+  SpatialChoice bestSpatialSplit(std::uint32_t begin, std::uint32_t count, std::uint32_t extra, const Aabb& box) {
+    SpatialChoice best;
+    const int nb = std::min(bins_, static_cast<int>(count / 2 + 4));
+    std::vector<SpatialBin> bins(static_cast<std::size_t>(nb));
+    const float nodeCost = options_.traversalCost * box.area();
+    for (int a = 0; a < 3; ++a) {
+      SpatialSlabs slabs;
+      slabs.lo = box.lo[a];
+      slabs.bins = nb;
+      slabs.width = (box.hi[a] - box.lo[a]) / static_cast<float>(nb);
+      slabs.scale = 1.0f / slabs.width;
+      if (!(slabs.width > 0.0f) || !std::isfinite(slabs.scale)) continue;
+      std::fill(bins.begin(), bins.end(), SpatialBin{});
+      for (std::uint32_t i = begin; i < begin + count; ++i) {
+        const PrimRef& r = refs_[i];
+        const int first = slabs.binOf(r.box.lo[a]);
+        const int last = slabs.binOf(r.box.hi[a]);
+        ++bins[static_cast<std::size_t>(first)].enter;
+        ++bins[static_cast<std::size_t>(last)].exit;
+        Aabb rest = r.box;
+        for (int b = first; b < last; ++b) {
+          Aabb piece, after;
+          clipReference(r.id, rest, a, slabs.plane(b), piece, after);
+          bins[static_cast<std::size_t>(b)].box.grow(piece);
+          rest = after;
+        }
+        bins[static_cast<std::size_t>(last)].box.grow(rest);
+      }
+      std::array<float, kMaxBins> rightCost{};
+      std::array<std::uint32_t, kMaxBins> rightN{};
+      Aabb acc;
+      std::uint32_t n = 0;
+      for (int i = nb - 1; i > 0; --i) {
+        acc.grow(bins[static_cast<std::size_t>(i)].box);
+        n += bins[static_cast<std::size_t>(i)].exit;
+        rightN[static_cast<std::size_t>(i)] = n;
+        rightCost[static_cast<std::size_t>(i)] = acc.area() * static_cast<float>(n);
+      }
+      acc = Aabb{};
+      n = 0;
+      for (int i = 0; i < nb - 1; ++i) {
+        acc.grow(bins[static_cast<std::size_t>(i)].box);
+        n += bins[static_cast<std::size_t>(i)].enter;
+        const std::uint32_t nr = rightN[static_cast<std::size_t>(i + 1)];
+        if (n == 0 || nr == 0 || n >= count || nr >= count || n + nr - count > extra) continue;
+        const float cost = nodeCost + options_.intersectionCost * (acc.area() * static_cast<float>(n) +
+                                                                   rightCost[static_cast<std::size_t>(i + 1)]);
+        if (cost < best.cost) {
+          best = SpatialChoice{.valid = true, .axis = a, .bin = i, .cost = cost, .slabs = slabs,
+                               .leftCount = n, .rightCount = nr};
+          best.leftBox = acc;
+        }
+      }
+      if (best.valid && best.axis == a) {
+        best.rightBox = Aabb{};
+        for (int i = best.bin + 1; i < nb; ++i) best.rightBox.grow(bins[static_cast<std::size_t>(i)].box);
+      }
+    }
+    return best;
+  }
+
+  // The node's refs on either side of `split`'s plane, a straddling one clipped into both.
+  void spatialPartition(std::uint32_t begin, std::uint32_t count, const SpatialChoice& split,
+                        std::vector<PrimRef>& left, std::vector<PrimRef>& right) const {
+    const int a = split.axis;
+    const float pos = split.slabs.plane(split.bin);
+    left.reserve(split.leftCount);
+    right.reserve(split.rightCount);
+    Aabb leftBox = split.leftBox, rightBox = split.rightBox;
+    std::uint32_t nl = split.leftCount, nr = split.rightCount;
+    for (std::uint32_t i = begin; i < begin + count; ++i) {
+      const PrimRef& r = refs_[i];
+      const int first = split.slabs.binOf(r.box.lo[a]);
+      const int last = split.slabs.binOf(r.box.hi[a]);
+      if (last <= split.bin) {
+        left.push_back(r);
+        continue;
+      }
+      if (first > split.bin) {
+        right.push_back(r);
+        continue;
+      }
+      // Straddling. Reference unsplitting (§4.4): whole to one side where the SAH says so.
+      Aabb withLeft = leftBox, withRight = rightBox;
+      withLeft.grow(r.box);
+      withRight.grow(r.box);
+      const float both = leftBox.area() * static_cast<float>(nl) + rightBox.area() * static_cast<float>(nr);
+      const float toLeft = withLeft.area() * static_cast<float>(nl) + rightBox.area() * static_cast<float>(nr - 1);
+      const float toRight = leftBox.area() * static_cast<float>(nl - 1) + withRight.area() * static_cast<float>(nr);
+      Aabb l, rr;
+      clipReference(r.id, r.box, a, pos, l, rr);
+      if (empty(rr) || (toLeft < both && toLeft <= toRight)) {
+        left.push_back(r);
+        leftBox = withLeft;
+        --nr;
+      } else if (empty(l) || toRight < both) {
+        right.push_back(r);
+        rightBox = withRight;
+        --nl;
+      } else {
+        left.push_back(PrimRef{.box = l, .centroid = 0.5f * (l.lo + l.hi), .id = r.id});
+        right.push_back(PrimRef{.box = rr, .centroid = 0.5f * (rr.lo + rr.hi), .id = r.id});
+      }
     }
   }
 
@@ -428,7 +664,7 @@ private:
     if (root.count > 0) {
       // A one-leaf tree: a root whose only child is the leaf.
       std::array<WideChild, gpu::kBvhWidth> slots{};
-      slots[0] = leafChild(root.first, root.count, root.box, bvh);
+      slots[0] = leafChild(0, root.box, bvh);
       bvh.nodes.emplace_back();
       writeWideNode(bvh.nodes[0], slots, 0, 0);
       bvh.stats.leafCount = 1;
@@ -456,7 +692,7 @@ private:
         const CollapsedSlot& child = children[static_cast<std::size_t>(slotOf[s])];
         const TempNode& c = nodes_[child.node];
         if (child.leaf) {
-          slots[s] = leafChild(firstRef(child.node), subtreeTriangles(child.node), c.box, bvh);
+          slots[s] = leafChild(child.node, c.box, bvh);
           slots[s].triangleOffset = slots[s].triangleOffset - firstTriangle;
           ++bvh.stats.leafCount;
           bvh.stats.maxDepth = std::max(bvh.stats.maxDepth, depth[w] + 1);
@@ -491,31 +727,35 @@ private:
     return in;
   }
 
-  // A subtree's refs are one range (partition() keeps the left child's refs first): from its
-  // leftmost leaf's first ref, as many as it holds.
-  std::uint32_t firstRef(std::uint32_t slot) const {
-    while (nodes_[slot].count == 0) slot = nodes_[slot].child[0];
-    return nodes_[slot].first;
-  }
-  std::uint32_t subtreeTriangles(std::uint32_t slot) const {
-    const TempNode& t = nodes_[slot];
-    return t.count > 0 ? t.count : subtreeTriangles(t.child[0]) + subtreeTriangles(t.child[1]);
-  }
-
-  // Appends the triangles of refs [first, first + count) as one leaf; returns its slot
-  // (triangleOffset = absolute first index).
-  WideChild leafChild(std::uint32_t first, std::uint32_t count, const Aabb& box, Bvh& bvh) const {
+  // Appends the triangles of the binary subtree at `slot` as one leaf, each once (spatial splits
+  // may put two pieces of one triangle below it); returns its slot (triangleOffset = absolute
+  // first index). Leaves left to right, so without spatial splits the triangles keep the order
+  // of the refs.
+  WideChild leafChild(std::uint32_t slot, const Aabb& box, Bvh& bvh) const {
     WideChild c;
     c.kind = WideChild::Kind::Leaf;
     c.box = toBox(box);
     c.triangleOffset = static_cast<std::uint32_t>(bvh.triangles.size());
-    c.triangleCount = count;
-    for (std::uint32_t i = first; i < first + count; ++i) {
-      const std::uint32_t id = refs_[i].id;
-      bvh.order.push_back(id);
-      bvh.triangles.push_back({.v0 = gpu::vec4(soup_.v0[id], std::bit_cast<float>(id)),
-                               .v1 = gpu::vec4(soup_.v1[id], 0.0f),
-                               .v2 = gpu::vec4(soup_.v2[id], 0.0f)});
+    c.triangleCount = 0;
+    std::vector<std::uint32_t> todo = {slot};
+    while (!todo.empty()) {
+      const TempNode& t = nodes_[todo.back()];
+      todo.pop_back();
+      if (t.count == 0) {
+        todo.push_back(t.child[1]);
+        todo.push_back(t.child[0]);
+        continue;
+      }
+      for (std::uint32_t i = t.first; i < t.first + t.count; ++i) {
+        const std::uint32_t id = refs_[i].id;
+        const auto stored = bvh.order.end() - c.triangleCount;
+        if (std::find(stored, bvh.order.end(), id) != bvh.order.end()) continue;
+        ++c.triangleCount;
+        bvh.order.push_back(id);
+        bvh.triangles.push_back({.v0 = gpu::vec4(soup_.v0[id], std::bit_cast<float>(id)),
+                                 .v1 = gpu::vec4(soup_.v1[id], 0.0f),
+                                 .v2 = gpu::vec4(soup_.v2[id], 0.0f)});
+      }
     }
     return c;
   }
@@ -588,6 +828,7 @@ private:
   std::vector<PrimRef> refs_;
   std::vector<TempNode> nodes_;
   std::atomic<std::uint32_t> medianFallbacks_{0};
+  std::atomic<std::uint32_t> spatialSplits_{0};
 
   // writeWide() state
   double sah_ = 0.0;

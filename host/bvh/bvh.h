@@ -28,6 +28,15 @@ struct BuildOptions {
   // 13.1 -> 12.8 loop passes per closest-hit ray, docs/BENCHMARKS.md). <= maxLeafSize.
   std::uint32_t binaryLeafSize = 1;
   unsigned threads = 0;          // 0 = hardware concurrency
+  // Spatial splits (SBVH, Stich et al. 2009): extra references the build may add by clipping
+  // triangles at split planes, as a share of the triangle count; 0 = none (every triangle stored
+  // once). A triangle split this way is stored once in every leaf that holds a piece of it.
+  // Measured on lavapipe (docs/BENCHMARKS.md): fewer loop passes per ray, but not faster rays,
+  // so the renderer builds without them; `bench-rays --spatial-splits` measures a scene with them.
+  float spatialSplitBudget = 0.0f;
+  // A spatial split is tried at a node whose object split's children overlap by more than this
+  // share of the root's surface area (the paper's alpha).
+  float spatialSplitOverlap = 1e-5f;
 };
 
 struct BuildStats {
@@ -38,6 +47,8 @@ struct BuildStats {
   double sahCost = 0.0;          // SAH cost of the binary tree before collapsing (root area = 1)
   double wideSahCost = 0.0;      // SAH cost of the 8-wide tree, as the collapse minimised it
   std::uint32_t medianFallbacks = 0; // nodes split by median to honour the depth bound
+  std::uint32_t spatialSplits = 0;   // nodes split by a plane that clips triangles
+  std::uint32_t references = 0;      // triangles stored in the leaves (> triangles with spatial splits)
 };
 
 // Input: one entry per triangle, its three world-space vertices.

@@ -71,9 +71,12 @@ void expectAgreement(const Comparison& c, const char* what) {
 class GpuTraversal : public GpuTest {
 protected:
   Comparison traceAndCompare(const scene::Scene& scene, std::size_t count, std::uint64_t seed,
-                             std::optional<render::TraceShape> shape = {}) {
+                             std::optional<render::TraceShape> shape = {}, const bvh::BuildOptions& options = {}) {
     bvh::TriangleSoup soup = render::triangleSoup(scene);
-    bvh::Bvh tree = bvh::build(soup);
+    bvh::Bvh tree = bvh::build(soup, options);
+    if (options.spatialSplitBudget > 0.0f) {
+      EXPECT_GT(tree.stats.spatialSplits, 0u);
+    }
     render::SceneBuffers buffers(context(), scene, tree);
     render::RayTracer tracer(context(), buffers, shape);
     auto rays = render::closestBenchRays(scene.bounds, count, seed);
@@ -103,6 +106,22 @@ TEST_F(GpuTraversal, RandomSoupsMatchBruteForce) {
     scene::Scene s = soupScene(randomSoup(seed == 1 ? 3000 : 500, seed));
     expectAgreement(traceAndCompare(s, 100000, seed), "random soup");
   }
+}
+
+// A tree with spatial splits: triangles clipped into several leaves, each stored once per leaf.
+// Long slivers crossing the soup make the builder use them.
+TEST_F(GpuTraversal, TreeWithSpatialSplitsMatchesBruteForce) {
+  bvh::TriangleSoup soup = randomSoup(2000, 3);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> pos(-10.0f, 10.0f);
+  for (std::size_t i = 0; i < soup.size(); i += 8) {
+    const glm::vec3 far(pos(rng), pos(rng), pos(rng));
+    soup.v1[i] = far;
+    soup.v2[i] = far + 0.02f * (soup.v0[i] - far);
+  }
+  bvh::BuildOptions options;
+  options.spatialSplitBudget = 0.3f;
+  expectAgreement(traceAndCompare(soupScene(soup), 100000, 3, {}, options), "spatial splits");
 }
 
 TEST_F(GpuTraversal, CornellBoxMatchesBruteForce) {
