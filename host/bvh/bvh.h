@@ -31,8 +31,9 @@ struct BuildOptions {
   // Spatial splits (SBVH, Stich et al. 2009): extra references the build may add by clipping
   // triangles at split planes, as a share of the triangle count; 0 = none (every triangle stored
   // once). A triangle split this way is stored once in every leaf that holds a piece of it.
-  // Measured on lavapipe (docs/BENCHMARKS.md): fewer loop passes per ray, but not faster rays,
-  // so the renderer builds without them; `bench-rays --spatial-splits` measures a scene with them.
+  // Measured on lavapipe (docs/BENCHMARKS.md): fewer loop passes per ray, but faster closest-hit
+  // rays on Sponza only where lavapipe's threads flush subnormals, and slower shadow rays, so the
+  // renderer builds without them; `bench-rays --spatial-splits` measures a scene with them.
   float spatialSplitBudget = 0.0f;
   // A spatial split is tried at a node whose object split's children overlap by more than this
   // share of the root's surface area (the paper's alpha).
