@@ -84,7 +84,6 @@ struct PathState {
   uint rng;       // what is gathered
   vec3 pathLo;    // the box of the path's vertices (dirty.comp)
   vec3 pathHi;
-  uint lightSamples; // the light samples drawn at the vertex the next lobe ray leaves (its MIS)
   bool escaped;   // a ray of the path left the scene
   bool truncated; // a traversal of the path ran out of loop passes
   uint pixel;     // band-local
@@ -144,7 +143,6 @@ PathState startPath(SpecularConstants c, uint pixel) {
   path.rng = rngSeed(bp.frame, pc.frame.z, pc.frame.w ^ 0x6c8e9cf5u);
   path.pathLo = path.sp.position;
   path.pathHi = path.sp.position;
-  path.lightSamples = c.shadowRays; // shadow.comp's at the primary hit
   path.escaped = false;
   path.truncated = false;
   path.pixel = pixel;
@@ -165,8 +163,10 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
   if (wo.z <= 0.0 || !sampleSpecularLobe(sp, wo, vec2(rngNext(path.pathRng), rngNext(path.pathRng)), wiLocal, weight, delta)) return false;
   vec3 wi = toWorld(wiLocal, t, b, sp.ns);
   if (dot(wi, sp.ng) <= 0.0) return false; // below the geometric surface: no leaks
-  // What MIS needs of the vertex the lobe sample leaves (its light samples' density).
+  // What MIS needs of the vertex the lobe sample leaves: its lobe's density, and how many light
+  // samples it drew (as many as its throughput gave it, below; shadow.comp's at the primary hit).
   float lobePdf = delta ? 0.0 : ggxReflectionPdf(wo, wiLocal, ggxAlpha(sp.roughness));
+  const float vertexLightSamples = float(raysAtVertex(c, c.shadowRays, path.throughput));
   vec3 previous = sp.position, previousNormal = sp.ng;
   path.throughput *= weight;
   const vec3 throughput = path.throughput;
@@ -188,7 +188,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
     uint sky = findBackgroundLight(c.lightCount);
     if ((c.oneLight && sky != c.addedLight) || c.noDirect) sky = kInvalidIndex;
     if (!kProbe && h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || (c.glossyMis && !c.oneLight))) { // a miss, not a truncation
-      float w = delta ? 1.0 : powerHeuristic(lobePdf, float(path.lightSamples) * backgroundLightPdf(sky, previous, previousNormal, c.lightCount, wi));
+      float w = delta ? 1.0 : powerHeuristic(lobePdf, vertexLightSamples * backgroundLightPdf(sky, previous, previousNormal, c.lightCount, wi));
       OBS_ACCUMULATE(specularBasis, sky * c.pixelCount + pixel, vec4(w * throughput, 0.0))
     }
     return false;
@@ -203,7 +203,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
     float w = 1.0;
     if (!delta) {
       float lightPdf = emitterHitLightPdf(s.lightGroup, previous, previousNormal, c.lightCount, h, s.position, wi);
-      w = powerHeuristic(lobePdf, float(path.lightSamples) * lightPdf);
+      w = powerHeuristic(lobePdf, vertexLightSamples * lightPdf);
     }
     // Seen emission in unit-emission terms: divided by the group's E_s (1 where E_s is 0).
     vec3 unit = unitEmission(materialEmission(m, s.uv, s.frontFacing), lightScales[s.lightGroup].rgb);
@@ -216,7 +216,6 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
   // A metal vertex reflects none of the ambient (R(P) = 0, lib/shade.glsl): no obscurance ray.
   const bool reflectsAmbient = any(greaterThan(obscuranceReflectance(sp), vec3(0.0)));
   const uint obscuranceRays = reflectsAmbient ? raysAtVertex(c, pc.counts.z, throughput) : 0u;
-  path.lightSamples = shadowRays;
   // MIS only where a lobe sample follows from this vertex (the path goes on past it).
   float misSamples = c.glossyMis && depth + 1u < c.maxDepth ? float(shadowRays) : 0.0;
   const vec4 lightShift = rngNext4(path.rng); // this vertex's light samples: one shifted low-discrepancy set
@@ -267,7 +266,7 @@ void finishPath(SpecularConstants c, PathState path) {
 // shading point's material parameters are read again, as shadingPoint reads them).
 void storePath(PathState path) {
   const uint at = kSpecularPathTexels * path.pixel;
-  const uint flags = (path.escaped ? 1u : 0u) | (path.truncated ? 2u : 0u) | (path.lightSamples << 2u);
+  const uint flags = (path.escaped ? 1u : 0u) | (path.truncated ? 2u : 0u);
   specularPaths[at] = vec4(path.sp.position, path.throughput.x);
   specularPaths[at + 1u] = vec4(path.sp.ng, path.throughput.y);
   specularPaths[at + 2u] = vec4(path.sp.ns, path.throughput.z);
@@ -291,7 +290,6 @@ PathState loadPath(uint pixel) {
   path.pathHi = t6.xyz;
   path.escaped = (flags & 1u) != 0u;
   path.truncated = (flags & 2u) != 0u;
-  path.lightSamples = flags >> 2u;
   path.pixel = pixel;
   return path;
 }
