@@ -242,6 +242,9 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
     throw std::logic_error("ObscuranceRenderer::configure: resolution and AOVs are the frame's; make a new renderer");
   if (settings.ambient != settings_.ambient)
     throw std::logic_error("ObscuranceRenderer::configure: the ambient model is the scene's; make a new renderer");
+  if (settings.editableGeometry != settings_.editableGeometry)
+    throw std::logic_error("ObscuranceRenderer::configure: whether the scene may be edited is fixed when the renderer "
+                           "is made (its primary pass's kernels); make a new renderer");
   if (settings.secondaryReflectors > 0.0f && settings.shadowSampling == ShadowSampling::PerLight)
     throw InputError("secondary reflectors choose among all lights by importance, which per-light shadow sampling "
                      "(each light's transport independent of the others' power) does not allow");
@@ -251,9 +254,7 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
                            "renderer with them or with the Reached ambient model");
   const bool remark = settings.secondaryReflectors != settings_.secondaryReflectors;
   const SeenView fittedTo = seenView();
-  const bool editableGeometry = settings_.editableGeometry; // the primary pass's kernels are made for it
   settings_ = settings;
-  settings_.editableGeometry = editableGeometry;
   if (remark) markReflectors();
   dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax_;
   const bool depthChanged = ambient_.depth != (reached_ ? settings.maxDepth : 0u);

@@ -146,8 +146,9 @@ public:
   ObscuranceRenderer(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
                      const ObscuranceSettings& settings);
 
-  // New per-sample parameters (rays, rho, dmax, sampling, seed, camera, spp); the resolution
-  // must stay. Restarts the accumulation.
+  // New per-sample parameters (rays, rho, dmax, sampling, seed, camera, spp); what the renderer
+  // was made for must stay (resolution, AOVs, ambient model, editableGeometry: a logic_error).
+  // Restarts the accumulation.
   void configure(const ObscuranceSettings& settings);
   // Forgets every sample (the next iterate starts at sample 0) and the ray counters.
   void reset();

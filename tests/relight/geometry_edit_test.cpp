@@ -158,9 +158,10 @@ TEST_F(GeometryEdit, ARendererMadeWithoutHitBoundsRendersTheSameFrameAndRefusesA
   EXPECT_EQ(differ, 0u);
   const std::vector<scene::Bounds> changed = {objectBox({0.3f, 0.8f, 0.0f}, 0.5f)};
   EXPECT_THROW(renderOnly.updateGeometry(room, tree, changed), std::logic_error);
-  // configure() keeps what the renderer was made for.
+  // Whether the scene may be edited is the renderer's, like its resolution: configure() refuses
+  // to change it, and the renderer stays as it was made.
   settings.editableGeometry = true;
-  renderOnly.configure(settings);
+  EXPECT_THROW(renderOnly.configure(settings), std::logic_error);
   EXPECT_THROW(renderOnly.updateGeometry(room, tree, changed), std::logic_error);
 }
 
