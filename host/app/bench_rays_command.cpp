@@ -357,8 +357,7 @@ void runBench(const BenchOptions& o) {
   for (const auto& f : o.frames) frameSizes.push_back(parseSize(f, "--frame"));
   if (!(std::isfinite(o.frameWork.dMax) && o.frameWork.dMax > 0.0f))
     throw InputError(fmt::format("--frame-dmax {}: must be a finite positive distance in scene units", o.frameWork.dMax));
-  LoadedScene loaded = loadScene(o.scenePath);
-  if (o.spatialSplits > 0.0f) loaded.bvh = bvh::build(render::triangleSoup(loaded.scene), treeOptions(o));
+  LoadedScene loaded = loadScene(o.scenePath, "node", treeOptions(o));
   if (!o.move.empty()) applyMove(o, loaded);
   gpu::Context context(o.device.contextOptions());
   if (!o.json) fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);

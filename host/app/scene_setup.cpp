@@ -11,7 +11,7 @@
 
 namespace obscura::app {
 
-LoadedScene loadScene(const std::string& path, const std::string& lightGroups) {
+LoadedScene loadScene(const std::string& path, const std::string& lightGroups, const bvh::BuildOptions& tree) {
   LoadedScene loaded;
   auto start = std::chrono::steady_clock::now();
   loaded.scene = scene::loadGltf(path);
@@ -20,7 +20,7 @@ LoadedScene loadScene(const std::string& path, const std::string& lightGroups) {
   scene::makeLightNamesUnique(loaded.scene);
   scene::makeObjectNamesUnique(loaded.scene);
   loaded.loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  loaded.bvh = bvh::build(render::triangleSoup(loaded.scene));
+  loaded.bvh = bvh::build(render::triangleSoup(loaded.scene), tree);
   return loaded;
 }
 

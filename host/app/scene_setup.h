@@ -17,7 +17,9 @@ struct LoadedScene {
 
 // `lightGroups`: "node" (one light per emissive mesh node, the default), "material" (one per
 // emissive material) or a JSON file of groups (scene/light_groups.h). Light names are made unique.
-LoadedScene loadScene(const std::string& path, const std::string& lightGroups = "node");
+// `tree`: how the BVH is built (the renderer's default; bench-rays may ask for spatial splits).
+LoadedScene loadScene(const std::string& path, const std::string& lightGroups = "node",
+                      const bvh::BuildOptions& tree = {});
 
 // Scene statistics and BVH figures for the metrics JSON.
 nlohmann::json sceneJson(const LoadedScene& loaded);

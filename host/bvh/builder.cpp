@@ -48,6 +48,7 @@ struct Aabb {
     lo = glm::min(lo, b.lo);
     hi = glm::max(hi, b.hi);
   }
+  bool empty() const { return !(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z); }
   // Surface area; 0 for an empty (inverted) box. Flat boxes keep their non-zero area.
   float area() const {
     const glm::vec3 d = hi - lo;
@@ -374,7 +375,6 @@ private:
     right.hi = glm::min(right.hi, box.hi);
     right.lo[axis] = std::max(right.lo[axis], pos);
   }
-  static bool empty(const Aabb& b) { return !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z); }
 
   struct SpatialBin {
     Aabb box;
@@ -487,11 +487,11 @@ private:
       const float toRight = leftBox.area() * static_cast<float>(nl - 1) + withRight.area() * static_cast<float>(nr);
       Aabb l, rr;
       clipReference(r.id, r.box, a, pos, l, rr);
-      if (empty(rr) || (toLeft < both && toLeft <= toRight)) {
+      if (rr.empty() || (toLeft < both && toLeft <= toRight)) {
         left.push_back(r);
         leftBox = withLeft;
         --nr;
-      } else if (empty(l) || toRight < both) {
+      } else if (l.empty() || toRight < both) {
         right.push_back(r);
         rightBox = withRight;
         --nl;
@@ -657,7 +657,6 @@ private:
   // need them.
   void writeWide(Bvh& bvh) {
     const TempNode& root = nodes_[0];
-    rootArea_ = root.box.area();
     sah_ = 0.0;
     bvh.triangles.reserve(refs_.size());
     bvh.order.reserve(refs_.size());
@@ -829,10 +828,11 @@ private:
   std::vector<TempNode> nodes_;
   std::atomic<std::uint32_t> medianFallbacks_{0};
   std::atomic<std::uint32_t> spatialSplits_{0};
+  // The root's surface area: the spatial splits' overlap test and the SAH statistic divide by it.
+  double rootArea_ = 0.0;
 
   // writeWide() state
   double sah_ = 0.0;
-  double rootArea_ = 0.0;
 };
 
 } // namespace
