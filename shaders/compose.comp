@@ -10,13 +10,14 @@
 
 layout(local_size_x = kWorkgroupSize1D) in;
 layout(push_constant) uniform Push { ComposePush pc; };
-layout(std430, binding = kBindingComposeBasis) readonly buffer Basis { vec4 basis[]; };
-layout(std430, binding = kBindingComposeAmbient) readonly buffer Ambient { vec4 ambient[]; };
-layout(std430, binding = kBindingComposeEmissionBasis) readonly buffer EmissionBasis { vec4 emissionBasis[]; };
+// The Kahan sums through RGBA32F texel views (OBS_SUM_TEXEL): a quarter of the loads of an SSBO's.
+layout(binding = kBindingComposeBasis) uniform samplerBuffer basis;
+layout(binding = kBindingComposeAmbient) uniform samplerBuffer ambient;
+layout(binding = kBindingComposeEmissionBasis) uniform samplerBuffer emissionBasis;
 layout(std430, binding = kBindingComposeEmissions) readonly buffer Emissions { vec4 emission[]; };
 layout(std430, binding = kBindingComposeOutput) writeonly buffer Out { vec4 composed[]; };
-layout(std430, binding = kBindingComposeSpecularBasis) readonly buffer SpecularBasis { vec4 specularBasis[]; };
-layout(std430, binding = kBindingComposeSpecularAmbient) readonly buffer SpecularAmbient { vec4 specularAmbient[]; };
+layout(binding = kBindingComposeSpecularBasis) uniform samplerBuffer specularBasis;
+layout(binding = kBindingComposeSpecularAmbient) uniform samplerBuffer specularAmbient;
 layout(std430, binding = kBindingComposeSampleCounts) readonly buffer SampleCounts { uint sampleCounts[]; };
 
 void main() {
@@ -30,14 +31,14 @@ void main() {
   const bool withSpecular = pc.ambient.w != 0.0;
   for (uint s = 0u; s < pc.frame.w; ++s) {
     vec3 e = emission[s].rgb;
-    direct += e * OBS_SUM(basis, s * pixelCount + pixel).rgb;
-    seen += e * OBS_SUM(emissionBasis, s * pixelCount + pixel).rgb;
-    if (withSpecular) specular += e * OBS_SUM(specularBasis, s * pixelCount + pixel).rgb;
+    direct += e * OBS_SUM_TEXEL(basis, s * pixelCount + pixel).rgb;
+    seen += e * OBS_SUM_TEXEL(emissionBasis, s * pixelCount + pixel).rgb;
+    if (withSpecular) specular += e * OBS_SUM_TEXEL(specularBasis, s * pixelCount + pixel).rgb;
   }
   direct *= inv;
   seen *= inv;
-  if (withSpecular) specular = (specular + pc.ambient.rgb * OBS_SUM(specularAmbient, pixel).rgb) * inv;
-  vec4 a = OBS_SUM(ambient, pixel) * inv;
+  if (withSpecular) specular = (specular + pc.ambient.rgb * OBS_SUM_TEXEL(specularAmbient, pixel).rgb) * inv;
+  vec4 a = OBS_SUM_TEXEL(ambient, pixel) * inv;
   vec3 indirect = pc.ambient.rgb * a.rgb;
   uint o = pixel * pc.slots.x;
   composed[o + kComposeCombined] = vec4(direct + indirect + seen + specular, 1.0);

@@ -288,8 +288,8 @@ void ObscuranceRenderer::reset() {
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) {
       const auto& band = frame_.band(b);
-      for (const gpu::Buffer* buffer : {&band.basis, &band.ambient, &band.specularBasis, &band.specularAmbient,
-                                        &band.emissionBasis, &band.aovs, &band.sampleCounts})
+      for (const gpu::Buffer* buffer : {&band.basis.buffer(), &band.ambient.buffer(), &band.specularBasis.buffer(), &band.specularAmbient.buffer(),
+                                        &band.emissionBasis.buffer(), &band.aovs, &band.sampleCounts})
         cmd.fillBuffer(buffer->handle(), 0, VK_WHOLE_SIZE, 0u);
     }
   });
@@ -773,10 +773,10 @@ Transport ObscuranceRenderer::transport() const {
   auto sum = [](const std::vector<glm::vec4>& v, std::uint64_t i) { return v[i * gpu::kAccumulatorVec4s]; };
   for (std::uint32_t b = 0; b < layout.bandCount(); ++b) {
     const auto& band = frame_.band(b);
-    const auto basis = downloadBand(band.basis), seen = downloadBand(band.emissionBasis);
-    const auto ambient = downloadBand(band.ambient);
-    const std::vector<glm::vec4> specularBasis = runSpecular_ ? downloadBand(band.specularBasis) : std::vector<glm::vec4>();
-    const std::vector<glm::vec4> specularAmbient = runSpecular_ ? downloadBand(band.specularAmbient) : std::vector<glm::vec4>();
+    const auto basis = downloadBand(band.basis.buffer()), seen = downloadBand(band.emissionBasis.buffer());
+    const auto ambient = downloadBand(band.ambient.buffer());
+    const std::vector<glm::vec4> specularBasis = runSpecular_ ? downloadBand(band.specularBasis.buffer()) : std::vector<glm::vec4>();
+    const std::vector<glm::vec4> specularAmbient = runSpecular_ ? downloadBand(band.specularAmbient.buffer()) : std::vector<glm::vec4>();
     const auto counts = band.sampleCounts.download<std::uint32_t>(*context_);
     const std::uint64_t px = layout.bandPixels(b);
     const std::uint64_t first = std::uint64_t(layout.bands[b].firstRow) * layout.width;

@@ -14,6 +14,9 @@
 
 // GLSL cannot pass a buffer array to a function, hence macros.
 #define OBS_SUM(array, index) (array[2u * (index)])
+// The same sum read through an RGBA32F texel view of the accumulator buffer (compose, resolve):
+// lavapipe loads a texel as one 16-byte vector per lane, an SSBO vec4 as four scalar loads.
+#define OBS_SUM_TEXEL(view, index) texelFetch(view, int(2u * (index)))
 
 // One Kahan step: returns the new sum; `compensation` is updated in place.
 vec4 kahanStep(vec4 sum, inout vec4 compensation, vec4 value) {

@@ -69,15 +69,17 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
   for (const auto& k : bufferKinds(contents))
     if (k.splitsBands) largest = std::max(largest, k.bytesPerPixel * (k.perLight ? maxLights_ : 1u));
   // A band's texel views hold at most maxTexelBufferElements texels each: the G-buffer
-  // (kTexelsPerGBuffer a pixel, read by the shading passes) and the resolved transport (a word per
-  // light and pixel, each light's row padded to whole texels, resolvedStride). That bounds a band's
+  // (kTexelsPerGBuffer a pixel, read by the shading passes), the per-light Kahan sums (a vec4 pair
+  // per light and pixel, read by compose and resolve) and the resolved transport (a word per light
+  // and pixel, each light's row padded to whole texels, resolvedStride). That bounds a band's
   // pixels too, as a byte limit of the largest buffer.
   const std::uint64_t maxTexels = maxTexelElements > 0 ? std::min<std::uint64_t>(maxTexelElements, context.info().maxTexelBufferElements)
                                                        : context.info().maxTexelBufferElements;
   const std::uint64_t byGBuffer = maxTexels / gpu::kTexelsPerGBuffer;
   const std::uint64_t resolvedRowWords = 4 * maxTexels / (std::uint64_t(maxLights_) + 1);
   const std::uint64_t byResolved = resolvedRowWords > gpu::kResolvedPixelAlign ? resolvedRowWords - gpu::kResolvedPixelAlign : 1;
-  const std::uint64_t pixelBound = std::max<std::uint64_t>(std::min(byGBuffer, byResolved), 1);
+  const std::uint64_t bySums = maxTexels / (gpu::kAccumulatorVec4s * std::max<std::uint64_t>(maxLights_, 1));
+  const std::uint64_t pixelBound = std::max<std::uint64_t>(std::min({byGBuffer, bySums, byResolved}), 1);
   layout_ = FrameLayout::split(width, height, largest, std::min(limit, pixelBound * largest), "the per-light basis buffers");
   // The kept rays: as many samples as fit in one buffer of the largest band.
   std::uint64_t bandPixels = 1;
@@ -94,6 +96,9 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
                                  width, height, lights, static_cast<double>(need) / 1048576.0, context.info().name,
                                  static_cast<double>(context.info().deviceLocalBytes) / 1048576.0));
 
+  const auto sums = [&](std::uint64_t bytes, const std::string& name) {
+    return gpu::TexelBuffer(context, bytes, vk::Format::eR32G32B32A32Sfloat, kStorage, name);
+  };
   for (std::size_t i = 0; i < layout_.bands.size(); ++i) {
     Band b;
     b.rows = layout_.bands[i];
@@ -103,9 +108,8 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
                                  kStorage, "frame.gbuffer" + tag);
     b.aovs = gpu::Buffer(context, contents.primaryAovs ? px * gpu::kAovSlots * kAccumulator : kVec4, kStorage,
                          "frame.aovs" + tag);
-    b.ambient = gpu::Buffer(context, px * kAccumulator, kStorage, "frame.ambient" + tag);
-    b.specularAmbient = gpu::Buffer(context, specular ? px * kAccumulator : kVec4, kStorage,
-                                    "frame.specular_ambient" + tag);
+    b.ambient = sums(px * kAccumulator, "frame.ambient" + tag);
+    b.specularAmbient = sums(specular ? px * kAccumulator : kVec4, "frame.specular_ambient" + tag);
     b.queue = gpu::Buffer(context, 2 * (gpu::kQueueHeader + (specular ? px : 1)) * 4,
                           kStorage | Usage::eIndirectBuffer, "frame.specular_queue" + tag);
     b.specularPaths = gpu::Buffer(context, specular ? px * gpu::kSpecularPathTexels * kVec4 : kVec4, kStorage,
@@ -113,10 +117,9 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.composed = gpu::Buffer(context, px * contents.composedSlots * kVec4, kStorage, "frame.composed" + tag);
     b.display = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.display" + tag);
     const std::uint64_t slots = maxLights_;
-    b.basis = gpu::Buffer(context, px * slots * kAccumulator, kStorage, "frame.basis" + tag);
-    b.emissionBasis = gpu::Buffer(context, px * slots * kAccumulator, kStorage, "frame.emission_basis" + tag);
-    b.specularBasis = gpu::Buffer(context, specular ? px * slots * kAccumulator : kVec4, kStorage,
-                                  "frame.specular_basis" + tag);
+    b.basis = sums(px * slots * kAccumulator, "frame.basis" + tag);
+    b.emissionBasis = sums(px * slots * kAccumulator, "frame.emission_basis" + tag);
+    b.specularBasis = sums(specular ? px * slots * kAccumulator : kVec4, "frame.specular_basis" + tag);
     // One word per light and pixel, each light's row padded to whole RGBA32UI texels.
     const std::uint64_t resolvedWords = std::uint64_t(gpu::resolvedStride(static_cast<std::uint32_t>(px))) * (slots + 1);
     b.resolved = gpu::TexelBuffer(context, resolvedWords * 4, vk::Format::eR32G32B32A32Uint, kStorage,
@@ -137,9 +140,9 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
 std::uint64_t ObscuranceFrame::bytes() const {
   std::uint64_t total = status_.buffer().size();
   for (const auto& b : bands_)
-    for (const gpu::Buffer* buffer : {&b.gbuffer.buffer(), &b.aovs, &b.basis, &b.emissionBasis, &b.ambient,
-                                      &b.specularBasis,
-                                      &b.specularAmbient, &b.queue, &b.specularPaths, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty,
+    for (const gpu::Buffer* buffer : {&b.gbuffer.buffer(), &b.aovs, &b.basis.buffer(), &b.emissionBasis.buffer(), &b.ambient.buffer(),
+                                      &b.specularBasis.buffer(),
+                                      &b.specularAmbient.buffer(), &b.queue, &b.specularPaths, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty,
                                       &b.sampleCounts, &b.pathHits, &b.shadowRays})
       total += buffer->size();
   return total;
@@ -154,8 +157,8 @@ void ObscuranceFrame::addLightSlot(gpu::CommandStream& stream, std::uint32_t ind
     for (std::size_t i = 0; i < bands_.size(); ++i) {
       const std::uint64_t slot = layout_.bandPixels(i) * kAccumulator;
       Band& b = bands_[i];
-      std::vector<const gpu::Buffer*> perLight = {&b.basis, &b.emissionBasis};
-      if (contents_.specular) perLight.push_back(&b.specularBasis);
+      std::vector<const gpu::Buffer*> perLight = {&b.basis.buffer(), &b.emissionBasis.buffer()};
+      if (contents_.specular) perLight.push_back(&b.specularBasis.buffer());
       // Slot by slot from the top, each copy after the last (copies within one buffer must not overlap).
       for (std::uint32_t l = lights_; l > index; --l) {
         const vk::BufferCopy region{.srcOffset = (l - 1) * slot, .dstOffset = l * slot, .size = slot};
@@ -177,9 +180,9 @@ void ObscuranceFrame::removeLightSlot(gpu::CommandStream& stream, std::uint32_t 
       // Slot by slot, each copy after the last (copies within one buffer must not overlap).
       for (std::uint32_t l = index + 1; l < lights_; ++l) {
         const vk::BufferCopy region{.srcOffset = l * slot, .dstOffset = (l - 1) * slot, .size = slot};
-        cmd.copyBuffer(b.basis.handle(), b.basis.handle(), region);
-        cmd.copyBuffer(b.emissionBasis.handle(), b.emissionBasis.handle(), region);
-        if (contents_.specular) cmd.copyBuffer(b.specularBasis.handle(), b.specularBasis.handle(), region);
+        cmd.copyBuffer(b.basis.buffer().handle(), b.basis.buffer().handle(), region);
+        cmd.copyBuffer(b.emissionBasis.buffer().handle(), b.emissionBasis.buffer().handle(), region);
+        if (contents_.specular) cmd.copyBuffer(b.specularBasis.buffer().handle(), b.specularBasis.buffer().handle(), region);
         gpu::computeBarrier(cmd);
       }
     }

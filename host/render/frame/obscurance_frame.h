@@ -57,8 +57,11 @@ public:
     // The G-buffer: written by primary.comp as an SSBO, read by the shading passes through an
     // RGBA32F texel view (kTexelsPerGBuffer texels a pixel, lib/shading_bindings.glsl).
     gpu::TexelBuffer gbuffer;
-    gpu::Buffer aovs, basis, emissionBasis, ambient, specularBasis, specularAmbient, queue, specularPaths, composed,
-        display;
+    gpu::Buffer aovs, queue, specularPaths, composed, display;
+    // The Kahan sums (vec4 pairs, lib/accumulate.glsl): written by the shading passes as SSBOs, read
+    // by compose.comp and resolve.comp through RGBA32F texel views, which lavapipe loads as one
+    // 16-byte vector per lane instead of four scalar loads (docs/BENCHMARKS.md).
+    gpu::TexelBuffer basis, emissionBasis, ambient, specularBasis, specularAmbient;
     gpu::TexelBuffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits:
                                // lightmix.comp reads four pixels at a time as RGBA32UI texels
     gpu::Buffer hitBounds; // per pixel, the box of its primary hits over samples (geometry edits)

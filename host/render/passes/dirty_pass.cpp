@@ -82,10 +82,10 @@ void DirtyPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu
   lightBounds_ = &bounds;
   mark_.bind(gpu::kBindingDirtyStatus, frame.status(), band);
   clear_.bind(gpu::kBindingClearDirty, b.dirty, band);
-  clear_.bind(gpu::kBindingClearBasis, b.basis, band);
-  clear_.bind(gpu::kBindingClearAmbient, b.ambient, band);
-  clear_.bind(gpu::kBindingClearSpecularBasis, b.specularBasis, band);
-  clear_.bind(gpu::kBindingClearSpecularAmbient, b.specularAmbient, band);
+  clear_.bind(gpu::kBindingClearBasis, b.basis.buffer(), band);
+  clear_.bind(gpu::kBindingClearAmbient, b.ambient.buffer(), band);
+  clear_.bind(gpu::kBindingClearSpecularBasis, b.specularBasis.buffer(), band);
+  clear_.bind(gpu::kBindingClearSpecularAmbient, b.specularAmbient.buffer(), band);
 }
 
 void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu::GpuCamera& camera,

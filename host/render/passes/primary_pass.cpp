@@ -60,7 +60,7 @@ void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const Obsc
     kernel.bind(gpu::kBindingPrimaryGBuffer, b.gbuffer.buffer(), band);
     kernel.bind(gpu::kBindingPrimaryAovs, b.aovs, band);
     kernel.bind(gpu::kBindingPrimaryLightScales, lightScales, band);
-    kernel.bind(gpu::kBindingPrimaryEmissionBasis, b.emissionBasis, band);
+    kernel.bind(gpu::kBindingPrimaryEmissionBasis, b.emissionBasis.buffer(), band);
     kernel.bind(gpu::kBindingPrimaryHitBounds, b.hitBounds, band);
     kernel.bind(gpu::kBindingPrimaryDirty, b.dirty, band);
     kernel.bind(gpu::kBindingPrimarySampleCounts, b.sampleCounts, band);

@@ -5,7 +5,14 @@
 namespace obscura::render {
 
 ResolvePass::ResolvePass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, gpu::storageKernelDesc("resolve", kSpirv_resolve, gpu::kResolveBindingCount, sizeof(gpu::ResolvePush), bands)) {}
+    : kernel_(context, [&] {
+        gpu::KernelDesc desc = gpu::storageKernelDesc("resolve", kSpirv_resolve, gpu::kResolveBindingCount,
+                                                      sizeof(gpu::ResolvePush), bands);
+        for (std::uint32_t sums : {gpu::kBindingResolveBasis, gpu::kBindingResolveAmbient, gpu::kBindingResolveEmissionBasis,
+                                     gpu::kBindingResolveSpecularBasis, gpu::kBindingResolveSpecularAmbient})
+          desc.bindings[sums] = gpu::BindingKind::UniformTexelBuffer;
+        return desc;
+      }()) {}
 
 void ResolvePass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
   const auto& b = frame.band(band);
