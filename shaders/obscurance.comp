@@ -39,7 +39,7 @@ void main() {
   StepBudget budget = newStepBudget();
   // A probe too (not in the macro): N_obs rays at every primary hit.
   const vec4 gathered = gatherObscurance(sp, rng, budget, pixel, bp.count, pc.counts.z);
-  OBS_ACCUMULATE(ambient, pixel, gathered)
+  OBS_ACCUMULATE_TEXEL(ambient, pixel, gathered)
   if (kProbe) endProbe(pixel);
   else atomicAdd(status[kStatusObscuranceRays], pc.counts.z);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);

@@ -54,7 +54,7 @@ void main() {
     const uint light = pc.band.w;
     uint taken;
     vec3 direct = directLightFromOne(sp, light, lightShift, budget, taken);
-    OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(direct, 0.0))
+    OBS_ACCUMULATE_TEXEL(basis, light * pixelCount + pixel, vec4(direct, 0.0))
     if (kProbe) endProbe(pixel);
     else atomicAdd(status[kStatusShadowRays], taken);
     if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
@@ -70,7 +70,7 @@ void main() {
     uint light;
     directLightSample(sp, u, pc.counts.x, misSamples, budget, contribution, light);
     if (keepRays) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, pixelCount, 0u, k)] = gShadowRay;
-    OBS_ACCUMULATE(basis, light * pixelCount + pixel, vec4(contribution * invCount, 0.0))
+    OBS_ACCUMULATE_TEXEL(basis, light * pixelCount + pixel, vec4(contribution * invCount, 0.0))
   }
   if (kProbe) endProbe(pixel);
   else atomicAdd(status[kStatusShadowRays], count);

@@ -189,7 +189,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
     if ((c.oneLight && sky != c.addedLight) || c.noDirect) sky = kInvalidIndex;
     if (!kProbe && h.primitive != kTruncatedHit && sky != kInvalidIndex && (delta || (c.glossyMis && !c.oneLight))) { // a miss, not a truncation
       float w = delta ? 1.0 : powerHeuristic(lobePdf, vertexLightSamples * backgroundLightPdf(sky, previous, previousNormal, c.lightCount, wi));
-      OBS_ACCUMULATE(specularBasis, sky * c.pixelCount + pixel, vec4(w * throughput, 0.0))
+      OBS_ACCUMULATE_TEXEL(specularBasis, sky * c.pixelCount + pixel, vec4(w * throughput, 0.0))
     }
     return false;
   }
@@ -207,7 +207,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
     }
     // Seen emission in unit-emission terms: divided by the group's E_s (1 where E_s is 0).
     vec3 unit = unitEmission(materialEmission(m, s.uv, s.frontFacing), lightScales[s.lightGroup].rgb);
-    OBS_ACCUMULATE(specularBasis, s.lightGroup * c.pixelCount + pixel, vec4(w * throughput * unit, 0.0))
+    OBS_ACCUMULATE_TEXEL(specularBasis, s.lightGroup * c.pixelCount + pixel, vec4(w * throughput * unit, 0.0))
   }
   sp = shadingPoint(s.position, s.geometricNormal, s.shadingNormal, -wi, baseColor, s.material);
   path.sp = sp;
@@ -230,7 +230,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
       uint taken = 0u;
       vec3 direct = vec3(0.0);
       if (drawn) direct = directLightFromOne(sp, c.addedLight, lightShift, budget, taken);
-      OBS_ACCUMULATE(specularBasis, c.addedLight * c.pixelCount + pixel, vec4(throughput * direct, 0.0))
+      OBS_ACCUMULATE_TEXEL(specularBasis, c.addedLight * c.pixelCount + pixel, vec4(throughput * direct, 0.0))
       rays += taken;
       return true; // one light's rays alone: no obscurance
     }
@@ -240,12 +240,12 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
       uint light;
       directLightSample(sp, u, c.lightCount, misSamples, budget, contribution, light);
       if (c.keepRays) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, c.pixelCount, depth, k)] = gShadowRay;
-      OBS_ACCUMULATE(specularBasis, light * c.pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
+      OBS_ACCUMULATE_TEXEL(specularBasis, light * c.pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
     }
   }
   // Secondary reflectors only at primary hits: here the ambient keeps its whole I_a.
   vec4 aw = gatherObscurance(sp, path.rng, budget, kInvalidIndex, c.pixelCount, obscuranceRays);
-  OBS_ACCUMULATE(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
+  OBS_ACCUMULATE_TEXEL(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
   rays += (c.noDirect ? 0u : shadowRays) + obscuranceRays;
   return true;
 }

@@ -45,6 +45,19 @@ vec4 kahanStep(vec4 sum, inout vec4 compensation, vec4 value) {
     }                                                                 \
   }
 
+// The same step on an accumulator bound as an RGBA32F storage texel buffer (imageBuffer): lavapipe
+// loads and stores a texel as one 16-byte vector per lane, an SSBO vec4 as four scalar accesses.
+// An invocation's own earlier store is visible to its later load (program order), as with an SSBO.
+#define OBS_ACCUMULATE_TEXEL(image, index, value)                  \
+  {                                                                 \
+    if (!OBS_SUMS_OFF) {                                            \
+      int k_ = int(2u * (index));                                   \
+      vec4 c_ = imageLoad(image, k_ + 1);                           \
+      imageStore(image, k_, kahanStep(imageLoad(image, k_), c_, (value))); \
+      imageStore(image, k_ + 1, c_);                                \
+    }                                                               \
+  }
+
 // Starts an accumulator at `value` (the first sample: no clear needed).
 #define OBS_ACCUMULATE_FIRST(array, index, value)           \
   {                                                          \

@@ -109,7 +109,7 @@ vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, 
             reflectedDirectLight(s, direction, uLight, budget, contribution, light);
             if (budget.traced != tracedBefore) ++reflectorRays;
             if (light != kInvalidIndex && any(greaterThan(contribution, vec3(0.0))))
-              OBS_ACCUMULATE(basis, light * pixelCount + reflectorPixel, vec4(rP * contribution * invN, 0.0))
+              OBS_ACCUMULATE_TEXEL(basis, light * pixelCount + reflectorPixel, vec4(rP * contribution * invN, 0.0))
           }
         }
       } else {

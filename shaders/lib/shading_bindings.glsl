@@ -17,14 +17,16 @@ GBufferTexel gbufferAt(uint pixel) {
                       texelFetch(gbufferTexels, at + 2), texelFetch(gbufferTexels, at + 3));
 }
 layout(std430, set = 0, binding = kBindingLightTree) readonly buffer LightTreeBuffer { GpuLightNode lightTree[]; };
+// The Kahan sums (vec4 pairs, OBS_ACCUMULATE_TEXEL), as RGBA32F storage texel buffers: a texel is one
+// vector access a lane on lavapipe, an SSBO vec4 four scalar ones.
 // basis[light * pixelCount + pixel] += D_s contributions (unit emission), summed over samples.
-layout(std430, set = 0, binding = kBindingBasis) buffer BasisBuffer { vec4 basis[]; };
+layout(set = 0, binding = kBindingBasis, rgba32f) uniform imageBuffer basis;
 // ambient[pixel].rgb += R(P) W_c (or R(P) W), .w += W, summed over samples.
-layout(std430, set = 0, binding = kBindingAmbient) buffer AmbientBuffer { vec4 ambient[]; };
+layout(set = 0, binding = kBindingAmbient, rgba32f) uniform imageBuffer ambient;
 
 // The same two along specular paths (specular.comp), kept apart for the "specular" AOV.
-layout(std430, set = 0, binding = kBindingSpecularBasis) buffer SpecularBasisBuffer { vec4 specularBasis[]; };
-layout(std430, set = 0, binding = kBindingSpecularAmbient) buffer SpecularAmbientBuffer { vec4 specularAmbient[]; };
+layout(set = 0, binding = kBindingSpecularBasis, rgba32f) uniform imageBuffer specularBasis;
+layout(set = 0, binding = kBindingSpecularAmbient, rgba32f) uniform imageBuffer specularAmbient;
 // queue[0..3] = indirect dispatch groups (x, y, z) and the entry count; pixel indices follow.
 // Two such queues take turns, one per path depth (specularQueueBase).
 layout(std430, set = 0, binding = kBindingSpecularQueue) buffer SpecularQueue { uint queue[]; };

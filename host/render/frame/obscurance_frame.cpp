@@ -97,7 +97,7 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
                                  static_cast<double>(context.info().deviceLocalBytes) / 1048576.0));
 
   const auto sums = [&](std::uint64_t bytes, const std::string& name) {
-    return gpu::TexelBuffer(context, bytes, vk::Format::eR32G32B32A32Sfloat, kStorage, name);
+    return gpu::TexelBuffer(context, bytes, vk::Format::eR32G32B32A32Sfloat, kStorage | Usage::eStorageTexelBuffer, name);
   };
   for (std::size_t i = 0; i < layout_.bands.size(); ++i) {
     Band b;

@@ -14,6 +14,8 @@ gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_
   bindings.insert(bindings.end(), gpu::kShadingBindingCount - gpu::kSceneBindingCount, gpu::BindingKind::StorageBuffer);
   bindings[gpu::kBindingGBuffer] = bindings[gpu::kBindingLights] = bindings[gpu::kBindingEmitters] =
       gpu::BindingKind::UniformTexelBuffer;
+  bindings[gpu::kBindingBasis] = bindings[gpu::kBindingAmbient] = bindings[gpu::kBindingSpecularBasis] =
+      bindings[gpu::kBindingSpecularAmbient] = gpu::BindingKind::StorageTexelBuffer;
   gpu::KernelDesc desc{.name = name, .spirv = spirv, .bindings = bindings, .pushConstantBytes = sizeof(gpu::ShadePush),
                        .setCount = s.bands};
   if (s.flatLightSelection) desc.specConstants.push_back({.id = gpu::kSpecConstantFlatLightSelection, .value = 1u});
@@ -66,10 +68,10 @@ void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInp
   kernel.bind(gpu::kBindingLights, in.lights.lights, band);
   kernel.bind(gpu::kBindingEmitters, in.lights.emitters, band);
   kernel.bind(gpu::kBindingLightTree, in.lights.tree, band);
-  kernel.bind(gpu::kBindingBasis, b.basis.buffer(), band);
-  kernel.bind(gpu::kBindingAmbient, b.ambient.buffer(), band);
-  kernel.bind(gpu::kBindingSpecularBasis, b.specularBasis.buffer(), band);
-  kernel.bind(gpu::kBindingSpecularAmbient, b.specularAmbient.buffer(), band);
+  kernel.bind(gpu::kBindingBasis, b.basis, band);
+  kernel.bind(gpu::kBindingAmbient, b.ambient, band);
+  kernel.bind(gpu::kBindingSpecularBasis, b.specularBasis, band);
+  kernel.bind(gpu::kBindingSpecularAmbient, b.specularAmbient, band);
   kernel.bind(gpu::kBindingSpecularQueue, b.queue, band);
   kernel.bind(gpu::kBindingSpecularPaths, b.specularPaths, band);
   kernel.bind(gpu::kBindingLightScales, in.lights.scales, band);
