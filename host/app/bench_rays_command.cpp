@@ -303,8 +303,8 @@ nlohmann::json frameJson(const BenchOptions& o, const FrameRun& f) {
 
 void printPasses(const PassesRun& p, double closestMrays, double shadowMrays) {
   const render::ObscuranceSettings budget; // the paper's budget is the defaults
-  fmt::print("passes: the paper's budget at {}x{} ({} spp, {} shadow + {} obscurance rays per hit{}), best repeat by "
-             "GPU time: wall {:.2f} s, GPU {:.0f} ms\n",
+  fmt::print("passes: the paper's budget at {}x{} ({} spp, {} shadow + {} obscurance rays per hit{}; the image alone, "
+             "as render -o out.png makes it), best repeat by GPU time: wall {:.2f} s, GPU {:.0f} ms\n",
              p.size.x, p.size.y, budget.spp, budget.shadowRays, budget.obscuranceRays,
              budget.vertexRaysByThroughput ? ", at specular path vertices scaled by throughput" : "",
              p.stats.wallSeconds, render::totalGpuMs(p.stats));

@@ -80,13 +80,17 @@ RenderStats renderPaperBudget(const gpu::Context& context, const scene::Scene& s
   settings.width = width;
   settings.height = height;
   settings.camera = camera;
-  settings.editableGeometry = false; // a render, as `render` makes it (the AOVs are kept, as the defaults do)
+  // The image as `render -o out.png` makes it: no AOV besides the combined one, no edits.
+  settings.editableGeometry = false;
+  settings.primaryAovs = false;
+  settings.composedAovs = false;
   ObscuranceRenderer renderer(context, scene, bvh, settings);
   renderer.iterate(1); // warm-up
   RenderStats best;
   for (int k = 0; k < std::max(1, repeats); ++k) {
     renderer.reset();
     renderer.iterate(settings.spp);
+    renderer.compose(); // and the frame from its sums, tonemapped, as the render's last step
     RenderStats stats = renderer.stats();
     if (stats.truncatedTraversals > 0)
       throw DeviceError(fmt::format("{} traversals ran out of steps", stats.truncatedTraversals));

@@ -27,8 +27,9 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
                                    const scene::Camera& camera, const ObscuranceFrameWork& work, int repeats);
 
 // The paper's budget (ObscuranceSettings' defaults: 8 spp, 5 shadow and 5 obscurance rays per
-// hit, specular paths on glossy surfaces, default dMax) at width x height; the stats of the repeat
-// with the least GPU time, after one warm-up sample.
+// hit, specular paths on glossy surfaces, default dMax) at width x height, rendered as `render -o
+// out.png --spp 8` renders it (the combined image only, composed and tonemapped); the stats of the
+// repeat with the least GPU time, after one warm-up sample.
 RenderStats renderPaperBudget(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
                               const scene::Camera& camera, std::uint32_t width, std::uint32_t height, int repeats);
 

@@ -32,11 +32,16 @@ TEST_F(CliBench, PassesAndFrameFiguresArePositiveAndConsistent) {
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const nlohmann::json j = lastJsonLine(r.output);
 
-  // --passes: the paper's budget (8 spp, 5 shadow and 5 obscurance rays per hit) at 24x24.
+  // --passes: the paper's budget (8 spp, 5 shadow and 5 obscurance rays per hit) at 24x24, the
+  // image as `render -o out.png` makes it: its passes, then compose and tonemap.
   const nlohmann::json& passes = j.at("passes");
   EXPECT_GT(passes.at("wall_s").get<double>(), 0.0);
   const nlohmann::json& perPass = passes.at("per_pass");
   double sumMs = 0.0;
+  for (const char* pass : {"compose", "tonemap"}) {
+    EXPECT_GT(perPass.at(pass).at("gpu_ms").get<double>(), 0.0) << pass;
+    sumMs += perPass.at(pass).at("gpu_ms").get<double>();
+  }
   for (const char* pass : {"primary", "shadow", "obscurance"}) {
     const nlohmann::json& p = perPass.at(pass);
     EXPECT_GT(p.at("gpu_ms").get<double>(), 0.0) << pass;
