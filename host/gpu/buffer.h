@@ -61,9 +61,10 @@ private:
   std::string name_;
 };
 
-// A buffer with a texel view, read through uniform texel buffers where lavapipe gathers texels as
-// vectors instead of one scalar load per lane (docs/ARCHITECTURE.md): the BVH (RGBA32F texels),
-// the resolved transport of light edits (RGBA32UI: four pixels per texel).
+// A buffer with a texel view, read through uniform texel buffers (or, where its usage allows,
+// written through storage texel buffers) where lavapipe moves texels as vectors instead of one
+// scalar access per lane and word (docs/ARCHITECTURE.md): the BVH (RGBA32F texels), the frame's
+// G-buffer and Kahan sums, the resolved transport of light edits (RGBA32UI: four pixels per texel).
 class TexelBuffer {
 public:
   TexelBuffer() = default;

@@ -58,9 +58,10 @@ public:
     // RGBA32F texel view (kTexelsPerGBuffer texels a pixel, lib/shading_bindings.glsl).
     gpu::TexelBuffer gbuffer;
     gpu::Buffer aovs, queue, specularPaths, composed, display;
-    // The Kahan sums (vec4 pairs, lib/accumulate.glsl): written by the shading passes as SSBOs, read
-    // by compose.comp and resolve.comp through RGBA32F texel views, which lavapipe loads as one
-    // 16-byte vector per lane instead of four scalar loads (docs/BENCHMARKS.md).
+    // The light and ambient Kahan sums (vec4 pairs, lib/accumulate.glsl) with RGBA32F views: the
+    // shading passes add to them as storage texel buffers, compose.comp and resolve.comp read them
+    // as uniform ones (primary.comp and clear.comp bind them as SSBOs). lavapipe moves a texel as
+    // one 16-byte vector per lane, an SSBO vec4 as four scalar accesses (docs/BENCHMARKS.md).
     gpu::TexelBuffer basis, emissionBasis, ambient, specularBasis, specularAmbient;
     gpu::TexelBuffer resolved; // RGB9E5 T_s per light, then A_t (resolve.comp), for light edits:
                                // lightmix.comp reads four pixels at a time as RGBA32UI texels
