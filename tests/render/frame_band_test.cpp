@@ -117,8 +117,8 @@ TEST_F(FrameBands, AFrameSplitByItsTexelViewLimitIsBitIdenticalToTheWholeFrame) 
   std::string where;
   EXPECT_TRUE(bitIdentical(whole.image, gbufferBound.image(), &where)) << where;
   // With 31 light slots (spares for lights added later) the per-light Kahan sums bind instead (a
-  // vec4 pair per slot and pixel, compose's and resolve's views): 3 rows of 48 pixels hold
-  // 8928 texels, 14 bands; the G-buffer would take 46 rows, the resolved transport 23.
+  // vec4 pair per slot and pixel): 3 rows of 48 pixels hold 8928 texels, 14 bands; the G-buffer
+  // would take 46 rows, and the resolved transport's view (checked too) needs fewer texels.
   const std::uint64_t bySums = 48ull * gpu::kAccumulatorVec4s * 31 * 3;
   settings.maxTexelElements = bySums;
   settings.spareLightSlots = 30;

@@ -69,17 +69,16 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
   for (const auto& k : bufferKinds(contents))
     if (k.splitsBands) largest = std::max(largest, k.bytesPerPixel * (k.perLight ? maxLights_ : 1u));
   // A band's texel views hold at most maxTexelBufferElements texels each: the G-buffer
-  // (kTexelsPerGBuffer a pixel, read by the shading passes), the per-light Kahan sums (a vec4 pair
-  // per light and pixel, read by compose and resolve) and the resolved transport (a word per light
-  // and pixel, each light's row padded to whole texels, resolvedStride). That bounds a band's
-  // pixels too, as a byte limit of the largest buffer.
+  // (kTexelsPerGBuffer a pixel, read by the shading passes) and the per-light Kahan sums (a vec4
+  // pair per light and pixel: the shading passes, compose and resolve). That bounds a band's pixels
+  // too, as a byte limit of the largest buffer. The resolved transport (a word per light and pixel
+  // and one for the ambient, rows padded to kResolvedPixelAlign) then fits with room to spare:
+  // (L + 1) ceil(px / 4) texels against the sums' 2 L px.
   const std::uint64_t maxTexels = maxTexelElements > 0 ? std::min<std::uint64_t>(maxTexelElements, context.info().maxTexelBufferElements)
                                                        : context.info().maxTexelBufferElements;
   const std::uint64_t byGBuffer = maxTexels / gpu::kTexelsPerGBuffer;
-  const std::uint64_t resolvedRowWords = 4 * maxTexels / (std::uint64_t(maxLights_) + 1);
-  const std::uint64_t byResolved = resolvedRowWords > gpu::kResolvedPixelAlign ? resolvedRowWords - gpu::kResolvedPixelAlign : 1;
   const std::uint64_t bySums = maxTexels / (gpu::kAccumulatorVec4s * std::max<std::uint64_t>(maxLights_, 1));
-  const std::uint64_t pixelBound = std::max<std::uint64_t>(std::min({byGBuffer, bySums, byResolved}), 1);
+  const std::uint64_t pixelBound = std::max<std::uint64_t>(std::min(byGBuffer, bySums), 1);
   layout_ = FrameLayout::split(width, height, largest, std::min(limit, pixelBound * largest), "the per-light basis buffers");
   // The kept rays: as many samples as fit in one buffer of the largest band.
   std::uint64_t bandPixels = 1;
