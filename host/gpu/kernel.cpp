@@ -24,6 +24,14 @@ KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> sp
           .pushConstantBytes = pushConstantBytes, .setCount = setCount};
 }
 
+KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
+                             std::uint32_t pushConstantBytes, std::initializer_list<std::uint32_t> uniformTexelBindings,
+                             std::uint32_t setCount) {
+  KernelDesc desc = storageKernelDesc(std::move(name), spirv, bindingCount, pushConstantBytes, setCount);
+  for (std::uint32_t b : uniformTexelBindings) desc.bindings.at(b) = BindingKind::UniformTexelBuffer;
+  return desc;
+}
+
 Kernel::Kernel(const Context& context, const KernelDesc& desc)
     : context_(&context), name_(desc.name), bindings_(desc.bindings), pushBytes_(desc.pushConstantBytes),
       spirv_(desc.spirv), specConstants_(desc.specConstants) {

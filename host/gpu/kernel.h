@@ -38,6 +38,11 @@ struct KernelDesc {
 // A kernel whose bindings are all storage buffers (the frame passes: compose, tonemap, ...).
 KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
                              std::uint32_t pushConstantBytes, std::uint32_t setCount = 1);
+// The same but for `uniformTexelBindings`, read through uniform texel buffers (where lavapipe
+// gathers a texel per lane as one vector: compose, resolve, the light mix, the denoiser).
+KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
+                             std::uint32_t pushConstantBytes, std::initializer_list<std::uint32_t> uniformTexelBindings,
+                             std::uint32_t setCount = 1);
 
 class Kernel {
 public:

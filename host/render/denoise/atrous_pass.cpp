@@ -10,9 +10,9 @@ FilterSource filterSourceAfter(std::uint32_t iterations) {
 }
 
 AtrousPass::AtrousPass(const gpu::Context& context)
-    : kernel_(context, denoiseKernelDesc("denoise.atrous", kSpirv_denoise_atrous, gpu::kAtrousBindingCount,
-                                         sizeof(gpu::DenoisePush), {gpu::kBindingAtrousGuide, gpu::kBindingAtrousIn},
-                                         2 * kFilterSources)) {}
+    : kernel_(context, gpu::storageKernelDesc("denoise.atrous", kSpirv_denoise_atrous, gpu::kAtrousBindingCount,
+                                              sizeof(gpu::DenoisePush), {gpu::kBindingAtrousGuide, gpu::kBindingAtrousIn},
+                                              2 * kFilterSources)) {}
 
 void AtrousPass::bind(std::uint32_t parity, const DenoiseFrame& frame) {
   struct Route {

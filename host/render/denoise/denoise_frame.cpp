@@ -39,14 +39,6 @@ DenoiseFrame::DenoiseFrame(const gpu::Context& context, std::uint32_t w, std::ui
   display = gpu::Buffer(context, px * 4, kStorage, "denoise.display");
 }
 
-gpu::KernelDesc denoiseKernelDesc(std::string name, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
-                                  std::uint32_t pushConstantBytes, std::initializer_list<std::uint32_t> texelBindings,
-                                  std::uint32_t sets) {
-  gpu::KernelDesc desc = gpu::storageKernelDesc(std::move(name), spirv, bindingCount, pushConstantBytes, sets);
-  for (std::uint32_t b : texelBindings) desc.bindings[b] = gpu::BindingKind::UniformTexelBuffer;
-  return desc;
-}
-
 void dispatchImage(const gpu::Kernel& kernel, const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame,
                    const void* push, std::uint32_t set) {
   kernel.dispatch(cmd, gpu::groupsFor(frame.width, gpu::kWorkgroupSizeX), gpu::groupsFor(frame.height, gpu::kWorkgroupSizeY),

@@ -35,12 +35,6 @@ struct DenoiseFrame {
   std::uint64_t pixels() const { return std::uint64_t(width) * height; }
 };
 
-// A kernel of the denoiser: storage buffers but for `texelBindings` (read through uniform texel
-// buffers).
-gpu::KernelDesc denoiseKernelDesc(std::string name, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
-                                  std::uint32_t pushConstantBytes, std::initializer_list<std::uint32_t> texelBindings,
-                                  std::uint32_t sets);
-
 // Workgroups covering a width x height image in 2D (kWorkgroupSizeX x kWorkgroupSizeY).
 void dispatchImage(const gpu::Kernel& kernel, const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame,
                    const void* push, std::uint32_t set);

@@ -5,8 +5,8 @@
 namespace obscura::render {
 
 GatherPass::GatherPass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, denoiseKernelDesc("denoise.gather", kSpirv_denoise_gather, gpu::kGatherBindingCount,
-                                         sizeof(gpu::DenoisePush), {}, 2 * bands)) {}
+    : kernel_(context, gpu::storageKernelDesc("denoise.gather", kSpirv_denoise_gather, gpu::kGatherBindingCount,
+                                              sizeof(gpu::DenoisePush), {}, 2 * bands)) {}
 
 void GatherPass::bind(std::uint32_t band, std::uint32_t parity, const ObscuranceFrame& source,
                       const DenoiseFrame& target) {

@@ -5,9 +5,9 @@
 namespace obscura::render {
 
 RemodulatePass::RemodulatePass(const gpu::Context& context)
-    : kernel_(context, denoiseKernelDesc("denoise.remodulate", kSpirv_denoise_remodulate, gpu::kRemodulateBindingCount,
-                                         0, {gpu::kBindingRemodulateGuide, gpu::kBindingRemodulateIllum},
-                                         2 * kFilterSources)) {}
+    : kernel_(context, gpu::storageKernelDesc("denoise.remodulate", kSpirv_denoise_remodulate, gpu::kRemodulateBindingCount,
+                                              0, {gpu::kBindingRemodulateGuide, gpu::kBindingRemodulateIllum},
+                                              2 * kFilterSources)) {}
 
 void RemodulatePass::bind(std::uint32_t parity, const DenoiseFrame& frame) {
   const gpu::TexelBuffer* sources[kFilterSources] = {&frame.integrated[parity], &frame.filtered[0], &frame.filtered[1]};

@@ -5,10 +5,10 @@
 namespace obscura::render {
 
 ReprojectPass::ReprojectPass(const gpu::Context& context)
-    : kernel_(context, denoiseKernelDesc("denoise.reproject", kSpirv_denoise_reproject, gpu::kReprojectBindingCount, 0,
-                                         {gpu::kBindingReprojectGuide, gpu::kBindingReprojectHistoryGuide,
-                                          gpu::kBindingReprojectHistory},
-                                         2)) {}
+    : kernel_(context, gpu::storageKernelDesc("denoise.reproject", kSpirv_denoise_reproject, gpu::kReprojectBindingCount, 0,
+                                              {gpu::kBindingReprojectGuide, gpu::kBindingReprojectHistoryGuide,
+                                               gpu::kBindingReprojectHistory},
+                                              2)) {}
 
 void ReprojectPass::bind(std::uint32_t parity, const DenoiseFrame& frame) {
   const std::uint32_t history = 1 - parity;

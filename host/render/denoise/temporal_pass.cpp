@@ -5,8 +5,8 @@
 namespace obscura::render {
 
 TemporalPass::TemporalPass(const gpu::Context& context)
-    : kernel_(context, denoiseKernelDesc("denoise.temporal", kSpirv_denoise_temporal, gpu::kTemporalBindingCount, 0,
-                                         {gpu::kBindingTemporalGuide, gpu::kBindingTemporalNoisy}, 2)) {}
+    : kernel_(context, gpu::storageKernelDesc("denoise.temporal", kSpirv_denoise_temporal, gpu::kTemporalBindingCount, 0,
+                                              {gpu::kBindingTemporalGuide, gpu::kBindingTemporalNoisy}, 2)) {}
 
 void TemporalPass::bind(std::uint32_t parity, const DenoiseFrame& frame) {
   kernel_.bind(gpu::kBindingDenoiseParams, frame.params, parity);

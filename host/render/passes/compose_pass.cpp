@@ -5,14 +5,11 @@
 namespace obscura::render {
 
 ComposePass::ComposePass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, [&] {
-        gpu::KernelDesc desc = gpu::storageKernelDesc("compose", kSpirv_compose, gpu::kComposeBindingCount,
-                                                      sizeof(gpu::ComposePush), bands);
-        for (std::uint32_t sums : {gpu::kBindingComposeBasis, gpu::kBindingComposeAmbient, gpu::kBindingComposeEmissionBasis,
-                                     gpu::kBindingComposeSpecularBasis, gpu::kBindingComposeSpecularAmbient})
-          desc.bindings[sums] = gpu::BindingKind::UniformTexelBuffer;
-        return desc;
-      }()) {}
+    : kernel_(context, gpu::storageKernelDesc("compose", kSpirv_compose, gpu::kComposeBindingCount, sizeof(gpu::ComposePush),
+                                              {gpu::kBindingComposeBasis, gpu::kBindingComposeAmbient,
+                                               gpu::kBindingComposeEmissionBasis, gpu::kBindingComposeSpecularBasis,
+                                               gpu::kBindingComposeSpecularAmbient},
+                                              bands)) {}
 
 void ComposePass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& emissions) {
   const auto& b = frame.band(band);

@@ -7,12 +7,8 @@
 namespace obscura::render {
 
 LightMixPass::LightMixPass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, [&] {
-        gpu::KernelDesc desc = gpu::storageKernelDesc("lightmix", kSpirv_lightmix, gpu::kLightMixBindingCount,
-                                                      sizeof(gpu::LightMixPush), bands);
-        desc.bindings[gpu::kBindingLightMixResolved] = gpu::BindingKind::UniformTexelBuffer;
-        return desc;
-      }()) {}
+    : kernel_(context, gpu::storageKernelDesc("lightmix", kSpirv_lightmix, gpu::kLightMixBindingCount,
+                                              sizeof(gpu::LightMixPush), {gpu::kBindingLightMixResolved}, bands)) {}
 
 void LightMixPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const gpu::Buffer& emissions) {
   kernel_.bind(gpu::kBindingLightMixResolved, frame.band(band).resolved, band);

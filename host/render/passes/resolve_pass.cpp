@@ -5,14 +5,11 @@
 namespace obscura::render {
 
 ResolvePass::ResolvePass(const gpu::Context& context, std::uint32_t bands)
-    : kernel_(context, [&] {
-        gpu::KernelDesc desc = gpu::storageKernelDesc("resolve", kSpirv_resolve, gpu::kResolveBindingCount,
-                                                      sizeof(gpu::ResolvePush), bands);
-        for (std::uint32_t sums : {gpu::kBindingResolveBasis, gpu::kBindingResolveAmbient, gpu::kBindingResolveEmissionBasis,
-                                     gpu::kBindingResolveSpecularBasis, gpu::kBindingResolveSpecularAmbient})
-          desc.bindings[sums] = gpu::BindingKind::UniformTexelBuffer;
-        return desc;
-      }()) {}
+    : kernel_(context, gpu::storageKernelDesc("resolve", kSpirv_resolve, gpu::kResolveBindingCount, sizeof(gpu::ResolvePush),
+                                              {gpu::kBindingResolveBasis, gpu::kBindingResolveAmbient,
+                                               gpu::kBindingResolveEmissionBasis, gpu::kBindingResolveSpecularBasis,
+                                               gpu::kBindingResolveSpecularAmbient},
+                                              bands)) {}
 
 void ResolvePass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
   const auto& b = frame.band(band);
