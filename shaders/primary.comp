@@ -50,7 +50,9 @@ void main() {
   uvec2 p = bp.frame;
   uint pixel = bp.index;
   uint sampleIndex = pc.frame.z;
-  bool first = sampleIndex == 0u;
+  // A farm's part (render --samples A:B) accumulates from sample A of the frame's sequence.
+  const uint firstSample = pc.accumulation.x;
+  bool first = sampleIndex == firstSample;
   const uint lightCount = pc.band.z;
   const bool accumulateSums = (pc.band.w & kPrimaryFlagGBufferOnly) == 0u;
   const bool accumulateAovs = kAovs && accumulateSums && (pc.band.w & kPrimaryFlagNoAovs) == 0u;
@@ -102,10 +104,10 @@ void main() {
   }
   gbuffer[pixel] = g;
   if (!accumulateSums) return;
-  // Every sum of the pixel restarts at its sample 0 (a whole frame's, or a dirty pixel's retrace),
-  // and so does its count, which is therefore the sample index + 1 (a store, not a load and a
+  // Every sum of the pixel restarts at its first sample (a whole frame's, or a dirty pixel's retrace),
+  // and so does its count, which is therefore the sample index + 1 - first (a store, not a load and a
   // store): compose divides each pixel by its own.
-  sampleCounts[pixel] = sampleIndex + 1u;
+  sampleCounts[pixel] = sampleIndex + 1u - firstSample;
 
   // The box of the pixel's hits over its samples, for the dirty pixels of a geometry edit
   // (specular.comp adds its paths' vertices, and w = 1 when one left the scene).

@@ -23,5 +23,6 @@ void addCompareCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
 void addRecoverCommand(CLI::App& app);
 void addRemodelCommand(CLI::App& app);
+void addMergeCommand(CLI::App& app);
 
 } // namespace obscura::app

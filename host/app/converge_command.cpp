@@ -28,6 +28,7 @@
 #include "app/render_options.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
+#include "farm/merge.h"
 #include "io/image_io.h"
 #include "analysis/convergence.h"
 #include "analysis/image_error.h"
@@ -53,6 +54,10 @@ struct ConvergeOptions {
   std::uint32_t pathMaxSpp = 256;
   std::uint32_t referenceFactor = 64;   // a reference has this many times the largest curve's spp
   std::uint32_t pathReferenceSpp = 0;   // 0: referenceFactor x pathMaxSpp
+  // A merged farm render (`obscura merge`'s EXR of --method pathtrace parts) to take as the path
+  // tracing reference instead of rendering it here: the longest render of a study, spread over a
+  // cluster (tools/farm/).
+  std::string pathReferenceFile;
   std::uint32_t seed = 1;
   float dMax = 0.0f; // 0: the renderer's default
   float secondaryReflectors = 0.0f; // > 0: one more method, obscurances with secondary reflectors
@@ -198,8 +203,36 @@ public:
     return r;
   }
 
+  // The path tracing reference from a merged farm render, checked to be of this study's image:
+  // the same scene (hash), camera, size, depth and sky.
+  io::Image farmReference() const {
+    const std::string& file = o_.pathReferenceFile;
+    const io::Image image = io::readImage(file);
+    const std::string* text = image.attribute(farm::kMergedAttribute);
+    if (!text) throw InputError(fmt::format("{}: not a merged farm render (no {} attribute; 'obscura merge' writes it)",
+                                            file, farm::kMergedAttribute));
+    const nlohmann::json job = nlohmann::json::parse(*text, nullptr, false);
+    auto mismatch = [&](const std::string& what, const nlohmann::json& theirs, const nlohmann::json& ours) {
+      return InputError(fmt::format("{}: a reference of another image: its {} is {}, this study's {}", file, what,
+                                    theirs.dump(), ours.dump()));
+    };
+    if (!job.is_object() || !job.contains("method")) throw InputError(fmt::format("{}: its job description is malformed", file));
+    if (job.at("method") != "pathtrace") throw mismatch("method", job.at("method"), "pathtrace");
+    if (job.at("scene") != farm::sceneHash(o_.scenePath)) throw mismatch("scene", job.at("scene"), o_.scenePath);
+    if (job.at("width") != width_ || job.at("height") != height_)
+      throw mismatch("size", {job.at("width"), job.at("height")}, {width_, height_});
+    if (job.at("camera") != -1) throw mismatch("camera", job.at("camera"), -1);
+    if (job.at("max_depth") != render::PathTraceSettings{}.maxDepth)
+      throw mismatch("max depth", job.at("max_depth"), render::PathTraceSettings{}.maxDepth);
+    if (job.at("background") != nlohmann::json(o_.background)) throw mismatch("background", job.at("background"), o_.background);
+    if (image.channelIndex("combined.R") < 0) throw InputError(fmt::format("{}: no combined channels", file));
+    fmt::print("reference pathtrace: the farm render {} ({} spp)\n", file, job.at("spp").dump());
+    return combinedOnly(image);
+  }
+
   // The converged image of a method, from the cache when the same settings made it.
   io::Image reference(const Method& m) {
+    if (m.pathTrace && !o_.pathReferenceFile.empty()) return farmReference();
     std::uint32_t spp = m.pathTrace ? (o_.pathReferenceSpp ? o_.pathReferenceSpp : o_.referenceFactor * o_.pathMaxSpp)
                                     : o_.referenceFactor * o_.obscuranceMaxSpp;
     fs::path exr = fs::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
@@ -451,6 +484,10 @@ void addConvergeCommand(CLI::App& app) {
   cmd->add_option("--reference-factor", o->referenceFactor, "reference spp = factor x largest curve spp (>= 64 per SPEC)")
       ->check(CLI::Range(1u, 4096u));
   cmd->add_option("--pt-reference-spp", o->pathReferenceSpp, "path-tracing reference spp (default: factor x --pt-max-spp)");
+  cmd->add_option("--pt-reference", o->pathReferenceFile,
+                  "a merged farm render to use as the path-tracing reference instead of rendering it (obscura merge's "
+                  "EXR of 'render --method pathtrace --width W' parts of this scene; tools/farm/)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--seed", o->seed, "seed");
   cmd->add_option("--dmax", o->dMax, "obscurance dmax (default: the renderer's, half the median free path)")
       ->check(CLI::PositiveNumber);

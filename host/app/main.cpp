@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   obscura::app::addViewCommand(app);
   obscura::app::addRecoverCommand(app);
   obscura::app::addRemodelCommand(app);
+  obscura::app::addMergeCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -11,6 +11,7 @@
 
 #include "app/commands.h"
 #include "app/render_options.h"
+#include "app/render_part.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
 #include "gpu/buffer.h"
@@ -130,6 +131,10 @@ void writeOutputs(const RenderOptions& o, const io::Image& image, const render::
 }
 
 void runRender(RenderOptions& o) {
+  if (isPartRender(o)) {
+    renderPart(o);
+    return;
+  }
   std::string ext = io::extensionOf(o.output);
   if (ext != "exr" && ext != "png")
     throw InputError(fmt::format("{}: the output must be .exr or .png", o.output));
@@ -265,6 +270,12 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_flag("--denoise", options->denoise,
                  "denoise the obscurance frame (render/denoise/: demodulated direct and ambient terms, edge-aware "
                  "a-trous filter): the PNG of combined shows it, the EXR gets a `denoised` layer");
+  cmd->add_option("--samples", options->partSamples,
+                  "A:B: render only samples A (included) to B (excluded) of --spp, as a part of a farm render "
+                  "(written as sums to -o part.exr; 'obscura merge' adds the parts up; tools/farm/)");
+  cmd->add_option("--tile", options->partTile,
+                  "I/T: render only the I-th (0-based) of T strips of whole rows, as a part of a farm render "
+                  "(with or without --samples)");
   addDeviceOptions(*cmd, options->device);
   cmd->callback([options] { runRender(*options); });
 }

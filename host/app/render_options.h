@@ -40,6 +40,9 @@ struct RenderOptions {
   std::string dirtyTest = "auto";
   std::vector<float> background; // R,G,B radiance of the sky; empty: none
   bool denoise = false;          // render only: the denoised combined image too (render/denoise/)
+  // render only: a farm's part (host/farm/part.h): samples "A:B" of --spp and tile "I/T"; empty:
+  // the whole frame.
+  std::string partSamples, partTile;
   DeviceOptions device;
 };
 

@@ -82,6 +82,8 @@ void writeUncompressedExr(const std::string& path, const std::string& shownPath,
   out.attribute("pixelAspectRatio", "float", [&] { out.put<float>(1.0f); });
   out.attribute("screenWindowCenter", "v2f", [&] { out.put<float>(0.0f), out.put<float>(0.0f); });
   out.attribute("screenWindowWidth", "float", [&] { out.put<float>(1.0f); });
+  for (const auto& [name, text] : image.attributes) // "string": the bytes, no terminator
+    out.attribute(name, "string", [&] { for (char c : text) out.put<char>(c); });
   out.put<std::uint8_t>(0); // end of header
 
   // Offset table: one chunk per scan line without compression. The chunks stream to the file one

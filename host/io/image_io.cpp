@@ -23,6 +23,12 @@ int Image::channelIndex(const std::string& name) const {
   return it == channels.end() ? -1 : static_cast<int>(it - channels.begin());
 }
 
+const std::string* Image::attribute(const std::string& name) const {
+  for (const auto& [key, text] : attributes)
+    if (key == name) return &text;
+  return nullptr;
+}
+
 std::string extensionOf(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);
@@ -108,6 +114,7 @@ void writeExr(const std::string& path, const Image& image) {
   OIIO::ImageSpec spec(image.width, image.height, image.channelCount(), OIIO::TypeDesc::FLOAT);
   spec.channelnames = image.channels;
   spec.attribute("compression", "zip");
+  for (const auto& [name, text] : image.attributes) spec.attribute(name, text);
   writeAtomically(path, [&](const std::string& temp) {
     writeWithOiio(temp, path, spec, OIIO::TypeDesc::FLOAT, image.pixels.data());
   });
@@ -146,6 +153,9 @@ Image readImage(const std::string& path) {
   image.width = spec.width;
   image.height = spec.height;
   image.channels = spec.channelnames;
+  for (const OIIO::ParamValue& p : spec.extra_attribs)
+    if (p.type() == OIIO::TypeDesc::STRING && p.name().string().rfind("obscura:", 0) == 0)
+      image.attributes.emplace_back(p.name().string(), p.get_string());
   image.pixels.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
     throw InputError(fmt::format("{}: cannot read image: {}", path, in->geterror()));

@@ -8,6 +8,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace obscura::io {
@@ -16,11 +17,17 @@ struct Image {
   int width = 0, height = 0;
   std::vector<std::string> channels; // names, e.g. {"R","G","B"} or {"albedo.R", …}
   std::vector<float> pixels;         // interleaved, rows top to bottom
+  // Text attributes an EXR carries in its header, named "obscura:..." (a farm's part and a merged
+  // frame say which job they belong to, host/farm/). Other formats drop them; readImage reads
+  // back only those named "obscura:...".
+  std::vector<std::pair<std::string, std::string>> attributes;
 
   int channelCount() const { return static_cast<int>(channels.size()); }
   float& at(int x, int y, int c) { return pixels[(std::size_t(y) * width + x) * channels.size() + c]; }
   float at(int x, int y, int c) const { return pixels[(std::size_t(y) * width + x) * channels.size() + c]; }
   int channelIndex(const std::string& name) const; // -1 when absent
+  // The attribute `name`'s text; nullptr when absent.
+  const std::string* attribute(const std::string& name) const;
 };
 
 // Writes an EXR (float, all channels). Throws InputError naming the path on failure.

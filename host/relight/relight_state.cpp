@@ -60,11 +60,7 @@ void saveState(const std::string& dir, const render::ObscuranceRenderer& rendere
   saveState(dir, renderer, renderer.transport(), scenePath);
 }
 
-void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const render::Transport& transport,
-               const std::string& scenePath) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw InputError(fmt::format("{}: cannot create the state folder", dir));
+nlohmann::json stateJson(const render::ObscuranceRenderer& renderer, const std::string& scenePath) {
   const auto& lights = renderer.lights();
   const auto& s = renderer.settings();
   nlohmann::json json = {
@@ -85,11 +81,23 @@ void saveState(const std::string& dir, const render::ObscuranceRenderer& rendere
     json["lights"].push_back({{"name", lights.names[i]}, {"type", lightTypeName(lights.lights[i].info.x)},
                               {"emission", vec3Json(renderer.emissions()[i])},
                               {"ambient_weight", vec3Json(renderer.ambient().weight[i])}});
+  return json;
+}
+
+void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const render::Transport& transport,
+               const std::string& scenePath) {
+  saveState(dir, stateJson(renderer, scenePath), transport);
+}
+
+void saveState(const std::string& dir, const nlohmann::json& state, const render::Transport& transport) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw InputError(fmt::format("{}: cannot create the state folder", dir));
   io::writeExr((fs::path(dir) / "transport.exr").string(), transport.toImage());
   const std::string path = (fs::path(dir) / "state.json").string(), temp = path + ".tmp";
   {
     std::ofstream out(temp);
-    out << json.dump(2) << "\n";
+    out << state.dump(2) << "\n";
     if (!out) throw InputError(fmt::format("{}: cannot write", path));
   }
   if (std::rename(temp.c_str(), path.c_str()) != 0) {

@@ -48,6 +48,11 @@ void saveState(const std::string& dir, const render::ObscuranceRenderer& rendere
 void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const render::Transport& transport,
                const std::string& scenePath);
 
+// What state.json says of a renderer's frame (its samples so far among it).
+nlohmann::json stateJson(const render::ObscuranceRenderer& renderer, const std::string& scenePath);
+// Writes DIR from state.json's contents and the resolved transport (a farm's merged parts).
+void saveState(const std::string& dir, const nlohmann::json& state, const render::Transport& transport);
+
 // Reads DIR; InputError naming the file for a missing, truncated, foreign-version or inconsistent
 // state.
 RelightState loadState(const std::string& dir);

@@ -99,7 +99,7 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
                            .spareLightSlots = settings.spareLightSlots,
                            .keptRaySamples = keptRaySamples(context, settings, runSpecular_),
                            .keptShadowRays = keptShadowRays(settings)},
-             settings.maxBufferBytes, settings.maxTexelElements),
+             settings.maxBufferBytes, settings.maxTexelElements, settings.rows),
       sceneKernels_(sceneBuffers_.specialisation()),
       primary_(context, frame_.layout().bandCount(), sceneKernels_, settings.editableGeometry),
       shadow_(context, shadingKernels()),
@@ -236,7 +236,11 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
   if (settings.emissionSamples == 0 || settings.emissionSamples > gpu::kMaxEmissionSamples)
     throw InputError(fmt::format("--emission-samples {}: camera rays per sample for the seen emission must be in 1..{}",
                                  settings.emissionSamples, gpu::kMaxEmissionSamples));
-  if (settings.width != frame_.layout().width || settings.height != frame_.layout().height ||
+  if ((settings.firstSample > 0 || !settings.rows.whole()) && (settings.editableGeometry || settings.keptRaySamples > 0))
+    throw std::logic_error("ObscuranceRenderer: a part of a frame (firstSample, rows) is rendered, not edited");
+  if (settings.width != frame_.layout().width || settings.height != frame_.layout().imageHeight ||
+      settings.rows.first != frame_.layout().firstRow ||
+      (settings.rows.whole() ? settings.height : settings.rows.count) != frame_.layout().height ||
       settings.primaryAovs != frame_.contents().primaryAovs ||
       (settings.composedAovs ? gpu::kComposeSlots : 1u) != frame_.contents().composedSlots)
     throw std::logic_error("ObscuranceRenderer::configure: resolution and AOVs are the frame's; make a new renderer");
@@ -358,7 +362,7 @@ gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
                               (glossyMis ? gpu::kFlagGlossyMis : 0u) |
                               (reflectorsOn() ? gpu::kFlagSecondaryReflectors : 0u) |
                               (settings_.vertexRaysByThroughput ? gpu::kFlagVertexRaysByThroughput : 0u);
-  return {.frame = glm::uvec4(settings_.width, settings_.height, sample, settings_.seed),
+  return {.frame = glm::uvec4(settings_.width, settings_.height, settings_.firstSample + sample, settings_.seed),
           .counts = glm::uvec4(static_cast<std::uint32_t>(lights_.size()), settings_.shadowRays,
                                settings_.obscuranceRays, flags),
           .params = glm::vec4(dMax_, settings_.tau, static_cast<float>(settings_.rho),
@@ -424,7 +428,8 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   if (tracePrimary) {
     timestamps_.begin(cmd, label("primary"));
     for (std::uint32_t b = 0; b < bands; ++b)
-      primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, primaryFlags, dirtyOf);
+      primary_.record(cmd, b, layout, camera, {.index = settings_.firstSample + s, .first = settings_.firstSample},
+                      settings_.seed, lightCount, primaryFlags, dirtyOf);
     timestamps_.end(cmd, label("primary"));
     gpu::computeBarrier(cmd);
   }
@@ -736,7 +741,7 @@ io::Image ObscuranceRenderer::image() const {
       primary = resolvePrimaryAovs(downloadBand(frame_.band(b).aovs), layout.width, layout.bands[b].rows,
                                    frame_.band(b).sampleCounts.download<std::uint32_t>(*context_));
     const std::size_t pc = primary.channels.size();
-    const std::uint64_t first = std::uint64_t(layout.bands[b].firstRow) * layout.width;
+    const std::uint64_t first = layout.bandFirstPixel(b);
     for (std::uint64_t p = 0; p < layout.bandPixels(b); ++p) {
       float* out = &image.pixels[(first + p) * nc];
       std::size_t k = 0;
@@ -755,8 +760,14 @@ io::Image ObscuranceRenderer::image() const {
 }
 
 Transport ObscuranceRenderer::transport() const {
+  Sums s = sums();
+  return resolveSums(std::move(s.transport), s.counts);
+}
+
+ObscuranceRenderer::Sums ObscuranceRenderer::sums() const {
   const FrameLayout& layout = frame_.layout();
-  Transport t;
+  Sums out;
+  Transport& t = out.transport;
   t.width = static_cast<int>(layout.width);
   t.height = static_cast<int>(layout.height);
   t.lights = lights_.names;
@@ -769,6 +780,9 @@ Transport ObscuranceRenderer::transport() const {
     t.specularAmbient.resize(layout.pixels());
   }
   t.ambient.resize(layout.pixels());
+  out.counts.resize(layout.pixels());
+  const bool primaryAovs = frame_.contents().primaryAovs;
+  if (primaryAovs) out.primaryAovs.resize(layout.pixels() * gpu::kAovSlots);
   // Accumulators are Kahan pairs: the sum of entry i is element i * kAccumulatorVec4s.
   auto sum = [](const std::vector<glm::vec4>& v, std::uint64_t i) { return v[i * gpu::kAccumulatorVec4s]; };
   for (std::uint32_t b = 0; b < layout.bandCount(); ++b) {
@@ -777,21 +791,25 @@ Transport ObscuranceRenderer::transport() const {
     const auto ambient = downloadBand(band.ambient.buffer());
     const std::vector<glm::vec4> specularBasis = runSpecular_ ? downloadBand(band.specularBasis.buffer()) : std::vector<glm::vec4>();
     const std::vector<glm::vec4> specularAmbient = runSpecular_ ? downloadBand(band.specularAmbient.buffer()) : std::vector<glm::vec4>();
+    const std::vector<glm::vec4> aovs = primaryAovs ? downloadBand(band.aovs) : std::vector<glm::vec4>();
     const auto counts = band.sampleCounts.download<std::uint32_t>(*context_);
     const std::uint64_t px = layout.bandPixels(b);
-    const std::uint64_t first = std::uint64_t(layout.bands[b].firstRow) * layout.width;
+    const std::uint64_t first = layout.bandFirstPixel(b);
     for (std::uint64_t p = 0; p < px; ++p) {
-      const float inv = 1.0f / static_cast<float>(std::max(counts[p], 1u)); // compose.comp's divisor
-      t.ambient[first + p] = sum(ambient, p) * inv;
-      if (runSpecular_) t.specularAmbient[first + p] = glm::vec3(sum(specularAmbient, p)) * inv;
-      for (std::size_t s = 0; s < lights; ++s) {
-        t.direct[s][first + p] = glm::vec3(sum(basis, s * px + p)) * inv;
-        t.seen[s][first + p] = glm::vec3(sum(seen, s * px + p)) * inv;
-        if (runSpecular_) t.specularDirect[s][first + p] = glm::vec3(sum(specularBasis, s * px + p)) * inv;
+      out.counts[first + p] = counts[p];
+      t.ambient[first + p] = sum(ambient, p);
+      if (runSpecular_) t.specularAmbient[first + p] = glm::vec3(sum(specularAmbient, p));
+      for (std::size_t l = 0; l < lights; ++l) {
+        t.direct[l][first + p] = glm::vec3(sum(basis, l * px + p));
+        t.seen[l][first + p] = glm::vec3(sum(seen, l * px + p));
+        if (runSpecular_) t.specularDirect[l][first + p] = glm::vec3(sum(specularBasis, l * px + p));
       }
+      if (primaryAovs)
+        for (std::uint32_t slot = 0; slot < gpu::kAovSlots; ++slot)
+          out.primaryAovs[(first + p) * gpu::kAovSlots + slot] = sum(aovs, p * gpu::kAovSlots + slot);
     }
   }
-  return t;
+  return out;
 }
 
 std::vector<std::uint32_t> ObscuranceRenderer::sampleCounts() const {
@@ -884,7 +902,8 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
         if (s != gbufferSample_) {
           timestamps_.begin(cmd, "primary");
           for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
-            primary_.record(cmd, b, layout, camera, s, settings_.seed, lightCount, gpu::kPrimaryFlagGBufferOnly);
+            primary_.record(cmd, b, layout, camera, {.index = settings_.firstSample + s, .first = settings_.firstSample},
+                            settings_.seed, lightCount, gpu::kPrimaryFlagGBufferOnly);
           timestamps_.end(cmd, "primary");
           gpu::computeBarrier(cmd);
           primaryPixels += layout.pixels();

@@ -66,6 +66,13 @@ enum class DirtyTest { Auto, Bounds, Probe };
 struct ObscuranceSettings {
   std::uint32_t width = 512, height = 512;
   std::uint32_t spp = 8;             // primary samples (iterations) per pixel
+  // A part of a frame (a render farm's task, host/farm/): the accumulation starts at sample
+  // `firstSample` of the frame's sequence (the same seeds and sub-pixel positions a single process
+  // gives those samples), and the frame holds only the rows `rows` of the width x height image
+  // (every pixel as the whole frame would render it). Only for a renderer that does not edit
+  // (editableGeometry false, no kept rays).
+  std::uint32_t firstSample = 0;
+  RowRange rows;
   // Camera rays per primary sample for the emission the camera sees (M_s), 1..64: above 1, that
   // many cheap rays of their own (a closest hit, no shading) estimate it instead of the primary
   // ray, which sharpens the edges of bright emitters seen directly (lib/emission_samples.glsl).
@@ -222,6 +229,15 @@ public:
   // The samples each pixel's sums hold, row by row (compose divides by them): samples() everywhere
   // once a frame or an edit's retrace is done.
   std::vector<std::uint32_t> sampleCounts() const;
+  // The frame's sums as they are, not divided by the sample counts (what a farm's part keeps so
+  // that parts merge exactly, host/farm/): the per-light transport's sums, the primary pass's AOV
+  // accumulators (gpu::kAovSlots vec4 sums a pixel, kAovIds as written) and the counts.
+  struct Sums {
+    Transport transport;                   // sums, not means
+    std::vector<glm::vec4> primaryAovs;    // [pixel * kAovSlots + slot]; empty without primary AOVs
+    std::vector<std::uint32_t> counts;     // [pixel]
+  };
+  Sums sums() const;
   const ObscuranceSettings& settings() const { return settings_; }
   const FrameLayout& layout() const { return frame_.layout(); }
   // The frame's buffers, for passes outside the renderer that read them (the denoiser).

@@ -52,13 +52,13 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
       lights_(buildLightSet(scene)),
       layout_(FrameLayout::split(settings.width, settings.height, kAccumulator,
                                  maxBufferBytes ? maxBufferBytes : context.info().maxStorageBufferRange,
-                                 "the radiance accumulator")),
+                                 "the radiance accumulator", settings.rows)),
       kernel_(context, pathKernelDesc(layout_.bandCount(), sceneBuffers_.specialisation())), stream_(context),
       timestamps_(context) {
-  if (pathTraceBytesNeeded(settings.width, settings.height) > context.info().deviceLocalBytes)
+  if (pathTraceBytesNeeded(settings.width, layout_.height) > context.info().deviceLocalBytes)
     throw InputError(fmt::format("{}x{}: path tracing needs {:.1f} MiB, more than the device offers", settings.width,
-                                 settings.height,
-                                 static_cast<double>(pathTraceBytesNeeded(settings.width, settings.height)) / 1048576.0));
+                                 layout_.height,
+                                 static_cast<double>(pathTraceBytesNeeded(settings.width, layout_.height)) / 1048576.0));
   lightBuffer_ = tableTexels(context, lights_.lights, "lights", "pathtrace.lights");
   emitterBuffer_ = tableTexels(context, lights_.emitters, "emissive triangles", "pathtrace.emitters");
   treeBuffer_ = gpu::uploadArray(context, buildLightTree(lights_.lights), "pathtrace.light_tree");
@@ -79,7 +79,8 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
 
 void PathTracer::configure(const PathTraceSettings& settings) {
   checked(settings);
-  if (settings.width != settings_.width || settings.height != settings_.height)
+  if (settings.width != settings_.width || settings.height != settings_.height ||
+      settings.rows.first != settings_.rows.first || settings.rows.count != settings_.rows.count)
     throw std::logic_error("PathTracer::configure: the resolution is the frame's; make a new path tracer");
   settings_ = settings;
   reset();
@@ -119,7 +120,7 @@ void PathTracer::iterate(std::uint32_t samples, const ProgressFn& progress) {
       timestamps_.begin(cmd, "pathtrace");
       for (std::uint32_t s = samples_; s < last; ++s) {
         if (s > samples_) gpu::computeBarrier(cmd);
-        push.frame.z = s;
+        push.frame.z = settings_.firstSample + s;
         for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
           push.band.x = layout_.bands[b].firstRow;
           push.band.y = layout_.bands[b].rows;
@@ -143,18 +144,24 @@ void PathTracer::render(const ProgressFn& progress) {
 }
 
 io::Image PathTracer::image() const {
+  io::Image image = sums();
+  const float inv = 1.0f / static_cast<float>(std::max(samples_, 1u));
+  for (float& v : image.pixels) v *= inv;
+  return image;
+}
+
+io::Image PathTracer::sums() const {
   io::Image image;
-  image.width = static_cast<int>(settings_.width);
-  image.height = static_cast<int>(settings_.height);
+  image.width = static_cast<int>(layout_.width);
+  image.height = static_cast<int>(layout_.height);
   image.channels = aovChannels("combined");
   image.pixels.resize(layout_.pixels() * 3);
-  const float inv = 1.0f / static_cast<float>(std::max(samples_, 1u));
   for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
     // The shader never adds a non-finite sample (it counts it in .w instead).
     const auto sums = radiance_[b].download<glm::vec4>(*context_);
-    const std::uint64_t first = std::uint64_t(layout_.bands[b].firstRow) * settings_.width;
+    const std::uint64_t first = layout_.bandFirstPixel(b);
     for (std::uint64_t p = 0; p < layout_.bandPixels(b); ++p)
-      for (int c = 0; c < 3; ++c) image.pixels[(first + p) * 3 + c] = sums[p * gpu::kAccumulatorVec4s][c] * inv;
+      for (int c = 0; c < 3; ++c) image.pixels[(first + p) * 3 + c] = sums[p * gpu::kAccumulatorVec4s][c];
   }
   return image;
 }

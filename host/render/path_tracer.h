@@ -41,6 +41,10 @@ struct PathTraceSettings {
   LightSampling lightSampling = LightSampling::Spatial; // next-event estimation's light sampling
   // Camera rays per path for the emission the camera sees, 1..64 (as ObscuranceSettings's).
   std::uint32_t emissionSamples = 1;
+  // A farm's part (host/farm/): paths from sample `firstSample` of the frame's sequence on, for
+  // the rows `rows` of the width x height image only (as ObscuranceSettings's).
+  std::uint32_t firstSample = 0;
+  RowRange rows;
 };
 
 // The largest maxDepth accepted (each vertex costs loop passes of lavapipe's limiter; a deeper
@@ -65,6 +69,8 @@ public:
 
   // combined.R/G/B: the mean radiance per pixel so far.
   io::Image image() const;
+  // combined.R/G/B: the radiance sums per pixel so far, not divided by samples() (a farm's part).
+  io::Image sums() const;
   // Samples dropped because they were NaN or inf (expect 0).
   std::uint64_t nonFiniteSamples() const;
   RenderStats stats() const;

@@ -1,5 +1,8 @@
 #include "render/transport.h"
 
+#include <algorithm>
+#include <stdexcept>
+
 #include <fmt/format.h>
 
 #include "core/error.h"
@@ -35,6 +38,21 @@ glm::vec3 indirectIntensity(const std::vector<glm::vec3>& emissions, const std::
 }
 
 } // namespace
+
+Transport resolveSums(Transport t, const std::vector<std::uint32_t>& counts) {
+  if (counts.size() != t.pixels()) throw std::logic_error("resolveSums: one count per pixel");
+  for (std::size_t p = 0; p < t.pixels(); ++p) {
+    const float inv = 1.0f / static_cast<float>(std::max(counts[p], 1u)); // compose.comp's divisor
+    t.ambient[p] *= inv;
+    if (t.specular) t.specularAmbient[p] *= inv;
+    for (std::size_t l = 0; l < t.lights.size(); ++l) {
+      t.direct[l][p] *= inv;
+      t.seen[l][p] *= inv;
+      if (t.specular) t.specularDirect[l][p] *= inv;
+    }
+  }
+  return t;
+}
 
 io::Image Transport::toImage() const {
   io::Image image;

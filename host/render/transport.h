@@ -36,6 +36,11 @@ struct Transport {
                              const std::string& file);
 };
 
+// Sums over samples (`sums`, each pixel's over counts[pixel] samples) divided by their counts as
+// compose.comp divides them (by max(count, 1), as a float reciprocal): a frame's resolved
+// transport, whether its sums come from one renderer or from a farm's merged parts.
+Transport resolveSums(Transport sums, const std::vector<std::uint32_t>& counts);
+
 // compose.comp's C++ twin: the AOVs combined, direct, indirect, specular, obscurance, emission
 // (obscuranceAovNames' first five plus emission) with emissions E_s and I_a = sum_s E_s w_s.
 io::Image composeTransport(const Transport& transport, const std::vector<glm::vec3>& emissions,

@@ -246,7 +246,9 @@ struct PrimaryPush {
   GpuCamera camera;   // 0
   uvec4 frame;        // 64: width, height (of the whole frame), sample index, seed
   uvec4 band;         // 80: first row, rows, light count, flags (kPrimaryFlag*)
-};                    // 96 bytes
+  uvec4 accumulation; // 96: x = the sample the accumulation started at (0 but for a farm's part,
+                      //     render --samples A:B), unused
+};                    // 112 bytes
 // The primary pass re-creates the G-buffer of a sample without adding to the AOV and emission
 // accumulators (an added light traces its shadow rays from the same primary hits).
 OBS_CONST uint kPrimaryFlagGBufferOnly = 1u;

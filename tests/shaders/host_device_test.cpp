@@ -26,7 +26,7 @@ static_assert(sizeof(GpuRay) == 32);
 static_assert(sizeof(GpuHit) == 16 && offsetof(GpuHit, primitive) == 12);
 static_assert(sizeof(GpuCamera) == 64);
 static_assert(sizeof(GBufferTexel) == 64 && offsetof(GBufferTexel, albedo) == 48);
-static_assert(sizeof(PrimaryPush) == 96 && offsetof(PrimaryPush, band) == 80 && sizeof(PrimaryPush) <= 128);
+static_assert(sizeof(PrimaryPush) == 112 && offsetof(PrimaryPush, accumulation) == 96 && sizeof(PrimaryPush) <= 128);
 static_assert(sizeof(TracePush) == 16);
 static_assert(sizeof(PathPush) == 112 && offsetof(PathPush, band) == 96 && sizeof(PathPush) <= 128);
 static_assert(sizeof(ShadePush) == 112 && offsetof(ShadePush, reflectors) == 96 && sizeof(ComposePush) == 48);
@@ -53,7 +53,7 @@ struct LayoutBlock {
   gpu::GpuLight light;
   gpu::GpuEmitter emitter;
 };
-static_assert(sizeof(LayoutBlock) == 180 * 4);
+static_assert(sizeof(LayoutBlock) == 184 * 4);
 
 class HostDeviceLayout : public GpuTest {};
 
@@ -68,7 +68,8 @@ TEST_F(HostDeviceLayout, GlslWritesEveryFieldWhereCppReadsIt) {
   out.download(context(), &block, sizeof(block));
   // Word i holds the value i (as float, int or uint as the field's type says).
   const auto* words = reinterpret_cast<const std::uint32_t*>(&block);
-  const std::size_t intWords[] = {64, 65, 66, 67, 72, 73, 74, 75, 87, 136, 137, 138, 139, 140, 141, 142, 143, 144, 145, 146, 147, 156, 157, 158, 159};
+  const std::size_t intWords[] = {64, 65, 66, 67, 72, 73, 74, 75, 87, 136, 137, 138, 139, 140, 141, 142, 143,
+                                  144, 145, 146, 147, 148, 149, 150, 151, 160, 161, 162, 163};
   for (std::size_t i = 0; i < sizeof(LayoutBlock) / 4; ++i) {
     bool isInt = std::find(std::begin(intWords), std::end(intWords), i) != std::end(intWords);
     if (isInt) {
@@ -85,8 +86,9 @@ TEST_F(HostDeviceLayout, GlslWritesEveryFieldWhereCppReadsIt) {
   EXPECT_EQ(block.primaryPush.frame.x, 136u);
   EXPECT_EQ(block.gtexel.albedo.w, 119.0f);
   EXPECT_EQ(block.primaryPush.band.w, 143u);
-  EXPECT_EQ(block.light.info.x, 156u);
-  EXPECT_EQ(block.emitter.radiance.w, 179.0f);
+  EXPECT_EQ(block.primaryPush.accumulation.x, 144u);
+  EXPECT_EQ(block.light.info.x, 160u);
+  EXPECT_EQ(block.emitter.radiance.w, 183.0f);
 }
 
 } // namespace

@@ -34,8 +34,8 @@ void main() {
   hit = GpuHit(84.0, 85.0, 86.0, 87u);
   camera = GpuCamera(f4(88.0), f4(92.0), f4(96.0), f4(100.0));
   gtexel = GBufferTexel(f4(104.0), f4(108.0), f4(112.0), f4(116.0));
-  primaryPush = PrimaryPush(GpuCamera(f4(120.0), f4(124.0), f4(128.0), f4(132.0)), u4(136u), u4(140u));
-  tracePush = TracePush(u4(144u));
-  light = GpuLight(f4(148.0), f4(152.0), u4(156u), f4(160.0));
-  emitter = GpuEmitter(f4(164.0), f4(168.0), f4(172.0), f4(176.0));
+  primaryPush = PrimaryPush(GpuCamera(f4(120.0), f4(124.0), f4(128.0), f4(132.0)), u4(136u), u4(140u), u4(144u));
+  tracePush = TracePush(u4(148u));
+  light = GpuLight(f4(152.0), f4(156.0), u4(160u), f4(164.0));
+  emitter = GpuEmitter(f4(168.0), f4(172.0), f4(176.0), f4(180.0));
 }

@@ -16,19 +16,37 @@ struct FrameBand {
   std::uint32_t rows = 0;
 };
 
+// Rows [first, first + count) of an image: the part of it a frame holds (a farm's tile,
+// `render --tile`). count 0: every row.
+struct RowRange {
+  std::uint32_t first = 0, count = 0;
+  bool whole() const { return first == 0 && count == 0; }
+};
+
 struct FrameLayout {
+  // The frame's own pixels: `width` x `height`. A frame may hold only some rows of the image the
+  // camera sees (a tile): they start at row `firstRow` of an image `imageHeight` rows high. Bands'
+  // firstRow are rows of that image (the shaders' pixel coordinates, so a tile's pixels are
+  // bit-identical to the same pixels of the whole frame).
   std::uint32_t width = 0, height = 0;
   std::vector<FrameBand> bands;
+  std::uint32_t firstRow = 0, imageHeight = 0;
 
   std::uint64_t bandPixels(std::size_t band) const { return std::uint64_t(width) * bands[band].rows; }
+  // Where band `band` starts in the frame's own pixels (row-major, `height` rows).
+  std::uint64_t bandFirstPixel(std::size_t band) const {
+    return std::uint64_t(bands[band].firstRow - firstRow) * width;
+  }
   std::uint64_t pixels() const { return std::uint64_t(width) * height; }
   std::uint32_t bandCount() const { return static_cast<std::uint32_t>(bands.size()); }
 
   // Bands as tall as `largestBytesPerPixel` (the widest per-pixel buffer) lets them be within
   // `maxBufferBytes`, all of one height but the last. Throws InputError when even one row does
   // not fit; `what` names the cause for that message.
+  // `rows` (not whole) keeps only those rows of the `height`-row image (InputError when they are
+  // not inside it).
   static FrameLayout split(std::uint32_t width, std::uint32_t height, std::uint64_t largestBytesPerPixel,
-                           std::uint64_t maxBufferBytes, const char* what);
+                           std::uint64_t maxBufferBytes, const char* what, RowRange rows = {});
 };
 
 } // namespace obscura::render

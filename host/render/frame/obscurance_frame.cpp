@@ -61,7 +61,7 @@ std::uint64_t ObscuranceFrame::bytesNeeded(std::uint32_t width, std::uint32_t he
 
 ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t width, std::uint32_t height,
                                  std::uint32_t lights, const FrameContents& contents, std::uint64_t maxBufferBytes,
-                                 std::uint64_t maxTexelElements)
+                                 std::uint64_t maxTexelElements, RowRange rows)
     : context_(&context), lights_(lights), maxLights_(lights + contents.spareLightSlots), contents_(contents) {
   const bool specular = contents.specular;
   const std::uint64_t limit = maxBufferBytes > 0 ? maxBufferBytes : context.info().maxStorageBufferRange;
@@ -79,7 +79,8 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
   const std::uint64_t byGBuffer = maxTexels / gpu::kTexelsPerGBuffer;
   const std::uint64_t bySums = maxTexels / (gpu::kAccumulatorVec4s * std::max<std::uint64_t>(maxLights_, 1));
   const std::uint64_t pixelBound = std::max<std::uint64_t>(std::min(byGBuffer, bySums), 1);
-  layout_ = FrameLayout::split(width, height, largest, std::min(limit, pixelBound * largest), "the per-light basis buffers");
+  layout_ = FrameLayout::split(width, height, largest, std::min(limit, pixelBound * largest), "the per-light basis buffers",
+                               rows);
   // The kept rays: as many samples as fit in one buffer of the largest band.
   std::uint64_t bandPixels = 1;
   for (std::size_t i = 0; i < layout_.bands.size(); ++i) bandPixels = std::max<std::uint64_t>(bandPixels, layout_.bandPixels(i));
@@ -87,7 +88,7 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
   contents_.keptRaySamples = static_cast<std::uint32_t>(
       std::min<std::uint64_t>(contents.keptRaySamples, limit / (bandPixels * keptPerSample)));
 
-  const std::uint64_t need = bytesNeeded(width, height, maxLights_, contents_);
+  const std::uint64_t need = bytesNeeded(width, layout_.height, maxLights_, contents_);
   if (need > context.info().deviceLocalBytes)
     throw InputError(fmt::format("{}x{} with {} light groups: the frame buffers need {:.1f} MiB, more than the device "
                                  "'{}' offers ({:.0f} MiB); merge light groups (--light-groups material) or render "

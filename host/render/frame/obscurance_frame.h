@@ -78,7 +78,7 @@ public:
   // limit (smaller ones test banding).
   ObscuranceFrame(const gpu::Context& context, std::uint32_t width, std::uint32_t height, std::uint32_t lights,
                   const FrameContents& contents, std::uint64_t maxBufferBytes = 0,
-                  std::uint64_t maxTexelElements = 0);
+                  std::uint64_t maxTexelElements = 0, RowRange rows = {});
 
   // The buffer kinds a frame allocates, from which both the allocation and the memory figures
   // are computed.

@@ -68,12 +68,14 @@ void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const Obsc
 }
 
 void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-                         const gpu::GpuCamera& camera, std::uint32_t sampleIndex, std::uint32_t seed,
+                         const gpu::GpuCamera& camera, Sample sample, std::uint32_t seed,
                          std::uint32_t lights, std::uint32_t flags, const ObscuranceFrame* dirtyOf) const {
   const FrameBand& rows = layout.bands[band];
+  // The camera sees the whole image (a tile's rows are rows of it).
   gpu::PrimaryPush push{.camera = camera,
-                        .frame = glm::uvec4(layout.width, layout.height, sampleIndex, seed),
-                        .band = glm::uvec4(rows.firstRow, rows.rows, lights, flags)};
+                        .frame = glm::uvec4(layout.width, layout.imageHeight, sample.index, seed),
+                        .band = glm::uvec4(rows.firstRow, rows.rows, lights, flags),
+                        .accumulation = glm::uvec4(sample.first, 0u, 0u, 0u)};
   const gpu::Kernel& kernel = kernelFor(flags);
   if (dirtyOf != nullptr) {
     kernel.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &push, band);

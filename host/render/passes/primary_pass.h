@@ -30,12 +30,19 @@ public:
   void bind(std::uint32_t band, const SceneBuffers& scene, const ObscuranceFrame& frame,
             const gpu::Buffer& lightScales);
 
-  // Records sample `sampleIndex` of band `band` (sample 0 restarts the accumulators). `flags`:
+  // Which sample a dispatch draws: `index` in the frame's sample sequence (seeds, sub-pixel
+  // position); the accumulation started at sample `first` (0 but for a farm's part), which
+  // restarts the accumulators, so each pixel's count is index + 1 - first.
+  struct Sample {
+    std::uint32_t index = 0;
+    std::uint32_t first = 0;
+  };
+  // Records sample `sample` of band `band`. `flags`:
   // kPrimaryFlagGBufferOnly makes the G-buffer again and accumulates nothing; kPrimaryFlagNoAovs
   // skips the AOV accumulators the frame does not keep. With kPrimaryFlagDirtyOnly, only the pixels
   // of `dirtyOf`'s dirty list for the band run (an indirect dispatch).
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-              const gpu::GpuCamera& camera, std::uint32_t sampleIndex, std::uint32_t seed, std::uint32_t lights,
+              const gpu::GpuCamera& camera, Sample sample, std::uint32_t seed, std::uint32_t lights,
               std::uint32_t flags, const ObscuranceFrame* dirtyOf = nullptr) const;
 
 private:
