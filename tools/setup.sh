@@ -1,6 +1,16 @@
 #!/usr/bin/env bash
 # Installs what Obscura needs on Debian 12 (idempotent; quick when everything is present).
+# --tests: also what only some tests need: Slurm and munge for tests/farm/slurm_test.sh, which
+# starts and stops a one-node cluster of its own. (On a systemd host Debian's packages enable
+# munge.service, and slurmctld/slurmd units that do not start without /etc/slurm/slurm.conf.)
 set -euo pipefail
+with_tests=0
+for arg in "$@"; do
+  case $arg in
+    --tests) with_tests=1 ;;
+    *) echo "usage: tools/setup.sh [--tests]" >&2; exit 2 ;;
+  esac
+done
 packages=(
   cmake ninja-build g++ pkg-config git
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools glslang-tools
@@ -11,6 +21,7 @@ packages=(
   clang libclang-rt-14-dev
   python3-matplotlib
 )
+((with_tests)) && packages+=(slurm-wlm munge)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

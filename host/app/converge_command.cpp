@@ -148,6 +148,8 @@ public:
     width_ = o.width;
     height_ = std::max(1u, static_cast<std::uint32_t>(std::lround(static_cast<float>(o.width) / aspect)));
     stem_ = fs::path(o.scenePath).stem().string();
+    // Checked before anything is rendered: a wrong reference fails the study at once.
+    if (!o.pathReferenceFile.empty()) farmReference_ = farmReference();
   }
 
   // Renders with the study's persistent renderers: the scene is uploaded and the pipelines are
@@ -232,7 +234,7 @@ public:
 
   // The converged image of a method, from the cache when the same settings made it.
   io::Image reference(const Method& m) {
-    if (m.pathTrace && !o_.pathReferenceFile.empty()) return farmReference();
+    if (m.pathTrace && !o_.pathReferenceFile.empty()) return farmReference_;
     std::uint32_t spp = m.pathTrace ? (o_.pathReferenceSpp ? o_.pathReferenceSpp : o_.referenceFactor * o_.pathMaxSpp)
                                     : o_.referenceFactor * o_.obscuranceMaxSpp;
     fs::path exr = fs::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
@@ -317,6 +319,7 @@ private:
   std::string stem_;
   mutable render::RenderStats statsCopy_;
   std::map<std::string, std::map<std::string, io::Image>> otherReferences_; // model -> method -> image
+  io::Image farmReference_; // --pt-reference
 };
 
 void runConverge(const ConvergeOptions& o) {

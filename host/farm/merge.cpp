@@ -147,7 +147,11 @@ std::vector<std::string> partFiles(const std::vector<std::string>& names) {
     if (fs::is_directory(name)) {
       std::vector<std::string> found;
       for (const auto& entry : fs::directory_iterator(name))
-        if (entry.is_regular_file() && io::extensionOf(entry.path().string()) == "exr") found.push_back(entry.path().string());
+        // Hidden files are left out: a render killed while writing leaves its temporary file
+        // (".NAME.tmpPID.exr", io/image_io.cpp's atomic write) beside the parts.
+        if (entry.is_regular_file() && io::extensionOf(entry.path().string()) == "exr" &&
+            entry.path().filename().string().front() != '.')
+          found.push_back(entry.path().string());
       if (found.empty()) throw InputError(fmt::format("{}: the folder holds no .exr part", name));
       std::sort(found.begin(), found.end());
       files.insert(files.end(), found.begin(), found.end());

@@ -45,7 +45,8 @@ struct MergedFrame {
   std::string method() const { return job.at("method").get<std::string>(); }
 };
 
-// The part files named: files as given, folders as the .exr files in them (sorted). InputError
+// The part files named: files as given, folders as the .exr files in them (sorted; hidden ones,
+// such as a killed render's temporary file, left out). InputError
 // when a name is neither, or nothing is found.
 std::vector<std::string> partFiles(const std::vector<std::string>& names);
 

@@ -760,11 +760,11 @@ io::Image ObscuranceRenderer::image() const {
 }
 
 Transport ObscuranceRenderer::transport() const {
-  Sums s = sums();
+  Sums s = sums(false);
   return resolveSums(std::move(s.transport), s.counts);
 }
 
-ObscuranceRenderer::Sums ObscuranceRenderer::sums() const {
+ObscuranceRenderer::Sums ObscuranceRenderer::sums(bool withPrimaryAovs) const {
   const FrameLayout& layout = frame_.layout();
   Sums out;
   Transport& t = out.transport;
@@ -781,7 +781,7 @@ ObscuranceRenderer::Sums ObscuranceRenderer::sums() const {
   }
   t.ambient.resize(layout.pixels());
   out.counts.resize(layout.pixels());
-  const bool primaryAovs = frame_.contents().primaryAovs;
+  const bool primaryAovs = withPrimaryAovs && frame_.contents().primaryAovs;
   if (primaryAovs) out.primaryAovs.resize(layout.pixels() * gpu::kAovSlots);
   // Accumulators are Kahan pairs: the sum of entry i is element i * kAccumulatorVec4s.
   auto sum = [](const std::vector<glm::vec4>& v, std::uint64_t i) { return v[i * gpu::kAccumulatorVec4s]; };

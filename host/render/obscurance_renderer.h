@@ -231,13 +231,14 @@ public:
   std::vector<std::uint32_t> sampleCounts() const;
   // The frame's sums as they are, not divided by the sample counts (what a farm's part keeps so
   // that parts merge exactly, host/farm/): the per-light transport's sums, the primary pass's AOV
-  // accumulators (gpu::kAovSlots vec4 sums a pixel, kAovIds as written) and the counts.
+  // accumulators (gpu::kAovSlots vec4 sums a pixel, kAovIds as written; when the frame keeps them
+  // and `withPrimaryAovs`) and the counts.
   struct Sums {
     Transport transport;                   // sums, not means
     std::vector<glm::vec4> primaryAovs;    // [pixel * kAovSlots + slot]; empty without primary AOVs
     std::vector<std::uint32_t> counts;     // [pixel]
   };
-  Sums sums() const;
+  Sums sums(bool withPrimaryAovs = true) const;
   const ObscuranceSettings& settings() const { return settings_; }
   const FrameLayout& layout() const { return frame_.layout(); }
   // The frame's buffers, for passes outside the renderer that read them (the denoiser).
