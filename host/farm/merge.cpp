@@ -168,7 +168,10 @@ std::vector<std::string> partFiles(const std::vector<std::string>& names) {
 MergedFrame mergeParts(const std::vector<std::string>& files) {
   MergedFrame merged;
   std::vector<PartExtent> extents;
-  std::vector<double> sums;                 // [pixel * channels + channel], the merged sums
+  // The merged sums are merged.sums (float); a row that a second part adds to is summed in double
+  // (doubleRows[y]) and rounded once at the end.
+  std::vector<std::vector<double>> doubleRows;
+  std::vector<std::uint32_t> partsOfRow;
   std::vector<std::uint32_t> idsFromSample; // per row: the first sample of the part its ids came from
   std::vector<bool> firstSampleOnly;        // per channel: written by a part's first sample, not summed
   std::uint32_t width = 0, height = 0;
@@ -183,7 +186,9 @@ MergedFrame mergeParts(const std::vector<std::string>& files) {
       merged.sums.width = static_cast<int>(width);
       merged.sums.height = static_cast<int>(height);
       merged.sums.channels = part.sums.channels;
-      sums.assign(std::size_t(width) * height * part.sums.channels.size(), 0.0);
+      merged.sums.pixels.resize(std::size_t(width) * height * part.sums.channels.size());
+      doubleRows.resize(height);
+      partsOfRow.assign(height, 0);
       idsFromSample.assign(height, std::numeric_limits<std::uint32_t>::max());
       for (const auto& c : part.sums.channels) firstSampleOnly.push_back(c.rfind(fmt::format("P{}.", gpu::kAovIds), 0) == 0);
     } else {
@@ -205,19 +210,26 @@ MergedFrame mergeParts(const std::vector<std::string>& files) {
                                      std::max(part.rows.first, other.rows.first),
                                      std::min(part.rows.first + part.rows.count, other.rows.first + other.rows.count)));
     }
-    const std::size_t nc = part.sums.channels.size();
+    const std::size_t nc = part.sums.channels.size(), rowValues = std::size_t(width) * nc;
     for (std::uint32_t row = 0; row < part.rows.count; ++row) {
       const std::uint32_t y = part.rows.first + row;
+      const float* in = &part.sums.pixels[row * rowValues];
+      float* merged_ = &merged.sums.pixels[y * rowValues];
       const bool takeIds = part.samples.begin < idsFromSample[y];
-      if (takeIds) idsFromSample[y] = part.samples.begin;
-      for (std::uint32_t x = 0; x < width; ++x) {
-        const float* in = &part.sums.pixels[(std::size_t(row) * width + x) * nc];
-        double* out = &sums[(std::size_t(y) * width + x) * nc];
-        for (std::size_t c = 0; c < nc; ++c) {
-          if (!firstSampleOnly[c]) out[c] += static_cast<double>(in[c]);
-          else if (takeIds) out[c] = static_cast<double>(in[c]);
+      if (partsOfRow[y]++ == 0) {
+        // The row's first part: its float sums as they are (a row one part holds stays bit-exact).
+        std::copy_n(in, rowValues, merged_);
+      } else {
+        // A second part of the row: its sums are added in double from here on.
+        std::vector<double>& acc = doubleRows[y];
+        if (acc.empty()) acc.assign(merged_, merged_ + rowValues);
+        for (std::size_t i = 0; i < rowValues; ++i) {
+          const std::size_t c = i % nc;
+          if (!firstSampleOnly[c]) acc[i] += static_cast<double>(in[i]);
+          else if (takeIds) merged_[i] = in[i];
         }
       }
+      if (takeIds) idsFromSample[y] = part.samples.begin;
     }
     extents.push_back({file, part.samples, part.rows, part.tile});
     merged.files.push_back(file);
@@ -225,10 +237,14 @@ MergedFrame mergeParts(const std::vector<std::string>& files) {
     if (part.info.contains("wall_s")) merged.partWallSeconds += part.info.at("wall_s").get<double>();
   }
   merged.missing = findMissing(extents, height, merged.spp());
-  merged.sums.pixels.resize(sums.size());
-  for (std::size_t i = 0; i < sums.size(); ++i) {
-    // The ids are bit patterns (uintBitsToFloat), which double holds exactly: copied, not rounded.
-    merged.sums.pixels[i] = static_cast<float>(sums[i]);
+  // Rows summed in double are rounded to float once; the ids (bit patterns, uintBitsToFloat) were
+  // copied from the part with the row's first sample, never summed.
+  const std::size_t rowValues = std::size_t(width) * merged.sums.channels.size();
+  for (std::uint32_t y = 0; y < height; ++y) {
+    if (doubleRows[y].empty()) continue;
+    float* out = &merged.sums.pixels[y * rowValues];
+    for (std::size_t i = 0; i < rowValues; ++i)
+      if (!firstSampleOnly[i % merged.sums.channels.size()]) out[i] = static_cast<float>(doubleRows[y][i]);
   }
   return merged;
 }
