@@ -69,13 +69,13 @@ protected:
   }
 };
 
-TEST_F(CliFarm, TilesMergeBitIdenticalToTheWholeFrameAndItsRender) {
+TEST_F(CliFarm, TilesMergeBitIdenticalToTheWholeFrameAndItsRenderAndRelightAsIt) {
   // The tiles in a folder of their own, merged by naming the folder.
   fs::create_directories(path("parts"));
   for (int i = 0; i < 3; ++i)
     render(std::string(kSize) + " --tile " + std::to_string(i) + "/3", "parts/tile" + std::to_string(i) + ".exr");
   render(std::string(kSize) + " --samples 0:4", "whole.exr");
-  render(kSize, "single.exr");
+  render(std::string(kSize) + " --save-state " + path("rendered"), "single.exr");
   mergeOk("parts", "tiles.exr");
   mergeOk("whole.exr", "one.exr");
   const io::Image merged = io::readImage(path("tiles.exr")), one = io::readImage(path("one.exr"));
@@ -95,6 +95,23 @@ TEST_F(CliFarm, TilesMergeBitIdenticalToTheWholeFrameAndItsRender) {
   // The merged EXR says which job it is.
   ASSERT_NE(merged.attribute("obscura:job"), nullptr);
   EXPECT_EQ(nlohmann::json::parse(*merged.attribute("obscura:job")).at("spp"), 4);
+
+  // A relighting state merged from the tiles: the render's per-light transport bit for bit, and
+  // relit as the render's own state is.
+  auto r = merge(path("parts") + " -o " + path("merged"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  expectBitIdentical(io::readImage(path("merged/transport.exr")), io::readImage(path("rendered/transport.exr")));
+  const std::string light = "light_rectangle_1";
+  for (const char* state : {"merged", "rendered"}) {
+    r = runObscura(std::string("relight ") + path(state) + " --light " + light + "=2 -o " + path(std::string(state) + ".exr"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+  }
+  expectBitIdentical(io::readImage(path("merged.exr")), io::readImage(path("rendered.exr")));
+
+  // converge takes a path-tracing reference only: this merged frame is of the obscurance method.
+  r = runObscura("converge " + cornellBox() + " -o " + path("study") + " --width 20 --pt-reference " + path("tiles.exr"));
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_CONTAINS(r.output, "tiles.exr: a reference of another image: its method is \"obscurance\"");
 }
 
 TEST_F(CliFarm, SampleRangesAndTilesMergeWithinFloatRoundingOnAGlossySceneWithManyLights) {
@@ -135,30 +152,23 @@ TEST_F(CliFarm, PathTracedPartsMergeIntoTheRender) {
         if (y < single.height / 2) EXPECT_EQ(got, want) << x << "," << y;
         else EXPECT_NEAR(got, want, 1e-6f * std::max(1.0f, std::abs(want))) << x << "," << y;
       }
-}
-
-TEST_F(CliFarm, AMergedRelightingStateRelightsAsARenderedOne) {
-  render(std::string(kSize) + " --tile 0/2", "t0.exr");
-  render(std::string(kSize) + " --tile 1/2", "t1.exr");
-  auto r = runObscura("render " + cornellBox() + kSize + " --save-state " + path("rendered") + " -o " + path("r.png"));
-  ASSERT_EQ(r.exitCode, 0) << r.output;
-  r = merge(path("t0.exr") + " " + path("t1.exr") + " -o " + path("merged"));
-  ASSERT_EQ(r.exitCode, 0) << r.output;
-  // The per-light transport is the render's, bit for bit (tiles only).
-  expectBitIdentical(io::readImage(path("merged/transport.exr")), io::readImage(path("rendered/transport.exr")));
-  const std::string light = "light_rectangle_1";
-  for (const char* state : {"merged", "rendered"}) {
-    r = runObscura(std::string("relight ") + path(state) + " --light " + light + "=2 -o " + path(std::string(state) + ".exr"));
-    ASSERT_EQ(r.exitCode, 0) << r.output;
-  }
-  expectBitIdentical(io::readImage(path("merged.exr")), io::readImage(path("rendered.exr")));
+  // converge takes its path-tracing reference from a merged farm render of its own image only,
+  // and says so before rendering anything.
+  const std::string converge = "converge " + cornellBox() + " -o " + path("study") + " --pt-reference ";
+  auto r = runObscura(converge + path("merged.exr") + " --width 20"); // the study's frame is 20x20
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_CONTAINS(r.output, "merged.exr: a reference of another image: its size is [20,14]");
+  r = runObscura(converge + path("t0.exr") + " --width 20");
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_CONTAINS(r.output, "t0.exr: not a merged farm render");
+  EXPECT_FALSE(fs::exists(path("study/cornell-box.convergence.csv")));
 }
 
 TEST_F(CliFarm, MergeRefusesForeignOverlappingAndIncompleteSetsNamingTheFile) {
   render(std::string(kSize) + " --tile 0/3 --samples 0:2", "a.exr");
   render(std::string(kSize) + " --tile 0/3 --samples 2:4", "b.exr");
   render(std::string(kSize) + " --tile 2/3", "c.exr");
-  render(std::string(kSize) + " --tile 0/3 --samples 1:3", "overlap.exr");
+  fs::copy_file(path("a.exr"), path("overlap.exr")); // the same part twice
   render(std::string(kSize) + " --tile 1/3 --seed 9", "foreign.exr");
   io::Image plain; // an image, but no part
   plain.width = plain.height = 2;
@@ -199,26 +209,6 @@ TEST_F(CliFarm, MergeRefusesForeignOverlappingAndIncompleteSetsNamingTheFile) {
   render(std::string(kSize) + " --tile 1/3 --samples 0:4", "d.exr");
   r = merge(complete + " " + path("d.exr") + " -o " + path("done.png"));
   EXPECT_EQ(r.exitCode, 0) << r.output;
-}
-
-// converge takes its path-tracing reference from a merged farm render of its own image only.
-TEST_F(CliFarm, ConvergeRefusesAFarmReferenceOfAnotherImageBeforeRendering) {
-  render(" --width 16 --spp 2 --method pathtrace --tile 0/2", "p0.exr");
-  render(" --width 16 --spp 2 --method pathtrace --tile 1/2", "p1.exr");
-  render(" --width 16 --spp 2 --tile 0/1", "o0.exr");
-  mergeOk("p0.exr p1.exr", "pt.exr");
-  mergeOk("o0.exr", "obscurance.exr");
-  const std::string converge = "converge " + cornellBox() + " -o " + path("study") + " --pt-reference ";
-  auto r = runObscura(converge + path("pt.exr") + " --width 20");
-  EXPECT_EQ(r.exitCode, 2) << r.output;
-  EXPECT_CONTAINS(r.output, "pt.exr: a reference of another image: its size is [16,");
-  r = runObscura(converge + path("obscurance.exr") + " --width 16");
-  EXPECT_EQ(r.exitCode, 2) << r.output;
-  EXPECT_CONTAINS(r.output, "its method is \"obscurance\"");
-  r = runObscura(converge + path("p0.exr") + " --width 16");
-  EXPECT_EQ(r.exitCode, 2) << r.output;
-  EXPECT_CONTAINS(r.output, "p0.exr: not a merged farm render");
-  EXPECT_FALSE(fs::exists(path("study/cornell-box.convergence.csv")));
 }
 
 TEST_F(CliFarm, BadPartOptionsAreRefusedBeforeAnyWork) {
