@@ -17,6 +17,22 @@ FARM_LIB_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 farm_die() { echo "${FARM_PROG:-farm}: $*" >&2; exit 2; }
 
 # farm_part_args INDEX / farm_part_name INDEX — part_args.sh for the loaded job.
+# farm_job_option OPTION VALUE — sets the job description's variable that OPTION names; the options
+# both submit.sh take alike. False for any other option.
+# shellcheck disable=SC2034 # the variables are the job description, read by the sourcing script
+farm_job_option() {
+  case $1 in
+    --scene) OBSCURA_SCENE=$2 ;;
+    --spp) OBSCURA_SPP=$2 ;;
+    --parts) OBSCURA_PARTS=$2 ;;
+    --tiles) OBSCURA_TILES=$2 ;;
+    --outdir) OBSCURA_OUTDIR=$2 ;;
+    --output) OBSCURA_OUTPUT=$2 ;;
+    --bin) OBSCURA_BIN=$2 ;;
+    --farm-dir) OBSCURA_FARM_DIR=$2 ;;
+    *) return 1 ;;
+  esac
+}
 farm_part_args() { "$FARM_LIB_DIR/part_args.sh" "$1" "$OBSCURA_PARTS" "$OBSCURA_TILES" "$OBSCURA_SPP"; }
 farm_part_name() { "$FARM_LIB_DIR/part_args.sh" --name "$1" "$OBSCURA_PARTS" "$OBSCURA_TILES" "$OBSCURA_SPP"; }
 

@@ -51,14 +51,7 @@ while [ $# -gt 0 ]; do
     --image) need "$@"; image=$2; shift 2 ;;
     --pvc) need "$@"; pvc=$2; shift 2 ;;
     --mount) need "$@"; mount=$2; shift 2 ;;
-    --scene) need "$@"; OBSCURA_SCENE=$2; shift 2 ;;
-    --spp) need "$@"; OBSCURA_SPP=$2; shift 2 ;;
-    --parts) need "$@"; OBSCURA_PARTS=$2; shift 2 ;;
-    --tiles) need "$@"; OBSCURA_TILES=$2; shift 2 ;;
-    --outdir) need "$@"; OBSCURA_OUTDIR=$2; shift 2 ;;
-    --output) need "$@"; OBSCURA_OUTPUT=$2; shift 2 ;;
-    --bin) need "$@"; OBSCURA_BIN=$2; shift 2 ;;
-    --farm-dir) need "$@"; OBSCURA_FARM_DIR=$2; shift 2 ;;
+    --scene|--spp|--parts|--tiles|--outdir|--output|--bin|--farm-dir) need "$@"; farm_job_option "$1" "$2"; shift 2 ;;
     --parallelism) need "$@"; parallelism=$2; shift 2 ;;
     --retries) need "$@"; retries=$2; shift 2 ;;
     --cpu) need "$@"; cpu=$2; shift 2 ;;

@@ -46,14 +46,7 @@ while [ $# -gt 0 ]; do
   opt=$1 val=""
   if [[ $opt == --*=* ]]; then val=${opt#*=} opt=${opt%%=*}; set -- "$opt" "$val" "${@:2}"; fi
   case $opt in
-    --scene) need "$@"; OBSCURA_SCENE=$2; shift 2 ;;
-    --spp) need "$@"; OBSCURA_SPP=$2; shift 2 ;;
-    --parts) need "$@"; OBSCURA_PARTS=$2; shift 2 ;;
-    --tiles) need "$@"; OBSCURA_TILES=$2; shift 2 ;;
-    --outdir) need "$@"; OBSCURA_OUTDIR=$2; shift 2 ;;
-    --bin) need "$@"; OBSCURA_BIN=$2; shift 2 ;;
-    --output) need "$@"; OBSCURA_OUTPUT=$2; shift 2 ;;
-    --farm-dir) need "$@"; OBSCURA_FARM_DIR=$2; shift 2 ;;
+    --scene|--spp|--parts|--tiles|--outdir|--output|--bin|--farm-dir) need "$@"; farm_job_option "$1" "$2"; shift 2 ;;
     --sbatch-opt) need "$@"; OBSCURA_SBATCH_OPTS+=("$2"); shift 2 ;;
     --part-sbatch-opt) need "$@"; OBSCURA_PART_SBATCH_OPTS+=("$2"); shift 2 ;;
     --merge-sbatch-opt) need "$@"; OBSCURA_MERGE_SBATCH_OPTS+=("$2"); shift 2 ;;
