@@ -33,6 +33,18 @@ farm_job_option() {
     *) return 1 ;;
   esac
 }
+# farm_check_job_options — the job options both submit.sh require, checked alike; a missing
+# --tiles means strips only (TILES = PARTS).
+farm_check_job_options() {
+  local v
+  for v in scene spp parts outdir; do
+    local var=OBSCURA_${v^^}
+    [ -n "${!var}" ] || farm_die "--$v is required (--help)"
+  done
+  OBSCURA_TILES=${OBSCURA_TILES:-$OBSCURA_PARTS}
+  farm_check_numbers "$OBSCURA_PARTS" "$OBSCURA_TILES" "$OBSCURA_SPP"
+  [[ $OBSCURA_OUTPUT =~ ^[^/]+\.(exr|png)$ ]] || farm_die "--output must be a file name ending in .exr or .png"
+}
 farm_part_args() { "$FARM_LIB_DIR/part_args.sh" "$1" "$OBSCURA_PARTS" "$OBSCURA_TILES" "$OBSCURA_SPP"; }
 farm_part_name() { "$FARM_LIB_DIR/part_args.sh" --name "$1" "$OBSCURA_PARTS" "$OBSCURA_TILES" "$OBSCURA_SPP"; }
 

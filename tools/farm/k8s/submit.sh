@@ -78,13 +78,7 @@ yaml_safe() {
 
 if [ -z "$rerun" ]; then
   for v in image pvc; do [ -n "${!v}" ] || farm_die "--$v is required (--help)"; done
-  [ -n "$OBSCURA_SCENE" ] || farm_die "--scene is required (--help)"
-  [ -n "$OBSCURA_SPP" ] || farm_die "--spp is required (--help)"
-  [ -n "$OBSCURA_PARTS" ] || farm_die "--parts is required (--help)"
-  [ -n "$OBSCURA_OUTDIR" ] || farm_die "--outdir is required (--help)"
-  OBSCURA_TILES=${OBSCURA_TILES:-$OBSCURA_PARTS}
-  farm_check_numbers "$OBSCURA_PARTS" "$OBSCURA_TILES" "$OBSCURA_SPP"
-  [[ $OBSCURA_OUTPUT =~ ^[^/]+\.(exr|png)$ ]] || farm_die "--output must be a file name ending in .exr or .png"
+  farm_check_job_options
   for v in OBSCURA_SCENE OBSCURA_OUTDIR OBSCURA_BIN OBSCURA_FARM_DIR mount; do
     [[ ${!v} == /* ]] || farm_die "${v} must be an absolute path in the pods, got '${!v}'"
   done

@@ -57,15 +57,9 @@ while [ $# -gt 0 ]; do
     *) farm_die "unknown option '$1' (render options go after --; --help)" ;;
   esac
 done
-[ -n "$OBSCURA_SCENE" ] || farm_die "--scene is required (--help)"
-[ -n "$OBSCURA_SPP" ] || farm_die "--spp is required (--help)"
-[ -n "$OBSCURA_PARTS" ] || farm_die "--parts is required (--help)"
-[ -n "$OBSCURA_OUTDIR" ] || farm_die "--outdir is required (--help)"
-OBSCURA_TILES=${OBSCURA_TILES:-$OBSCURA_PARTS}
-farm_check_numbers "$OBSCURA_PARTS" "$OBSCURA_TILES" "$OBSCURA_SPP"
+farm_check_job_options
 [[ -z $OBSCURA_MAX_RUNNING || $OBSCURA_MAX_RUNNING =~ ^[1-9][0-9]*$ ]] \
   || farm_die "--max-running must be a positive integer"
-[[ $OBSCURA_OUTPUT =~ ^[^/]+\.(exr|png)$ ]] || farm_die "--output must be a file name ending in .exr or .png"
 # Paths as absolute ones: the jobs do not start in this folder.
 OBSCURA_OUTDIR=$(realpath -m -- "$OBSCURA_OUTDIR")
 [[ $OBSCURA_SCENE == /* ]] || OBSCURA_SCENE=$(realpath -m -- "$OBSCURA_SCENE")
