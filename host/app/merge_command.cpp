@@ -33,28 +33,6 @@ std::string missingList(const farm::MergedFrame& merged) {
   return text;
 }
 
-// The channels of `aovs` (all when empty); InputError naming an AOV the merged frame lacks.
-io::Image selectAovs(const io::Image& all, const std::vector<std::string>& aovs) {
-  if (aovs.empty()) return all;
-  io::Image out;
-  out.width = all.width;
-  out.height = all.height;
-  out.attributes = all.attributes;
-  std::vector<int> source;
-  for (const auto& aov : aovs)
-    for (const auto& channel : render::aovChannels(aov)) {
-      const int c = all.channelIndex(channel);
-      if (c < 0) throw InputError(fmt::format("--aov {}: the merged frame has no such AOV", aov));
-      out.channels.push_back(channel);
-      source.push_back(c);
-    }
-  out.pixels.reserve(std::size_t(out.width) * out.height * source.size());
-  for (int y = 0; y < all.height; ++y)
-    for (int x = 0; x < all.width; ++x)
-      for (int c : source) out.pixels.push_back(all.at(x, y, c));
-  return out;
-}
-
 void runMerge(const MergeOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<std::string> files = farm::partFiles(o.parts);
@@ -86,7 +64,7 @@ void runMerge(const MergeOptions& o) {
   if (!stateOnly) {
     const io::Image image = farm::mergedImage(merged);
     if (ext == "exr") {
-      io::writeExr(o.output, selectAovs(image, o.aovs));
+      io::writeExr(o.output, render::selectAovs(image, o.aovs));
     } else {
       const std::string first = o.aovs.empty() ? "combined" : o.aovs.front();
       const auto channels = render::aovChannels(first);

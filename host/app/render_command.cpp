@@ -25,26 +25,6 @@
 namespace obscura::app {
 namespace {
 
-// Keeps only the requested AOVs' channels (all when none requested).
-io::Image selectAovs(const io::Image& all, const std::vector<std::string>& aovs) {
-  if (aovs.empty()) return all;
-  io::Image out;
-  out.width = all.width;
-  out.height = all.height;
-  std::vector<int> source;
-  for (const auto& aov : aovs)
-    for (const auto& channel : render::aovChannels(aov)) {
-      out.channels.push_back(channel);
-      source.push_back(all.channelIndex(channel));
-    }
-  out.pixels.resize(std::size_t(out.width) * out.height * out.channels.size());
-  std::size_t k = 0;
-  for (int y = 0; y < all.height; ++y)
-    for (int x = 0; x < all.width; ++x)
-      for (int c : source) out.pixels[k++] = all.at(x, y, c);
-  return out;
-}
-
 void printProgress(std::uint32_t done, std::uint32_t total, double seconds, std::uint64_t raysPerSample) {
   double rate = seconds > 0 ? static_cast<double>(raysPerSample) * done / seconds / 1e6 : 0.0;
   double eta = done > 0 ? seconds / done * (total - done) : 0.0;
@@ -88,7 +68,7 @@ void writeOutputs(const RenderOptions& o, const io::Image& image, const render::
     throw DeviceError(fmt::format("{} traversals ran out of steps (kMaxTraversalSteps); the image would be wrong",
                                   stats.truncatedTraversals));
 
-  io::Image selected = selectAovs(image, o.aovs);
+  io::Image selected = render::selectAovs(image, o.aovs);
   if (io::extensionOf(o.output) == "exr") {
     io::writeExr(o.output, selected);
   } else if (display && (o.aovs.empty() || o.aovs.front() == "combined" || o.aovs.front() == "denoised")) {

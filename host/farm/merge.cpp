@@ -249,15 +249,22 @@ MergedFrame mergeParts(const std::vector<std::string>& files) {
   return merged;
 }
 
-render::Transport mergedTransport(const MergedFrame& merged) {
+namespace {
+
+// The merged per-light transport, resolved by the pixels' sample counts `counts`.
+render::Transport resolvedTransport(const MergedFrame& merged, const std::vector<std::uint32_t>& counts) {
   if (merged.method() != "obscurance") throw InputError("merge: only the obscurance method keeps per-light transport");
   const nlohmann::json& state = merged.frame.at("state");
   std::vector<std::string> names;
   for (const auto& light : state.at("lights")) names.push_back(light.at("name").get<std::string>());
   render::Transport sums = render::Transport::fromImage(merged.sums, names, state.at("specular").get<bool>(),
                                                         merged.files.front());
-  return render::resolveSums(std::move(sums), countsOf(merged.sums));
+  return render::resolveSums(std::move(sums), counts);
 }
+
+} // namespace
+
+render::Transport mergedTransport(const MergedFrame& merged) { return resolvedTransport(merged, countsOf(merged.sums)); }
 
 nlohmann::json mergedStateJson(const MergedFrame& merged) {
   nlohmann::json state = merged.frame.at("state");
@@ -284,7 +291,7 @@ io::Image mergedImage(const MergedFrame& merged) {
     image.attributes.emplace_back(kMergedAttribute, merged.job.dump());
     return image;
   }
-  const render::Transport transport = mergedTransport(merged);
+  const render::Transport transport = resolvedTransport(merged, counts);
   const std::vector<glm::vec3> emissions = lightVectors(merged.frame, "emission");
   const std::vector<glm::vec3> weights = lightVectors(merged.frame, "ambient_weight");
   const io::Image composed = render::composeTransport(transport, emissions, weights);

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <bit>
 
+#include <fmt/format.h>
+
+#include "core/error.h"
 #include "shared/host_device.h"
 
 namespace obscura::render {
@@ -20,6 +23,28 @@ std::vector<std::string> aovChannels(const std::string& aov) {
   if (aov == "coverage") return {"coverage.A"};
   if (aov == "primitive" || aov == "material") return {aov + ".id"};
   return {aov + ".R", aov + ".G", aov + ".B"};
+}
+
+io::Image selectAovs(const io::Image& image, const std::vector<std::string>& aovs) {
+  if (aovs.empty()) return image;
+  io::Image out;
+  out.width = image.width;
+  out.height = image.height;
+  out.attributes = image.attributes;
+  std::vector<int> source;
+  for (const auto& aov : aovs)
+    for (const auto& channel : aovChannels(aov)) {
+      const int c = image.channelIndex(channel);
+      if (c < 0) throw InputError(fmt::format("--aov {}: the image has no such AOV", aov));
+      out.channels.push_back(channel);
+      source.push_back(c);
+    }
+  out.pixels.resize(std::size_t(out.width) * out.height * out.channels.size());
+  std::size_t k = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      for (int c : source) out.pixels[k++] = image.at(x, y, c);
+  return out;
 }
 
 // Converts the accumulated AOV slots into image channels.

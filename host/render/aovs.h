@@ -30,6 +30,9 @@ struct RenderStats {
 const std::vector<std::string>& aovNames();
 // Channel names of one AOV ("albedo" -> albedo.R, albedo.G, albedo.B).
 std::vector<std::string> aovChannels(const std::string& aov);
+// Only the channels of `aovs`, in that order (all of `image` when empty), its attributes kept;
+// InputError naming an AOV the image lacks.
+io::Image selectAovs(const io::Image& image, const std::vector<std::string>& aovs);
 
 // Progressive samples recorded into one submission by the renderers: each pass of a sample takes
 // one timestamp pair of a 256-pair pool, and fewer per submission keep the progress line moving.
