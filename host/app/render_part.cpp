@@ -1,6 +1,5 @@
 #include "app/render_part.h"
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 
@@ -90,10 +89,7 @@ nlohmann::json jobIdentity(const RenderOptions& o) {
 void renderPart(RenderOptions& o) {
   checkPartOptions(o);
   checkRenderOptions(o);
-  LoadedScene loaded = loadScene(o.scenePath, o.lightGroups);
-  applyBackground(o, loaded);
-  const scene::Camera camera = chooseCamera(loaded.scene, o.camera);
-  chooseSize(o, camera);
+  // What can be checked without the scene is, before it is loaded.
   farm::Part part;
   part.samples = o.partSamples.empty() ? farm::SampleRange{0, o.spp} : farm::parseSampleRange(o.partSamples);
   if (part.samples.end > o.spp)
@@ -101,6 +97,10 @@ void renderPart(RenderOptions& o) {
                                  part.samples.end, o.spp, o.spp));
   if (o.spp > (1u << 24)) throw InputError("--spp above 2^24: a part's sample counts are kept as floats");
   part.tile = o.partTile.empty() ? farm::Tile{} : farm::parseTile(o.partTile);
+  LoadedScene loaded = loadScene(o.scenePath, o.lightGroups);
+  applyBackground(o, loaded);
+  const scene::Camera camera = chooseCamera(loaded.scene, o.camera);
+  chooseSize(o, camera); // the tile's rows need the image's height
   part.rows = farm::tileRows(part.tile, o.height);
   part.job = jobIdentity(o);
   fmt::print(stderr, "{}\n", sceneSummary(loaded));
