@@ -51,7 +51,9 @@ void streamHit(uint k, RayHit h) {
 #include "lib/bvh_stream.glsl"
 
 void main() {
-  if (kRaysPerLane == 1u) { // one ray per invocation: straight through traverseBvh
+  // One ray per invocation, straight through traverseBvh; the binary layout always (the
+  // refilling loop of lib/bvh_stream.glsl walks the wide one).
+  if (kRaysPerLane == 1u || kBinaryLayout) {
     const uint i = rayIndex(0u);
     if (i >= pc.params.x) return;
     GpuRay ray = streamRay(0u);

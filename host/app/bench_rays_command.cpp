@@ -363,10 +363,12 @@ void runBench(const BenchOptions& o) {
   if (!o.json) fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
 
   render::SceneBuffers buffers(context, loaded.scene, loaded.bvh);
+  for (const std::string& note : buffers.notes()) fmt::print(stderr, "note: {}\n", note);
+  if (!o.json) fmt::print("traversal: {}\n", render::traversalName(buffers.traversal()));
   std::optional<render::TraceShape> shape;
   if (!o.traceShape.empty()) shape = parseTraceShape(o.traceShape, context);
   if (o.bvhItems == "storage") {
-    if (!shape) shape = render::TraceShape::forDevice(context);
+    if (!shape) shape = render::TraceShape::forDevice(context, buffers.traversal());
     shape->bvhItemsFromStorage = true;
   }
   if (o.stackRegisters && !bvh::compactStackHolds(*o.stackRegisters, buffers.compactStackVectors()))
@@ -414,6 +416,7 @@ void runBench(const BenchOptions& o) {
   if (o.json) {
     nlohmann::json j = {{"scene", loaded.scene.sourcePath}, {"device", context.info().name},
                         {"rays", o.rays}, {"seed", o.seed},
+                        {"traversal", render::traversalName(buffers.traversal())},
                         {"trace_workgroup_size", tracer.shape().workgroupSize},
                         {"trace_rays_per_invocation", tracer.shape().raysPerLane},
                         {"triangles", loaded.scene.triangles.size()},

@@ -9,7 +9,8 @@
 namespace obscura::render {
 
 namespace {
-gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::uint32_t compactStackVectors) {
+gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::uint32_t compactStackVectors,
+                                Traversal traversal) {
   auto bindings = sceneBindingKinds();
   // rays (two RGBA32F texels each), hits (one RGBA32F texel each), steps (R32UI): texel views,
   // which lavapipe reads and writes a texel per lane at a time (an SSBO: a word per lane at a time).
@@ -24,20 +25,25 @@ gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::
                             {gpu::kSpecConstantTraceRaysPerLane, shape.raysPerLane},
                             {gpu::kSpecConstantTraceWorkgroupSize, shape.workgroupSize},
                             {gpu::kSpecConstantCompactStack, compactStackVectors},
-                            {gpu::kSpecConstantBvhItemsFromStorage, shape.bvhItemsFromStorage ? 1u : 0u}},
+                            {gpu::kSpecConstantBvhItemsFromStorage, shape.bvhItemsFromStorage ? 1u : 0u},
+                            {gpu::kSpecConstantBvhLayout, bvhLayoutOf(traversal)},
+                            {gpu::kSpecConstantBinaryLoop, binaryWhileWhile(traversal) ? 1u : 0u}},
           .deferCompile = recordSteps};
 }
 } // namespace
 
-TraceShape TraceShape::forDevice(const gpu::Context& context) {
+TraceShape TraceShape::forDevice(const gpu::Context& context, Traversal traversal) {
+  if (traversal != Traversal::Wide) return forBinary();
   return context.info().type == "cpu" ? forCpu() : forGpu();
 }
 
 RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape,
                      std::optional<std::uint32_t> compactStackVectors)
-    : context_(&context), shape_(shape.value_or(TraceShape::forDevice(context))),
-      kernel_(context, traceKernelDesc(shape_, false, compactStackVectors.value_or(scene.compactStackVectors()))),
-      stepsKernel_(context, traceKernelDesc(shape_, true, compactStackVectors.value_or(scene.compactStackVectors()))),
+    : context_(&context), shape_(shape.value_or(TraceShape::forDevice(context, scene.traversal()))),
+      kernel_(context, traceKernelDesc(shape_, false, compactStackVectors.value_or(scene.compactStackVectors()),
+                                       scene.traversal())),
+      stepsKernel_(context, traceKernelDesc(shape_, true, compactStackVectors.value_or(scene.compactStackVectors()),
+                                            scene.traversal())),
       timestamps_(context) {
   scene.bindTo(kernel_);
   scene.bindTo(stepsKernel_);

@@ -30,7 +30,11 @@ struct TraceShape {
   bool bvhItemsFromStorage = false;
   static TraceShape forCpu() { return {}; }
   static TraceShape forGpu() { return {gpu::kTraceGpuWorkgroupSize, gpu::kTraceGpuRaysPerLane}; }
-  static TraceShape forDevice(const gpu::Context& context); // forCpu() on a CPU device, forGpu() otherwise
+  // The binary traversal goes straight through traverseBvh, one ray per invocation (trace.comp's
+  // refilling loop is the wide one's).
+  static TraceShape forBinary() { return {gpu::kTraceBinaryWorkgroupSize, 1}; }
+  // For the wide layout forCpu() on a CPU device, forGpu() otherwise; forBinary() for a binary one.
+  static TraceShape forDevice(const gpu::Context& context, Traversal traversal);
 };
 
 class RayTracer {

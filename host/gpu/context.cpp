@@ -170,7 +170,7 @@ std::vector<DeviceInfo> Context::listDevices(std::uint32_t* automaticChoice) {
   return result;
 }
 
-Context::Context(const ContextOptions& options) {
+Context::Context(const ContextOptions& options) : traversal_(options.traversal) {
   validation_ = options.validate || environmentFlag("OBSCURA_VALIDATE");
   if (validation_ && !layerAvailable(context_, kValidationLayer))
     throw DeviceError("validation was requested but the Khronos validation layer is not "

@@ -42,6 +42,10 @@ struct ContextOptions {
   // to the window's surface) are eligible. Headless rendering leaves it empty.
   std::function<bool(const vk::raii::PhysicalDevice&, std::uint32_t family)> canPresent;
   std::vector<const char*> instanceExtensions; // e.g. the window system's surface extensions
+  // The BVH layout and traversal loop the kernels use on this device: "" or "auto" for the
+  // device's own (render/scene/bvh_layout.h, which also reads and checks the name), else one it
+  // names. Kept by the context because it is a property of how this device is driven.
+  std::string traversal;
 };
 
 class Context {
@@ -54,6 +58,8 @@ public:
   static std::vector<DeviceInfo> listDevices(std::uint32_t* automaticChoice = nullptr);
 
   const DeviceInfo& info() const { return info_; }
+  // ContextOptions::traversal, as given.
+  const std::string& traversalRequest() const { return traversal_; }
   const vk::raii::Device& device() const { return device_; }
   const vk::raii::PhysicalDevice& physicalDevice() const { return physicalDevice_; }
   const vk::raii::Queue& queue() const { return queue_; }
@@ -86,6 +92,7 @@ private:
 
   bool validation_ = false;
   bool debugUtils_ = false;
+  std::string traversal_;
   vk::raii::Context context_;
   vk::raii::Instance instance_ = nullptr;
   vk::raii::DebugUtilsMessengerEXT messenger_ = nullptr;

@@ -181,17 +181,23 @@ PassItems fetchPassItems(inout uint triangleBase, inout uint triangleBits, inout
 
 // The pass's triangle test: true when it found a nearer hit (closest) or any hit within tmax
 // (anyHit), which `hit` then holds; an any-hit ray is done there.
-bool testPassTriangle(PassItems it, WatertightRay wr, float tmin, float tmax, bool anyHit, inout RayHit hit) {
+// The triangle test of every traversal loop: the triangle (p0, p1, p2) at texel `item`.
+bool testTriangle(vec4 p0, vec4 p1, vec4 p2, uint item, WatertightRay wr, float tmin, float tmax, bool anyHit,
+                  inout RayHit hit) {
   float t, u, v;
-  if (!intersectTriangle(wr, it.p0.xyz, it.p1.xyz, it.p2.xyz, tmin, hit.t, t, u, v)) return false;
-  uint primitive = floatBitsToUint(it.p0.w);
+  if (!intersectTriangle(wr, p0.xyz, p1.xyz, p2.xyz, tmin, hit.t, t, u, v)) return false;
+  uint primitive = floatBitsToUint(p0.w);
   if (!(anyHit ? t < tmax : (t < hit.t || primitive < hit.primitive))) return false;
   hit.t = t;
   hit.u = u;
   hit.v = v;
   hit.primitive = primitive;
-  hit.item = it.triangle;
+  hit.item = item;
   return true;
+}
+
+bool testPassTriangle(PassItems it, WatertightRay wr, float tmin, float tmax, bool anyHit, inout RayHit hit) {
+  return testTriangle(it.p0, it.p1, it.p2, it.triangle, wr, tmin, tmax, anyHit, hit);
 }
 
 // The pass's node visit: the node leaves the node group, and its leaf triangles hit become the
@@ -265,6 +271,112 @@ uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uve
   return top;
 }
 
+// ---- The binary layout (kBvhLayoutBinary, shared/host_device.h), for GPUs: a node holds both
+// children's exact boxes, so one fetch of 64 bytes decides both (Aila & Laine, "Understanding the
+// Efficiency of Ray Traversal on GPUs", HPG 2009), the nearer child is visited first and the
+// other pushed on a per-invocation array of kBinaryStackSize (which the host keeps deeper trees
+// from: render/scene/bvh_layout.cpp). The CPU twin is host/bvh/binary_layout.cpp.
+layout(constant_id = kSpecConstantBvhLayout) const uint kBvhLayout = kBvhLayoutWide;
+const bool kBinaryLayout = kBvhLayout == kBvhLayoutBinary;
+// The binary loop's shape (kSpecConstantBinaryLoop): false, ONE loop whose pass visits a node or
+// tests a triangle, so that every pass is counted against lavapipe's loop limiter exactly as the
+// wide loop's are; true, Aila & Laine's while-while (a loop over nodes until a leaf, then one over
+// the leaf's triangles, inside an outer loop), for GPUs, which have no loop limiter: its step
+// count bounds each lane's passes, not the passes of lavapipe's 8-lane group.
+layout(constant_id = kSpecConstantBinaryLoop) const bool kBinaryWhileWhile = false;
+
+// One node: x = the child to visit next (the nearer one met), y = the other one met, to push;
+// kInvalidIndex where none. An absent child's box is never met.
+uvec2 visitBinaryNode(uint node, vec3 origin, vec3 invDir, float tmin, float tmax) {
+  int b = int(node * kTexelsPerBinaryNode);
+  vec4 leftLo = bvhItem(b), leftHi = bvhItem(b + 1), rightLo = bvhItem(b + 2), rightHi = bvhItem(b + 3);
+  vec2 l = intersectBox(leftLo.xyz, leftHi.xyz, origin, invDir, tmin, tmax);
+  vec2 r = intersectBox(rightLo.xyz, rightHi.xyz, origin, invDir, tmin, tmax);
+  bool hitL = l.x <= l.y, hitR = r.x <= r.y;
+  uint left = floatBitsToUint(leftLo.w), right = floatBitsToUint(leftHi.w);
+  if (hitL && hitR) return r.x < l.x ? uvec2(right, left) : uvec2(left, right);
+  if (hitL) return uvec2(left, kInvalidIndex);
+  if (hitR) return uvec2(right, kInvalidIndex);
+  return uvec2(kInvalidIndex);
+}
+
+bool isBinaryLeaf(uint ref) { return (ref & kBinaryLeafBit) != 0u; }
+
+// The triangle at `texel`, tested as every loop tests one.
+bool testBinaryTriangle(uint texel, WatertightRay wr, float tmin, float tmax, bool anyHit, inout RayHit hit) {
+  int i = int(texel);
+  return testTriangle(bvhItem(i), bvhItem(i + 1), bvhItem(i + 2), texel, wr, tmin, tmax, anyHit, hit);
+}
+
+// Same contract as traverseBvh below (the wide loop): closest hit or the first hit, cut off after
+// `maxSteps` passes and reported as kTruncatedHit.
+RayHit traverseBinary(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit, uint maxSteps) {
+  WatertightRay wr = prepareWatertightRay(origin, direction);
+  vec3 invDir = safeReciprocal(direction);
+  RayHit hit = RayHit(tmax, 0.0, 0.0, kInvalidIndex, kInvalidIndex, 0u);
+  uint stack[kBinaryStackSize];
+  uint sp = 0u;
+  uint ref = 0u; // the root
+  if (kBinaryWhileWhile) {
+    for (;;) {
+      while (!isBinaryLeaf(ref)) {
+        if (hit.steps >= maxSteps) {
+          hit.primitive = kTruncatedHit;
+          return hit;
+        }
+        hit.steps++;
+        uvec2 next = visitBinaryNode(ref, origin, invDir, tmin, hit.t);
+        if (next.y != kInvalidIndex) stack[sp++] = next.y;
+        if (next.x != kInvalidIndex) {
+          ref = next.x;
+        } else {
+          if (sp == 0u) return hit;
+          ref = stack[--sp];
+        }
+      }
+      uint first = ref & kBinaryLeafTexelMask;
+      uint end = first + kTexelsPerTriangle * ((ref >> kBinaryLeafCountShift) & 7u);
+      for (uint texel = first; texel < end; texel += kTexelsPerTriangle) {
+        if (hit.steps >= maxSteps) {
+          hit.primitive = kTruncatedHit;
+          return hit;
+        }
+        hit.steps++;
+        if (testBinaryTriangle(texel, wr, tmin, tmax, anyHit, hit) && anyHit) return hit;
+      }
+      if (sp == 0u) return hit;
+      ref = stack[--sp];
+    }
+  }
+  // One loop: a pass visits a node, or tests the first triangle of a leaf and leaves the rest of
+  // the leaf (a leaf reference one triangle shorter) for the next pass.
+  for (;;) {
+    if (hit.steps >= maxSteps) {
+      hit.primitive = kTruncatedHit;
+      break;
+    }
+    hit.steps++;
+    uint next;
+    if (!isBinaryLeaf(ref)) {
+      uvec2 children = visitBinaryNode(ref, origin, invDir, tmin, hit.t);
+      if (children.y != kInvalidIndex) stack[sp++] = children.y;
+      next = children.x;
+    } else {
+      uint texel = ref & kBinaryLeafTexelMask;
+      if (testBinaryTriangle(texel, wr, tmin, tmax, anyHit, hit) && anyHit) break;
+      uint left = ((ref >> kBinaryLeafCountShift) & 7u) - 1u;
+      next = left == 0u ? kInvalidIndex
+                        : kBinaryLeafBit | (left << kBinaryLeafCountShift) | (texel + kTexelsPerTriangle);
+    }
+    if (next == kInvalidIndex) {
+      if (sp == 0u) break;
+      next = stack[--sp];
+    }
+    ref = next;
+  }
+  return hit;
+}
+
 // Closest hit when anyHit is false (ties in t go to the lower primitive id), else the first hit
 // found with t < tmax (occlusion). Stops after `maxSteps` passes and reports kTruncatedHit:
 // lavapipe's loop limiter (65,535 passes for ALL loops of an invocation) would otherwise cut the
@@ -285,6 +397,7 @@ uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uve
 // (masked) pass when no ray overflowed; a compact-stack kernel (kCompactStack: up to 16 packed
 // entries in the same registers, for a BVH that cannot overflow them) has none.
 RayHit traverseBvh(vec3 origin, vec3 direction, float tmin, float tmax, bool anyHit, uint maxSteps) {
+  if (kBinaryLayout) return traverseBinary(origin, direction, tmin, tmax, anyHit, maxSteps);
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);
   uint octant = rayOctant(direction);

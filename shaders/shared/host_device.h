@@ -85,6 +85,31 @@ struct BvhNode {
   vec4 qz;     // 64: z axis, same
 };             // 80 bytes = kTexelsPerNode texels
 
+// ---- The binary layout (kBvhLayoutBinary), for GPUs: the same wide tree, each wide node made a
+// small binary tree over its children (host/bvh/binary_layout.cpp), in the layout of Aila & Laine,
+// "Understanding the Efficiency of Ray Traversal on GPUs", HPG 2009: a node holds the exact boxes
+// of its two children and their references, so one node fetch decides both children. The
+// triangles follow the nodes, as in the wide layout (a hit's `item` is the same texel). A
+// reference is a node index, or a leaf: kBinaryLeafBit | count << kBinaryLeafCountShift | the
+// texel of its first triangle. An absent child (a root with fewer than two) has the box of the
+// point (+inf, +inf, +inf), which no ray meets.
+struct BvhBinaryNode {
+  vec4 leftLo;  // 0:  left child's box lo xyz;  w = left reference (uintBitsToFloat)
+  vec4 leftHi;  // 16: left child's box hi xyz;  w = right reference
+  vec4 rightLo; // 32: right child's box lo xyz; w = unused
+  vec4 rightHi; // 48: right child's box hi xyz; w = unused
+};              // 64 bytes = kTexelsPerBinaryNode texels
+OBS_CONST uint kTexelsPerBinaryNode = 4;
+OBS_CONST uint kBinaryLeafBit = 0x80000000u;
+OBS_CONST uint kBinaryLeafCountShift = 28u;   // 3 bits: 1..kLeafMaxTriangles triangles
+OBS_CONST uint kBinaryLeafTexelMask = 0x0FFFFFFFu;
+// The binary traversal's stack (an array per invocation): a traversal pushes at most depth - 1
+// entries, and a scene whose binary tree is deeper keeps the wide layout (render/scene/bvh_layout.h).
+OBS_CONST uint kBinaryStackSize = 64;
+// Which layout and traversal loop a kernel is specialised for (kSpecConstantBvhLayout).
+OBS_CONST uint kBvhLayoutWide = 0u;
+OBS_CONST uint kBvhLayoutBinary = 1u;
+
 // Triangle for intersection, in the order the leaves need them.
 struct BvhTriangle {
   vec4 v0; // 0:  xyz, w = original triangle index (uintBitsToFloat)
@@ -278,6 +303,8 @@ OBS_CONST uint kTraceWorkgroupSize = 32;
 // 32 invocations caps the warps an SM holds, by 3-4x. `bench-rays --trace-shape` tries others.
 OBS_CONST uint kTraceGpuWorkgroupSize = 32;
 OBS_CONST uint kTraceGpuRaysPerLane = 8;
+// ...and with the binary layout (one ray per invocation, straight through traverseBvh).
+OBS_CONST uint kTraceBinaryWorkgroupSize = 128;
 #ifdef __cplusplus
 static_assert(kTraceRaysPerLane <= 64, "traverseStream marks the rays it puts aside in a 64-bit mask");
 static_assert(kTraceWorkgroupSize * kTraceRaysPerLane * 12 <= 32768, "trace.comp's hits must fit shared memory");
@@ -432,6 +459,12 @@ OBS_CONST uint kSpecConstantPrimaryHitBounds = 13u;
 OBS_CONST uint kSpecConstantTexturesAbsent = 14u;
 OBS_CONST uint kTexturesAbsentBaseColor = 1u;
 OBS_CONST uint kTexturesAbsentEmissive = 2u;
+// The BVH layout and traversal loop (kBvhLayoutWide, the default, or kBvhLayoutBinary) the
+// scene's items buffer holds: render/scene/bvh_layout.h chooses per device.
+OBS_CONST uint kSpecConstantBvhLayout = 15u;
+// The binary traversal's loop (a bool): false, one loop (what lavapipe's loop limiter needs),
+// true, Aila & Laine's while-while (lib/bvh.glsl, traverseBinary).
+OBS_CONST uint kSpecConstantBinaryLoop = 16u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

@@ -20,6 +20,8 @@
 #include "loop_limit_test.spv.h"
 #include "bench/bench_rays.h"
 #include "bench/ray_tracer.h"
+#include "core/error.h"
+#include "render/scene/bvh_layout.h"
 #include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
@@ -71,13 +73,15 @@ void expectAgreement(const Comparison& c, const char* what) {
 class GpuTraversal : public GpuTest {
 protected:
   Comparison traceAndCompare(const scene::Scene& scene, std::size_t count, std::uint64_t seed,
-                             std::optional<render::TraceShape> shape = {}, const bvh::BuildOptions& options = {}) {
+                             std::optional<render::TraceShape> shape = {}, const bvh::BuildOptions& options = {},
+                             std::optional<render::Traversal> traversal = {}) {
     bvh::TriangleSoup soup = render::triangleSoup(scene);
     bvh::Bvh tree = bvh::build(soup, options);
     if (options.spatialSplitBudget > 0.0f) {
       EXPECT_GT(tree.stats.spatialSplits, 0u);
     }
-    render::SceneBuffers buffers(context(), scene, tree);
+    render::SceneBuffers buffers(context(), scene, tree, traversal);
+    EXPECT_EQ(buffers.traversal(), traversal.value_or(render::Traversal::Wide)); // lavapipe's own: wide
     render::RayTracer tracer(context(), buffers, shape);
     auto rays = render::closestBenchRays(scene.bounds, count, seed);
     auto result = tracer.trace(rays, render::TraceMode::Closest);
@@ -145,6 +149,44 @@ TEST_F(GpuTraversal, GpuAndOneRayPerInvocationShapesMatchBruteForce) {
   render::TraceShape fromStorage = render::TraceShape::forGpu();
   fromStorage.bvhItemsFromStorage = true;
   expectAgreement(traceAndCompare(soup, 100000, 1, fromStorage), "random soup, GPU shape, BVH from an SSBO");
+}
+
+// The binary layout with both its loops (render/scene/bvh_layout.h: a GPU's traversal), run here
+// on lavapipe: the same closest hits as the brute force, the same occlusion as the CPU's any hit.
+TEST_F(GpuTraversal, BinaryLayoutMatchesBruteForceAndCpuAnyHit) {
+  const scene::Scene soup = soupScene(randomSoup(3000, 1));
+  const scene::Scene cornell = scene::loadGltf(sharedScene("cornell-box/cornell-box.gltf"));
+  bvh::BuildOptions splits;
+  splits.spatialSplitBudget = 0.3f;
+  for (const render::Traversal traversal : {render::Traversal::Binary, render::Traversal::BinaryWhileWhile}) {
+    const std::string name = render::traversalName(traversal);
+    expectAgreement(traceAndCompare(soup, 100000, 1, {}, {}, traversal), ("random soup, " + name).c_str());
+    expectAgreement(traceAndCompare(soup, 100000, 2, {}, splits, traversal), ("spatial splits, " + name).c_str());
+    expectAgreement(traceAndCompare(cornell, 100000, 11, {}, {}, traversal), ("cornell-box, " + name).c_str());
+
+    const bvh::Bvh tree = bvh::build(render::triangleSoup(cornell));
+    render::SceneBuffers buffers(context(), cornell, tree, traversal);
+    render::RayTracer tracer(context(), buffers);
+    EXPECT_EQ(tracer.shape().raysPerLane, 1u);
+    const auto rays = render::shadowBenchRays(cornell.bounds, 100000, 5);
+    const auto result = tracer.trace(rays, render::TraceMode::Any);
+    std::size_t disagreements = 0, occluded = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const bvh::Ray r{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
+      const bool cpu = bvh::anyHit(tree, r);
+      occluded += cpu;
+      disagreements += cpu != (result.hits[i].primitive != gpu::kInvalidIndex);
+    }
+    EXPECT_EQ(disagreements, 0u) << name;
+    EXPECT_GT(occluded, rays.size() / 10) << name;
+    EXPECT_EQ(buffers.truncatedTraversals(), 0u) << name;
+  }
+}
+
+TEST_F(GpuTraversal, BinaryLayoutOnModernHallMatchesBruteForce) {
+  const scene::Scene s = scene::loadGltf(sharedScene("modern-hall/modern-hall.gltf"));
+  expectAgreement(traceAndCompare(s, 100000, 12, {}, {}, render::Traversal::BinaryWhileWhile),
+                  "modern-hall, binary-while-while");
 }
 
 // Repeats traced back to back in one submission (bench-rays on a GPU) each give a time and the
@@ -215,6 +257,28 @@ TEST_F(GpuTraversal, LongTraversalIsReportedNotTruncatedSilently) {
       EXPECT_EQ(buffers.truncatedTraversals(), 0u);
     } else {
       // Too long: the traversal stops itself, says so per ray and in the status counter.
+      EXPECT_EQ(result.hits[0].primitive, gpu::kTruncatedHit);
+      EXPECT_EQ(result.steps[0], gpu::kMaxTraversalSteps);
+      EXPECT_EQ(buffers.truncatedTraversals(), rays.size());
+    }
+  }
+}
+
+// The binary layout's one loop counts its passes as the wide loop does, so lavapipe's loop limiter
+// cannot cut it off unnoticed either.
+TEST_F(GpuTraversal, LongBinaryTraversalIsReportedNotTruncatedSilently) {
+  for (std::size_t n : {20000u, 70000u}) {
+    scene::Scene s = stackedMisses(n);
+    bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+    render::SceneBuffers buffers(context(), s, tree, render::Traversal::Binary);
+    render::RayTracer tracer(context(), buffers);
+    std::vector<gpu::GpuRay> rays(8, gpu::GpuRay{glm::vec4(0, 0, -1, 0), glm::vec4(0, 0, 1, INFINITY)});
+    auto result = tracer.trace(rays, render::TraceMode::Closest, true);
+    if (n == 20000) {
+      EXPECT_EQ(result.hits[0].primitive, gpu::kInvalidIndex);
+      EXPECT_GE(result.steps[0], n);
+      EXPECT_EQ(buffers.truncatedTraversals(), 0u);
+    } else {
       EXPECT_EQ(result.hits[0].primitive, gpu::kTruncatedHit);
       EXPECT_EQ(result.steps[0], gpu::kMaxTraversalSteps);
       EXPECT_EQ(buffers.truncatedTraversals(), rays.size());
@@ -323,6 +387,25 @@ TEST_F(GpuTraversal, CompactStackHoldsTheDeepestBvhItAccepts) {
     EXPECT_THROW(render::RayTracer(context(), deeperBuffers, {}, v), std::logic_error);
   }
   static_assert(4 * gpu::kBvhCompactStackVectors + 2 == gpu::kBvhCompactStackMaxDepth);
+}
+
+// The binary traversals on the comb, whose every level pushes: the same hits as the brute force.
+// A comb deeper than the binary stack (kBinaryStackSize) cannot have the binary layout: asked for,
+// it is refused with a DeviceError; the device's choice falls back to the wide one.
+TEST_F(GpuTraversal, BinaryLayoutHoldsDeepStacksAndRefusesTreesDeeperThanItsStack) {
+  const std::uint32_t levels = 40;
+  Comb c = comb(levels);
+  scene::Scene s = soupScene(c.soup);
+  for (const render::Traversal traversal : {render::Traversal::Binary, render::Traversal::BinaryWhileWhile}) {
+    render::SceneBuffers buffers(context(), s, c.tree, traversal);
+    render::RayTracer tracer(context(), buffers);
+    expectCombHits(tracer, c, levels);
+    EXPECT_EQ(buffers.truncatedTraversals(), 0u);
+  }
+  Comb deep = comb(gpu::kBinaryStackSize + 4);
+  scene::Scene deepScene = soupScene(deep.soup);
+  EXPECT_FALSE(render::binaryBvhTexels(deep.tree).has_value());
+  EXPECT_THROW(render::SceneBuffers(context(), deepScene, deep.tree, render::Traversal::Binary), DeviceError);
 }
 
 class LoopLimiter : public GpuTest {};

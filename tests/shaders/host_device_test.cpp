@@ -14,6 +14,7 @@
 
 namespace obscura::gpu {
 static_assert(sizeof(BvhNode) == 80 && offsetof(BvhNode, qz) == 64 && sizeof(BvhNode) == kTexelsPerNode * 16);
+static_assert(sizeof(BvhBinaryNode) == 64 && offsetof(BvhBinaryNode, rightHi) == 48 && sizeof(BvhBinaryNode) == kTexelsPerBinaryNode * 16);
 static_assert(sizeof(BvhTriangle) == 48 && sizeof(BvhTriangle) == kTexelsPerTriangle * 16);
 static_assert(sizeof(TriangleShading) == 80 && offsetof(TriangleShading, uv2) == 64);
 static_assert(sizeof(GpuMaterial) == 80 && offsetof(GpuMaterial, textures) == 48 &&

@@ -5,12 +5,13 @@
 # OUT_DIR gets log.txt (everything printed) and a few images and JSON files, at most 8 files.
 # "quick" shrinks every size so that the script itself can be tried on lavapipe first.
 #
-#   bench-rays, both scenes: closest-hit and shadow rays per second (4M random rays, the best of
-#     5 timed repeats, the first 100k checked against the CPU traversal, on Sponza the first 1M),
-#     on modern-hall the paper's budget at 800x600 per pass (--passes), and on Sponza the general
-#     kernel (its stack in memory, --stack-registers 0) beside the compact stack that it takes
-#   render: the paper's budget (8 spp), modern-hall 800x600 and Sponza 1920x1080 under a uniform sky
-#     (Sponza has no lights), --metrics
+#   bench-rays, both scenes, with the device's own traversal (render/scene/bvh_layout.h) and with
+#     each other one (--traversal): closest-hit and shadow rays per second (4M random rays, the
+#     best of 5 timed repeats, the first 100k checked against the CPU traversal, on Sponza the
+#     first 1M), on modern-hall the paper's budget at 800x600 per pass (--passes) with the
+#     device's traversal and the wide one, and on Sponza the binary traversal's workgroup sizes
+#   render: the paper's budget (8 spp), modern-hall 800x600 (the device's traversal, then the
+#     wide one) and Sponza 1920x1080 under a uniform sky (Sponza has no lights), --metrics
 #   relight: modern-hall 800x600, 1 spp: a light's scale and colour, add and remove a point light,
 #     move an object, add an emissive quad (edits.jsonl: GPU and wall ms per edit)
 # STEP_LIMIT (seconds, default 150) bounds each step, so that a hang cannot eat the lease.
@@ -44,13 +45,27 @@ step() { # name command...: runs it under a time limit, everything into log.txt
   command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
   ldd "$obscura" | grep 'not found' && echo "LIBRARIES MISSING"
   step info "$obscura" info
-  step bench-hall "$obscura" bench-rays "$scenes/modern-hall/modern-hall.gltf" --rays "$rays" --repeats 5 \
-    --verify 100000 --passes "$passes"
-  step bench-sponza "$obscura" bench-rays "$scenes/sponza/sponza.gltf" --rays "$rays" --repeats 5 --verify "$verify"
-  step bench-sponza-general "$obscura" bench-rays "$scenes/sponza/sponza.gltf" --rays "$rays" --repeats 5 \
-    --stack-registers 0
-  step render-hall "$obscura" render "$scenes/modern-hall/modern-hall.gltf" --width "${hall[0]}" \
+  hall_scene=$scenes/modern-hall/modern-hall.gltf sponza_scene=$scenes/sponza/sponza.gltf
+  step bench-hall "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify 100000 --passes "$passes"
+  step bench-hall-wide "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify 100000 \
+    --passes "$passes" --traversal wide
+  step bench-hall-binary "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify 100000 \
+    --traversal binary
+  step bench-sponza "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$verify"
+  step bench-sponza-wide "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify 100000 \
+    --traversal wide
+  step bench-sponza-binary "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify 100000 \
+    --traversal binary
+  for shape in 64x1 256x1; do
+    step "bench-sponza-$shape" "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 \
+      --traversal binary-while-while --trace-shape "$shape"
+  done
+  step render-hall "$obscura" render "$hall_scene" --width "${hall[0]}" \
     --height "${hall[1]}" --spp 8 -o "$out/modern-hall.png" --metrics "$out/modern-hall.metrics.json"
+  step render-hall-wide "$obscura" render "$hall_scene" --width "${hall[0]}" \
+    --height "${hall[1]}" --spp 8 -o "$work/modern-hall-wide.png" --metrics "$work/modern-hall-wide.metrics.json" \
+    --traversal wide
+  cat "$work/modern-hall-wide.metrics.json"; echo
   step render-sponza "$obscura" render "$scenes/sponza/sponza.gltf" --width "${sponza[0]}" --height "${sponza[1]}" \
     --spp 8 --background 2,2,2 -o "$out/sponza.png" --metrics "$out/sponza.metrics.json"
   cat > "$work/edits.json" <<'JSON'

@@ -130,6 +130,10 @@ std::uint32_t texturesAbsent(const scene::Scene& scene) {
 } // namespace
 
 void SceneSpecialisation::addTo(gpu::KernelDesc& desc) const {
+  if (traversal != Traversal::Wide) {
+    desc.specConstants.push_back({gpu::kSpecConstantBvhLayout, bvhLayoutOf(traversal)});
+    desc.specConstants.push_back({gpu::kSpecConstantBinaryLoop, binaryWhileWhile(traversal) ? 1u : 0u});
+  }
   if (compactStackVectors != 0) desc.specConstants.push_back({gpu::kSpecConstantCompactStack, compactStackVectors});
   if (texturesAbsent != 0) desc.specConstants.push_back({gpu::kSpecConstantTexturesAbsent, texturesAbsent});
 }
@@ -141,9 +145,24 @@ void checkTexelLimit(const gpu::Context& context, std::size_t texels, const char
                                   context.info().maxTexelBufferElements));
 }
 
-SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh)
-    : context_(&context), compactStackVectors_(bvh::compactStackVectors(bvh)), texturesAbsent_(texturesAbsent(scene)) {
-  auto items = bvhTexels(bvh);
+std::vector<gpu::vec4> SceneBuffers::itemTexels(const bvh::Bvh& bvh) {
+  traversal_ = requested_.value_or(traversalForDevice(context_->info()));
+  if (traversal_ == Traversal::Wide) return bvhTexels(bvh);
+  if (auto binary = binaryBvhTexels(bvh)) return *std::move(binary);
+  const std::string why = fmt::format("the scene's binary BVH is deeper than the {}-entry stack of the binary traversal",
+                                      gpu::kBinaryStackSize);
+  if (requested_) throw DeviceError(fmt::format("--traversal {}: {}", traversalName(*requested_), why));
+  notes_.push_back(why + ": the wide layout is traversed instead");
+  traversal_ = Traversal::Wide;
+  return bvhTexels(bvh);
+}
+
+SceneBuffers::SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+                           std::optional<Traversal> traversal)
+    : context_(&context), requested_(traversal ? traversal : parseTraversal(context.traversalRequest())),
+      compactStackVectors_(bvh::compactStackVectors(bvh)),
+      texturesAbsent_(texturesAbsent(scene)) {
+  auto items = itemTexels(bvh);
   checkTexelLimit(context, items.size(), "BVH nodes and triangles");
   items_ = gpu::TexelBuffer(context, items.data(), items.size() * sizeof(gpu::vec4), "scene.bvhItems",
                             vk::BufferUsageFlagBits::eStorageBuffer);
@@ -185,7 +204,7 @@ void SceneBuffers::setSecondaryReflectors(const scene::Scene& scene, std::vector
 }
 
 bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh) {
-  auto items = bvhTexels(bvh);
+  auto items = itemTexels(bvh);
   auto shading = shadingData(scene, reflectors_);
   const std::size_t itemBytes = items.size() * sizeof(gpu::vec4);
   const std::size_t shadingBytes = shading.size() * sizeof(gpu::TriangleShading);
@@ -212,6 +231,9 @@ void SceneBuffers::bindTo(gpu::Kernel& kernel, std::uint32_t set, const gpu::Buf
                                        kernel.name(), kernelVectors,
                                        compactStackVectors_ == 0 ? "the general stack"
                                                                  : std::to_string(compactStackVectors_)));
+  if (kernel.specConstant(gpu::kSpecConstantBvhLayout) != bvhLayoutOf(traversal_))
+    throw std::logic_error(fmt::format("kernel '{}' traverses another BVH layout than this scene's ({})", kernel.name(),
+                                       traversalName(traversal_)));
   const std::uint32_t kernelAbsent = kernel.specConstant(gpu::kSpecConstantTexturesAbsent);
   if ((kernelAbsent & ~texturesAbsent_) != 0)
     throw std::logic_error(fmt::format("kernel '{}' is specialised for a scene without {} textures, which this "

@@ -2,12 +2,14 @@
 // pass; see shaders/lib/scene_bindings.glsl). Uploaded once; lives as long as the scene.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "bvh/bvh.h"
 #include "gpu/buffer.h"
 #include "gpu/context.h"
 #include "gpu/kernel.h"
+#include "render/scene/bvh_layout.h"
 #include "render/status_counters.h"
 #include "scene/scene.h"
 
@@ -56,10 +58,13 @@ gpu::TexelBuffer tableTexels(const gpu::Context& context, const std::vector<Row>
 struct SceneSpecialisation {
   std::uint32_t compactStackVectors = 0;
   std::uint32_t texturesAbsent = 0; // gpu::kTexturesAbsent* bits
+  // The layout of the scene's BVH items and the loop that traverses them (kSpecConstantBvhLayout,
+  // kSpecConstantBinaryLoop): a kernel reads one layout only.
+  Traversal traversal = Traversal::Wide;
   // Whether kernels made for this specialisation trace and shade a scene that needs `scene` right.
   bool holds(const SceneSpecialisation& scene) const {
     return bvh::compactStackHolds(compactStackVectors, scene.compactStackVectors) &&
-           (texturesAbsent & ~scene.texturesAbsent) == 0;
+           (texturesAbsent & ~scene.texturesAbsent) == 0 && bvhLayoutOf(traversal) == bvhLayoutOf(scene.traversal);
   }
   // Appends its specialisation constants to `desc` (none where the general kernel's).
   void addTo(gpu::KernelDesc& desc) const;
@@ -67,7 +72,11 @@ struct SceneSpecialisation {
 
 class SceneBuffers {
 public:
-  SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh);
+  // The BVH is uploaded in the layout of `traversal`, by default the context's request
+  // (--traversal) or else the device's (traversalForDevice). A binary tree deeper than its traversal's stack keeps the wide layout
+  // (noted in notes()), unless a binary traversal was asked for: then DeviceError.
+  SceneBuffers(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+               std::optional<Traversal> traversal = {});
 
   // Binds bindings 0..5 of descriptor set `set` of `kernel`. Binding 5 (status counters) is the
   // scene's own unless `status` is given: a renderer counts its frame's rays in its own buffer.
@@ -79,7 +88,9 @@ public:
   // date by updateGeometry: the specialisation of the kernels that trace it.
   std::uint32_t compactStackVectors() const { return compactStackVectors_; }
   // The specialisation of the kernels that trace and shade this scene.
-  SceneSpecialisation specialisation() const { return {compactStackVectors_, texturesAbsent_}; }
+  SceneSpecialisation specialisation() const { return {compactStackVectors_, texturesAbsent_, traversal_}; }
+  // The layout the BVH items are in and the loop that traverses them.
+  Traversal traversal() const { return traversal_; }
 
   // After an edit that kept the materials and textures (a move or a removal): uploads the BVH items
   // and the triangles' shading data again, in place when their sizes stayed (the texel buffer's
@@ -113,6 +124,11 @@ private:
   gpu::TexelBuffer texels_;
   StatusCounters status_;
   std::uint64_t bytes_ = 0;
+  // The BVH's texels in the layout of traversal_ (falling back to the wide one, see the constructor).
+  std::vector<gpu::vec4> itemTexels(const bvh::Bvh& bvh);
+
+  std::optional<Traversal> requested_; // the traversal asked for; nullopt: the device's
+  Traversal traversal_ = Traversal::Wide;
   std::uint32_t compactStackVectors_ = 0;
   std::uint32_t texturesAbsent_ = 0; // gpu::kTexturesAbsent* bits: the texture kinds no material uses
   std::vector<std::string> notes_;
