@@ -1,8 +1,8 @@
 #version 460
 // trace.comp — traces a buffer of rays (closest hit or any hit), kRaysPerLane per invocation
-// through one refilling traversal loop (lib/bvh_stream.glsl): 64 on lavapipe, 8 on a GPU (a
-// specialisation constant, as is the workgroup size; host/bench/ray_tracer.h); kRaysPerLane = 1
-// goes straight through traverseBvh. Used by `obscura bench-rays` and by the traversal tests, so
+// through one refilling traversal loop (lib/bvh_stream.glsl, the wide or the binary layout's):
+// 64 on lavapipe, 8 on a GPU (a specialisation constant, as is the workgroup size;
+// host/bench/ray_tracer.h); kRaysPerLane = 1 goes straight through traverseBvh. Used by `obscura bench-rays` and by the traversal tests, so
 // the benchmark measures the code tested.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
@@ -51,9 +51,7 @@ void streamHit(uint k, RayHit h) {
 #include "lib/bvh_stream.glsl"
 
 void main() {
-  // One ray per invocation, straight through traverseBvh; the binary layout always (the
-  // refilling loop of lib/bvh_stream.glsl walks the wide one).
-  if (kRaysPerLane == 1u || kBinaryLayout) {
+  if (kRaysPerLane == 1u) { // one ray per invocation: straight through traverseBvh
     const uint i = rayIndex(0u);
     if (i >= pc.params.x) return;
     GpuRay ray = streamRay(0u);
@@ -66,7 +64,8 @@ void main() {
   }
   uint count = 0u;
   while (count < kRaysPerLane && rayIndex(count) < pc.params.x) ++count;
-  uint truncated = traverseStream(count, pc.params.y != 0u, kMaxTraversalSteps);
+  uint truncated = kBinaryLayout ? traverseBinaryStream(count, pc.params.y != 0u, kMaxTraversalSteps)
+                                 : traverseStream(count, pc.params.y != 0u, kMaxTraversalSteps);
   if (truncated != 0u) atomicAdd(status[kStatusTruncated], truncated);
   for (uint k = 0u; k < count; ++k) {
     uvec2 stored = sHits[hitSlot(k)];

@@ -28,10 +28,13 @@ struct TraceShape {
   std::uint32_t raysPerLane = gpu::kTraceRaysPerLane;
   // The BVH read from its buffer bound as an SSBO, not through the texel view (the passes' path).
   bool bvhItemsFromStorage = false;
+  // The binary traversal's closest-hit rays drop popped children beyond their hit (the passes'
+  // default; kSpecConstantBinaryCullOnPop): false measures without.
+  bool binaryCullOnPop = true;
   static TraceShape forCpu() { return {}; }
   static TraceShape forGpu() { return {gpu::kTraceGpuWorkgroupSize, gpu::kTraceGpuRaysPerLane}; }
-  // The binary traversal goes straight through traverseBvh, one ray per invocation (trace.comp's
-  // refilling loop is the wide one's).
+  // The binary traversal: one ray per invocation, straight through traverseBvh (what a pass's
+  // ray gets); other shapes refill (lib/bvh_stream.glsl, traverseBinaryStream).
   static TraceShape forBinary() { return {gpu::kTraceBinaryWorkgroupSize, 1}; }
   // For the wide layout forCpu() on a CPU device, forGpu() otherwise; forBinary() for a binary one.
   static TraceShape forDevice(const gpu::Context& context, Traversal traversal);

@@ -33,7 +33,8 @@ std::uint32_t binaryLeafFirst(std::uint32_t ref);
 std::uint32_t binaryLeafCount(std::uint32_t ref);
 
 // The same traversal shaders/lib/bvh.glsl runs on this layout (traverseBinary): nearer child
-// first, the other pushed; boxes tested as intersectBox does. Same answers as closestHit and
+// first, the other pushed; boxes tested as intersectBox does (the GPU's cull on pop, which skips
+// a child that a box test would skip anyway, is left out). Same answers as closestHit and
 // anyHit over the wide nodes (ties in t to the lower primitive id).
 Hit closestHitBinary(const Bvh& bvh, const BinaryBvh& binary, const Ray& ray);
 bool anyHitBinary(const Bvh& bvh, const BinaryBvh& binary, const Ray& ray);

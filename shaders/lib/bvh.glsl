@@ -284,16 +284,22 @@ const bool kBinaryLayout = kBvhLayout == kBvhLayoutBinary;
 // the leaf's triangles, inside an outer loop), for GPUs, which have no loop limiter: its step
 // count bounds each lane's passes, not the passes of lavapipe's 8-lane group.
 layout(constant_id = kSpecConstantBinaryLoop) const bool kBinaryWhileWhile = false;
+// A closest-hit ray keeps each pushed child's entry distance beside it and drops the child when
+// it is popped beyond the hit found since, instead of fetching its node to find that out
+// (kSpecConstantBinaryCullOnPop; bench-rays --no-cull-on-pop measures without).
+layout(constant_id = kSpecConstantBinaryCullOnPop) const bool kBinaryCullOnPop = true;
 
 // One node: x = the child to visit next (the nearer one met), y = the other one met, to push;
-// kInvalidIndex where none. An absent child's box is never met.
-uvec2 visitBinaryNode(uint node, vec3 origin, vec3 invDir, float tmin, float tmax) {
+// kInvalidIndex where none. `farNear` gets the pushed child's entry distance.
+// An absent child's box is never met.
+uvec2 visitBinaryNode(uint node, vec3 origin, vec3 invDir, float tmin, float tmax, out float farNear) {
   int b = int(node * kTexelsPerBinaryNode);
   vec4 leftLo = bvhItem(b), leftHi = bvhItem(b + 1), rightLo = bvhItem(b + 2), rightHi = bvhItem(b + 3);
   vec2 l = intersectBox(leftLo.xyz, leftHi.xyz, origin, invDir, tmin, tmax);
   vec2 r = intersectBox(rightLo.xyz, rightHi.xyz, origin, invDir, tmin, tmax);
   bool hitL = l.x <= l.y, hitR = r.x <= r.y;
   uint left = floatBitsToUint(leftLo.w), right = floatBitsToUint(leftHi.w);
+  farNear = max(l.x, r.x);
   if (hitL && hitR) return r.x < l.x ? uvec2(right, left) : uvec2(left, right);
   if (hitL) return uvec2(left, kInvalidIndex);
   if (hitR) return uvec2(right, kInvalidIndex);
@@ -314,7 +320,9 @@ RayHit traverseBinary(vec3 origin, vec3 direction, float tmin, float tmax, bool 
   WatertightRay wr = prepareWatertightRay(origin, direction);
   vec3 invDir = safeReciprocal(direction);
   RayHit hit = RayHit(tmax, 0.0, 0.0, kInvalidIndex, kInvalidIndex, 0u);
+  const bool cull = kBinaryCullOnPop && !anyHit;
   uint stack[kBinaryStackSize];
+  float stackNear[kBinaryStackSize]; // written and read only where `cull`
   uint sp = 0u;
   uint ref = 0u; // the root
   if (kBinaryWhileWhile) {
@@ -325,14 +333,20 @@ RayHit traverseBinary(vec3 origin, vec3 direction, float tmin, float tmax, bool 
           return hit;
         }
         hit.steps++;
-        uvec2 next = visitBinaryNode(ref, origin, invDir, tmin, hit.t);
-        if (next.y != kInvalidIndex) stack[sp++] = next.y;
-        if (next.x != kInvalidIndex) {
-          ref = next.x;
-        } else {
-          if (sp == 0u) return hit;
-          ref = stack[--sp];
+        float farNear;
+        uvec2 next = visitBinaryNode(ref, origin, invDir, tmin, hit.t, farNear);
+        if (next.y != kInvalidIndex) {
+          stack[sp] = next.y;
+          if (cull) stackNear[sp] = farNear;
+          sp++;
         }
+        ref = next.x;
+        // Popped until a child still nearer than the hit (every child where not `cull`).
+        while (ref == kInvalidIndex && sp > 0u) {
+          sp--;
+          if (!cull || stackNear[sp] <= hit.t) ref = stack[sp];
+        }
+        if (ref == kInvalidIndex) return hit;
       }
       uint first = ref & kBinaryLeafTexelMask;
       uint end = first + kTexelsPerTriangle * ((ref >> kBinaryLeafCountShift) & 7u);
@@ -344,22 +358,33 @@ RayHit traverseBinary(vec3 origin, vec3 direction, float tmin, float tmax, bool 
         hit.steps++;
         if (testBinaryTriangle(texel, wr, tmin, tmax, anyHit, hit) && anyHit) return hit;
       }
-      if (sp == 0u) return hit;
-      ref = stack[--sp];
+      ref = kInvalidIndex;
+      while (ref == kInvalidIndex && sp > 0u) {
+        sp--;
+        if (!cull || stackNear[sp] <= hit.t) ref = stack[sp];
+      }
+      if (ref == kInvalidIndex) return hit;
     }
   }
   // One loop: a pass visits a node, or tests the first triangle of a leaf and leaves the rest of
-  // the leaf (a leaf reference one triangle shorter) for the next pass.
+  // the leaf (a leaf reference one triangle shorter) for the next pass. A pop that meets a child
+  // beyond the hit drops it and pops again at the next pass (no inner loop: every pass counted).
   for (;;) {
     if (hit.steps >= maxSteps) {
       hit.primitive = kTruncatedHit;
       break;
     }
     hit.steps++;
-    uint next;
-    if (!isBinaryLeaf(ref)) {
-      uvec2 children = visitBinaryNode(ref, origin, invDir, tmin, hit.t);
-      if (children.y != kInvalidIndex) stack[sp++] = children.y;
+    uint next = kInvalidIndex;
+    if (ref == kInvalidIndex) { // a dropped child: nothing this pass but the pop below
+    } else if (!isBinaryLeaf(ref)) {
+      float farNear;
+      uvec2 children = visitBinaryNode(ref, origin, invDir, tmin, hit.t, farNear);
+      if (children.y != kInvalidIndex) {
+        stack[sp] = children.y;
+        if (cull) stackNear[sp] = farNear;
+        sp++;
+      }
       next = children.x;
     } else {
       uint texel = ref & kBinaryLeafTexelMask;
@@ -370,7 +395,8 @@ RayHit traverseBinary(vec3 origin, vec3 direction, float tmin, float tmax, bool 
     }
     if (next == kInvalidIndex) {
       if (sp == 0u) break;
-      next = stack[--sp];
+      sp--;
+      next = !cull || stackNear[sp] <= hit.t ? stack[sp] : kInvalidIndex;
     }
     ref = next;
   }

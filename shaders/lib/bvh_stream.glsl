@@ -114,4 +114,81 @@ uint traverseStream(uint count, bool anyHit, uint maxSteps) {
   return truncated;
 }
 
+// The same refill over the binary layout (bvh.glsl, traverseBinary's one loop): a pass visits a
+// node or tests a triangle of the lane's current ray, and a lane whose ray is done sets up its
+// next one in the same pass site. The array stack takes any depth the host lets through
+// (kBinaryStackSize), so no ray is put aside. Returns how many rays ran out of passes.
+uint traverseBinaryStream(uint count, bool anyHit, uint maxSteps) {
+  const bool cull = kBinaryCullOnPop && !anyHit;
+  WatertightRay wr;
+  vec3 origin = vec3(0.0), invDir = vec3(0.0);
+  float tmin = 0.0, tmax = 0.0;
+  RayHit hit;
+  uint stack[kBinaryStackSize];
+  float stackNear[kBinaryStackSize];
+  uint sp = 0u;
+  uint ref = 0u;
+  uint laneSteps = 0u;
+  uint truncated = 0u;
+  uint k = 0u;
+  bool needRay = true;
+  for (;;) {
+    if (needRay) { // the one set-up site
+      if (k >= count) break;
+      GpuRay ray = streamRay(k);
+      origin = ray.origin.xyz;
+      tmin = ray.origin.w;
+      tmax = ray.direction.w;
+      wr = prepareWatertightRay(origin, ray.direction.xyz);
+      invDir = safeReciprocal(ray.direction.xyz);
+      hit = RayHit(tmax, 0.0, 0.0, kInvalidIndex, kInvalidIndex, 0u);
+      sp = 0u;
+      ref = 0u;
+      needRay = false;
+    }
+    bool done = false;
+    uint next = kInvalidIndex;
+    if (laneSteps >= maxSteps) { // out of passes: this ray and the lane's next ones end truncated
+      hit.primitive = kTruncatedHit;
+      done = true;
+    } else {
+      laneSteps++;
+      hit.steps++;
+      if (ref == kInvalidIndex) { // a dropped child: only the pop below
+      } else if (!isBinaryLeaf(ref)) {
+        float farNear;
+        uvec2 children = visitBinaryNode(ref, origin, invDir, tmin, hit.t, farNear);
+        if (children.y != kInvalidIndex) {
+          stack[sp] = children.y;
+          if (cull) stackNear[sp] = farNear;
+          sp++;
+        }
+        next = children.x;
+      } else {
+        uint texel = ref & kBinaryLeafTexelMask;
+        done = testBinaryTriangle(texel, wr, tmin, tmax, anyHit, hit) && anyHit;
+        uint left = ((ref >> kBinaryLeafCountShift) & 7u) - 1u;
+        next = left == 0u ? kInvalidIndex
+                          : kBinaryLeafBit | (left << kBinaryLeafCountShift) | (texel + kTexelsPerTriangle);
+      }
+      if (!done && next == kInvalidIndex) {
+        if (sp == 0u) {
+          done = true;
+        } else {
+          sp--;
+          next = !cull || stackNear[sp] <= hit.t ? stack[sp] : kInvalidIndex;
+        }
+      }
+      ref = next;
+    }
+    if (done) {
+      if (hit.primitive == kTruncatedHit) ++truncated;
+      streamHit(k, hit); // the one store site
+      ++k;
+      needRay = true;
+    }
+  }
+  return truncated;
+}
+
 #endif

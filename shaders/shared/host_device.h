@@ -465,6 +465,9 @@ OBS_CONST uint kSpecConstantBvhLayout = 15u;
 // The binary traversal's loop (a bool): false, one loop (what lavapipe's loop limiter needs),
 // true, Aila & Laine's while-while (lib/bvh.glsl, traverseBinary).
 OBS_CONST uint kSpecConstantBinaryLoop = 16u;
+// A closest-hit ray of the binary traversal drops a popped child that lies beyond its hit (a bool,
+// on by default; bench-rays --no-cull-on-pop measures without).
+OBS_CONST uint kSpecConstantBinaryCullOnPop = 17u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;
 

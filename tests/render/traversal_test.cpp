@@ -183,6 +183,15 @@ TEST_F(GpuTraversal, BinaryLayoutMatchesBruteForceAndCpuAnyHit) {
   }
 }
 
+// Several rays per invocation over the binary layout: trace.comp's refilling loop
+// (traverseBinaryStream), in lavapipe's shape and a GPU's.
+TEST_F(GpuTraversal, BinaryRefillingShapesMatchBruteForce) {
+  const scene::Scene soup = soupScene(randomSoup(3000, 1));
+  for (const render::TraceShape shape : {render::TraceShape::forCpu(), render::TraceShape::forGpu()})
+    expectAgreement(traceAndCompare(soup, 100000, 3, shape, {}, render::Traversal::Binary),
+                    ("random soup, binary, " + std::to_string(shape.raysPerLane) + " rays per invocation").c_str());
+}
+
 TEST_F(GpuTraversal, BinaryLayoutOnModernHallMatchesBruteForce) {
   const scene::Scene s = scene::loadGltf(sharedScene("modern-hall/modern-hall.gltf"));
   expectAgreement(traceAndCompare(s, 100000, 12, {}, {}, render::Traversal::BinaryWhileWhile),

@@ -9,7 +9,10 @@
 #     each other one (--traversal): closest-hit and shadow rays per second (4M random rays, the
 #     best of 5 timed repeats, the first 100k checked against the CPU traversal, on Sponza the
 #     first 1M), on modern-hall the paper's budget at 800x600 per pass (--passes) with the
-#     device's traversal and the wide one, and on Sponza the binary traversal's workgroup sizes
+#     device's traversal and the wide one, and on Sponza the binary traversal's refilling shapes
+#     (several rays per invocation, --trace-shape) and
+#     its BVH read as an SSBO (--bvh-items storage), without its cull on pop (--no-cull-on-pop) and
+#     every traversal over a tree with spatial splits (--spatial-splits 0.1)
 #   render: the paper's budget (8 spp), modern-hall 800x600 (the device's traversal, then the
 #     wide one) and Sponza 1920x1080 under a uniform sky (Sponza has no lights), --metrics
 #   relight: modern-hall 800x600, 1 spp: a light's scale and colour, add and remove a point light,
@@ -56,10 +59,21 @@ step() { # name command...: runs it under a time limit, everything into log.txt
     --traversal wide
   step bench-sponza-binary "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify 100000 \
     --traversal binary
-  for shape in 64x1 256x1; do
-    step "bench-sponza-$shape" "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 \
-      --traversal binary-while-while --trace-shape "$shape"
+  step bench-sponza-storage "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --bvh-items storage
+  step bench-sponza-no-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --no-cull-on-pop
+  step bench-sponza-binary-no-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 \
+    --traversal binary --no-cull-on-pop
+  for traversal in binary-while-while binary wide; do
+    step "bench-sponza-splits-$traversal" "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 \
+      --spatial-splits 0.1 --traversal "$traversal"
   done
+  step bench-hall-splits "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --spatial-splits 0.1
+  for shape in 32x8 64x4 32x16; do # several rays per invocation: the binary refilling loop
+    step "bench-sponza-$shape" "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 \
+      --traversal binary --trace-shape "$shape"
+  done
+  step bench-hall-32x8 "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --traversal binary \
+    --trace-shape 32x8
   step render-hall "$obscura" render "$hall_scene" --width "${hall[0]}" \
     --height "${hall[1]}" --spp 8 -o "$out/modern-hall.png" --metrics "$out/modern-hall.metrics.json"
   step render-hall-wide "$obscura" render "$hall_scene" --width "${hall[0]}" \
