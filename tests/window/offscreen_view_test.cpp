@@ -8,7 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli_runner.h"
+#include "gpu_test.h"
 #include "io/image_io.h"
+#include "window/event_script.h"
 #include "window/virtual_display.h"
 
 namespace obscura::test {
@@ -118,6 +120,22 @@ TEST_F(OffscreenView, WhatOnlyAWindowHasIsRefusedBeforeTheSceneLoads) {
   EXPECT_CONTAINS(resize.output, "'resize' at frame 1 needs a window");
   EXPECT_FALSE(fs::exists(path("ui.png")));
   for (const auto& r : {noEnd, panel, resize}) EXPECT_EQ(r.output.find("triangles"), std::string::npos) << r.output;
+}
+
+TEST(ViewBenchmarkScript, ParsesAndRunsItsSegmentsToFrame145) {
+  // tools/gpu/view_benchmark_script.json drives the GPU benchmark (docs/BENCHMARKS.md); the run is
+  // its length. Its names (bench_bulb, light_rectangle_6, Mesh017) are checked when it runs on
+  // modern-hall, which is too slow for a test here.
+  const window::EventScript script(repoPath("tools/gpu/view_benchmark_script.json"));
+  EXPECT_EQ(script.length(), 146u);
+  std::size_t drags = 0, moves = 0;
+  for (const auto& e : script.events()) {
+    EXPECT_NE(e.kind, window::ScriptEvent::Kind::Window) << "it must run --offscreen";
+    drags += e.kind == window::ScriptEvent::Kind::Panel && e.action.kind == window::ViewerAction::Kind::MoveLight;
+    moves += e.kind == window::ScriptEvent::Kind::Panel && e.action.kind == window::ViewerAction::Kind::MoveObject;
+  }
+  EXPECT_EQ(drags, 30u);
+  EXPECT_EQ(moves, 30u);
 }
 
 } // namespace
