@@ -228,6 +228,17 @@ void EventScript::feed(std::size_t frame, InputState& in) const {
   }
 }
 
+std::size_t EventScript::length() const {
+  std::size_t end = 0;
+  for (const auto& e : events_) {
+    // A drag releases its button the frame after; a held key is released at frame + hold.
+    const std::size_t last = e.kind == ScriptEvent::Kind::Key ? e.frame + std::max<std::size_t>(static_cast<std::size_t>(e.hold), 1) - 1
+                                                                   : e.frame;
+    end = std::max(end, last + 1);
+  }
+  return end;
+}
+
 std::vector<const ScriptEvent*> EventScript::eventsAt(std::size_t frame) const {
   std::vector<const ScriptEvent*> out;
   for (const auto& e : events_)

@@ -49,6 +49,10 @@ public:
   // The events of `frame` of the other kinds (panel, window, screenshot), in file order.
   std::vector<const ScriptEvent*> eventsAt(std::size_t frame) const;
   bool empty() const { return events_.empty(); }
+  // The frames the script spans: one past its last event's frame (a held key's last held frame).
+  // `view --offscreen` without --frames runs this many.
+  std::size_t length() const;
+  const std::vector<ScriptEvent>& events() const { return events_; }
 
 private:
   std::vector<ScriptEvent> events_;

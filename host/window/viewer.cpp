@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 #define GLFW_INCLUDE_NONE
-#include <GLFW/glfw3.h>
+#include <GLFW/glfw3.h> // the key codes alone: input arrives through the FrameTarget
 
 #include "bvh/bvh.h"
 #include "render/scene/scene_buffers.h"
@@ -16,6 +16,8 @@
 #include "render/aovs.h"
 #include "render/transport.h"
 #include "scene/scene_edit.h"
+#include "window/frame_presenter.h"
+#include "window/ui_overlay.h"
 
 namespace obscura::window {
 namespace {
@@ -25,16 +27,6 @@ using Kind = ViewerAction::Kind;
 
 // Light slots reserved for lights added in the window (each holds a basis buffer per pixel).
 constexpr std::uint32_t kSpareLightSlots = 8;
-
-gpu::ContextOptions presentable(gpu::ContextOptions options) {
-  options.instanceExtensions = GlfwWindow::requiredInstanceExtensions();
-  // The panel draws with a graphics pipeline and the frame is blitted: the queue must do graphics.
-  // Presentation to the surface itself is checked once the surface exists (Swapchain).
-  options.canPresent = [](const vk::raii::PhysicalDevice& device, std::uint32_t family) {
-    return static_cast<bool>(device.getQueueFamilyProperties()[family].queueFlags & vk::QueueFlagBits::eGraphics);
-  };
-  return options;
-}
 
 std::uint64_t totalRays(const render::RenderStats& stats) {
   std::uint64_t rays = 0;
@@ -59,19 +51,19 @@ struct Viewer::FrameRecord {
   double renderMs = 0.0;       // wall time of the edits, the samples and the compose
   double denoiseMs = 0.0;      // the denoiser's GPU time (0 when it did not run)
   std::map<std::string, double> passMs; // the renderer's GPU ms per pass this frame
-  double presentMs = 0.0;      // wall time of the panel and the presentation
-  double frameMs = 0.0;
+  double presentMs = 0.0;      // wall time of the panel and the presentation (and screenshots)
+  double wallMs = 0.0;         // the whole frame on the host's clock, from its input poll to its
+                               // end: edits, samples, waits for the device, read-backs, presentation
   std::vector<std::string> actions;
 };
 
-Viewer::Viewer(const gpu::ContextOptions& device, scene::Scene scene, bvh::Bvh bvh, ViewerConfig config)
+Viewer::Viewer(std::unique_ptr<FrameTarget> target, const gpu::ContextOptions& device, scene::Scene scene,
+               bvh::Bvh bvh, ViewerConfig config)
     : config_(std::move(config)),
-      window_(static_cast<int>(config_.obscurance.width), static_cast<int>(config_.obscurance.height), config_.title),
-      context_(presentable(device)),
-      surface_(window_.createSurface(context_.instance())),
-      swapchain_(context_, surface_),
-      presenter_(context_, swapchain_, config_.obscurance.width, config_.obscurance.height),
+      target_(std::move(target)),
+      context_(target_->contextOptions(device)),
       camera_(config_.obscurance.camera, scene.bounds) {
+  target_->attach(context_, config_.obscurance.width, config_.obscurance.height, config_.panel);
   if (!config_.log.empty()) {
     log_.open(config_.log);
     if (!log_) throw InputError(fmt::format("{}: cannot write the frame log", config_.log));
@@ -94,13 +86,13 @@ Viewer::Viewer(const gpu::ContextOptions& device, scene::Scene scene, bvh::Bvh b
   const auto& names = renderer_->lights().names;
   for (std::size_t i = 0; i < names.size(); ++i)
     lights_.push_back({.name = names[i], .base = renderer_->emissions()[i]});
-
-  swapchain_.recreate(config_.obscurance.width, config_.obscurance.height);
-  if (config_.panel) overlay_ = std::make_unique<UiOverlay>(context_, window_, swapchain_);
   lastFrameStart_ = Clock::now();
 }
 
-Viewer::~Viewer() { context_.device().waitIdle(); }
+Viewer::~Viewer() {
+  context_.device().waitIdle();
+  target_->detach();
+}
 
 render::ObscuranceSettings Viewer::fullSettings() const {
   render::ObscuranceSettings s = config_.obscurance;
@@ -288,21 +280,15 @@ void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
   }
 }
 
-void Viewer::applyWindowEvent(const ScriptEvent& e) {
-  if (e.text == "resize") window_.resize(static_cast<int>(e.xy[0]), static_cast<int>(e.xy[1]));
-  else if (e.text == "minimize") window_.iconify();
-  else if (e.text == "restore") window_.restore();
-  else if (e.text == "close") window_.requestClose();
-}
-
 int Viewer::pick(double x, double y) {
-  const auto drawable = window_.framebufferSize();
+  const auto drawable = target_->drawableSize();
   if (drawable[0] <= 0 || drawable[1] <= 0) return -1;
   const auto rect = fitToDrawable(config_.obscurance.width, config_.obscurance.height,
                                   {static_cast<std::uint32_t>(drawable[0]), static_cast<std::uint32_t>(drawable[1])});
   const double u = (x - rect[0].x) / double(rect[1].x - rect[0].x), v = (y - rect[0].y) / double(rect[1].y - rect[0].y);
   if (u < 0.0 || u >= 1.0 || v < 0.0 || v >= 1.0) return -1;
   const int px = static_cast<int>(u * config_.obscurance.width), py = static_cast<int>(v * config_.obscurance.height);
+  shownBytes(); // compose() writes the display bytes too: keep the frame shown as the light mix made it
   renderer_->compose(config_.exposure);
   const io::Image image = renderer_->image();
   const int channel = image.channelIndex(render::aovChannels("primitive").front());
@@ -337,7 +323,10 @@ void Viewer::renderStep(FrameRecord& record) {
       pathTracer_->iterate(1);
       needsCompose_ = true;
     }
-    if (needsCompose_) shown_ = io::encodeRgba8(pathTracer_->image(), 0, config_.exposure, 3);
+    if (needsCompose_) {
+      shown_ = io::encodeRgba8(pathTracer_->image(), 0, config_.exposure, 3);
+      shownAt_ = ShownAt::Host;
+    }
     needsCompose_ = false;
     return;
   }
@@ -359,17 +348,25 @@ void Viewer::renderStep(FrameRecord& record) {
     renderer_->compose(config_.exposure);
     denoiser_->denoise(*renderer_, config_.exposure);
     record.denoiseMs = denoiser_->lastGpuMs();
-    shown_ = denoiser_->display();
+    shownAt_ = ShownAt::Denoiser;
   } else if (config_.aov == "combined") {
     renderer_->composeDisplay(config_.exposure);
-    shown_ = renderer_->display();
+    shownAt_ = ShownAt::Renderer;
   } else {
     renderer_->compose(config_.exposure);
     const io::Image image = renderer_->image();
     const auto channels = render::aovChannels(config_.aov);
     shown_ = io::encodeRgba8(image, image.channelIndex(channels.front()), config_.exposure,
                              static_cast<int>(channels.size()));
+    shownAt_ = ShownAt::Host;
   }
+}
+
+const std::vector<std::uint32_t>& Viewer::shownBytes() {
+  if (shownAt_ == ShownAt::Denoiser) shown_ = denoiser_->display();
+  else if (shownAt_ == ShownAt::Renderer) shown_ = renderer_->display();
+  shownAt_ = ShownAt::Host; // until the next compose
+  return shown_;
 }
 
 render::RenderStats Viewer::currentStats() const {
@@ -427,7 +424,9 @@ void Viewer::writeLog(const FrameRecord& r) {
                          {"denoise_ms", r.denoiseMs},
                          {"pass_ms", r.passMs},
                          {"present_ms", r.presentMs},
-                         {"frame_ms", r.frameMs},
+                         {"frame_gpu_ms", r.gpuMs + r.denoiseMs},
+                         {"wall_ms", r.wallMs},
+                         {"frame_ms", r.wallMs}, // wall_ms's older name (tools/bench_view.sh)
                          {"actions", r.actions}};
   log_ << line.dump() << "\n";
   log_.flush();
@@ -436,12 +435,13 @@ void Viewer::writeLog(const FrameRecord& r) {
 io::Image Viewer::shownImage() {
   if (config_.method == "pathtrace") return pathTracer_->image();
   if (config_.aov == "combined" && config_.denoise) return denoiser_->image();
+  shownBytes(); // as in pick(): compose() overwrites the display bytes not yet read back
   renderer_->compose(config_.exposure);
   return renderer_->image();
 }
 
-void Viewer::takeScreenshot(const std::string& path, const std::vector<std::uint32_t>& shown,
-                            const std::vector<std::uint32_t>& captured, vk::Extent2D extent) {
+void Viewer::takeScreenshot(const std::string& path, const std::vector<std::uint32_t>& captured,
+                            vk::Extent2D extent) {
   if (io::extensionOf(path) == "exr") {
     io::writeExr(path, shownImage()); // linear, every AOV the frame keeps
     return;
@@ -450,7 +450,8 @@ void Viewer::takeScreenshot(const std::string& path, const std::vector<std::uint
     if (captured.empty()) throw DeviceError(fmt::format("{}: no frame was presented to capture (minimised?)", path));
     io::writePngRgba8(path, static_cast<int>(extent.width), static_cast<int>(extent.height), captured);
   } else {
-    io::writePngRgba8(path, static_cast<int>(config_.obscurance.width), static_cast<int>(config_.obscurance.height), shown);
+    io::writePngRgba8(path, static_cast<int>(config_.obscurance.width), static_cast<int>(config_.obscurance.height),
+                      shownBytes());
   }
 }
 
@@ -468,29 +469,30 @@ void Viewer::run() {
     FrameRecord record;
     record.frame = frame_;
 
-    InputState& input = window_.input();
+    InputState& input = target_->input();
     input.beginFrame();
-    const auto drawable = window_.framebufferSize();
+    const auto drawable = target_->drawableSize();
     // A person's window waits for input while there is nothing to do (minimised, or every sample
     // done and nothing changed last frame) instead of spinning; a script never waits.
     const bool idle = drawable[0] == 0 || idleLastFrame_;
-    window_.pollEvents(idle && config_.script.empty() ? 0.05 : 0.0);
-    if (window_.shouldClose()) break;
+    target_->pollEvents(idle && config_.script.empty() ? 0.05 : 0.0);
+    if (target_->shouldClose()) break;
     config_.script.feed(frame_, input);
     std::vector<ViewerAction> actions;
-    if (overlay_ && panelVisible) {
-      overlay_->beginFrame(input);
+    UiOverlay* overlay = panelVisible ? target_->overlay() : nullptr;
+    if (overlay) {
+      overlay->beginFrame(input);
       actions = drawControlPanel(panelState());
     }
     std::vector<std::string> screenshots;
     for (const ScriptEvent* e : config_.script.eventsAt(frame_)) {
       if (e->kind == ScriptEvent::Kind::Panel) actions.push_back(e->action);
-      else if (e->kind == ScriptEvent::Kind::Window) applyWindowEvent(*e);
+      else if (e->kind == ScriptEvent::Kind::Window) target_->applyWindowEvent(*e);
       else screenshots.push_back(e->text);
     }
     if (!input.uiWantsKeyboard) {
       for (int key : input.keysPressed) {
-        if (key == GLFW_KEY_ESCAPE) window_.requestClose();
+        if (key == GLFW_KEY_ESCAPE) target_->requestClose();
         if (key == GLFW_KEY_TAB) panelVisible = !panelVisible;
         if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && std::size_t(key - GLFW_KEY_1) < scenes_.back().cameras.size()) {
           ViewerAction a;
@@ -530,6 +532,7 @@ void Viewer::run() {
       restart(true, true);
       record.preview = true;
       record.restarted = true;
+      record.actions.push_back("camera_move"); // a drag, a key, the wheel (the log tells them apart from edits)
     }
     renderStep(record);
     const render::RenderStats after = currentStats();
@@ -548,15 +551,14 @@ void Viewer::run() {
     vk::Extent2D capturedExtent{};
     const bool lastFrame = config_.frames != 0 && frame_ + 1 == config_.frames;
     const bool capture = config_.screenshotUi && (!screenshots.empty() || (lastFrame && !config_.screenshot.empty()));
-    record.presented = presenter_.present(shown_, window_.framebufferSize(),
-                                          overlay_ && panelVisible ? overlay_.get() : nullptr,
-                                          capture ? &captured : nullptr, &capturedExtent);
-    if (overlay_ && panelVisible && !record.presented) overlay_->discardFrame();
-    for (const auto& path : screenshots) takeScreenshot(path, shown_, captured, capturedExtent);
-    if (lastFrame && !config_.screenshot.empty()) takeScreenshot(config_.screenshot, shown_, captured, capturedExtent);
+    if (target_->presents())
+      record.presented = target_->present(shownBytes(), overlay, capture ? &captured : nullptr, &capturedExtent);
+    if (overlay && !record.presented) overlay->discardFrame();
+    for (const auto& path : screenshots) takeScreenshot(path, captured, capturedExtent);
+    if (lastFrame && !config_.screenshot.empty()) takeScreenshot(config_.screenshot, captured, capturedExtent);
     record.presentMs = std::chrono::duration<double, std::milli>(Clock::now() - presentStart).count();
-    record.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-    lastFrameMs_ = record.frameMs;
+    record.wallMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    lastFrameMs_ = record.wallMs;
     writeLog(record);
     idleLastFrame_ = record.rays == 0 && record.actions.empty() && !record.restarted && !needsCompose_;
   }

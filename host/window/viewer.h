@@ -6,7 +6,10 @@
 //   - edits as the relighting paper does: a light's intensity or colour is one compose pass (the
 //     accumulation goes on), an added or dragged light traces only that light, a moved object
 //     retraces only the pixels it can change, and a camera move restarts;
-//   - shows it with the panel (window/control_panel.h) over it, driven by a person or a script.
+//   - shows it on a FrameTarget (window/frame_target.h): a window with the panel
+//     (window/control_panel.h) over it, driven by a person or a script (WindowTarget), or nowhere,
+//     driven by a script alone (OffscreenTarget, `view --offscreen`). The loop, the actions and the
+//     log are the same for both.
 #pragma once
 #include <chrono>
 #include <cstdint>
@@ -29,10 +32,7 @@
 #include "window/camera_controller.h"
 #include "window/control_panel.h"
 #include "window/event_script.h"
-#include "window/frame_presenter.h"
-#include "window/glfw_window.h"
-#include "window/swapchain.h"
-#include "window/ui_overlay.h"
+#include "window/frame_target.h"
 #include "window/viewer_action.h"
 
 namespace obscura::window {
@@ -56,21 +56,24 @@ struct ViewerConfig {
 
 class Viewer {
 public:
-  // Opens the window and makes the renderer. DeviceError without a window system.
-  Viewer(const gpu::ContextOptions& device, scene::Scene scene, bvh::Bvh bvh, ViewerConfig config);
+  // Makes the device (with what `target` needs of it), attaches the target and makes the renderer.
+  Viewer(std::unique_ptr<FrameTarget> target, const gpu::ContextOptions& device, scene::Scene scene, bvh::Bvh bvh,
+         ViewerConfig config);
   ~Viewer();
-  // The frame loop, until the window closes or `frames` have been shown.
+  // The frame loop, until the target closes (the window, a script's "close") or `frames` have
+  // been shown.
   void run();
 
 private:
   struct FrameRecord; // what one frame did, for the log and the panel
   void apply(const ViewerAction& action, FrameRecord& record);
-  void applyWindowEvent(const ScriptEvent& event);
   // Restarts accumulation with the current settings (and camera); `cameraOnly`: only the view
   // changed (the denoiser's history is then reprojected, not forgotten).
   void restart(bool preview, bool cameraOnly = false);
   void renderStep(FrameRecord& record);
-  std::vector<std::uint32_t> displayBytes();
+  // The display bytes of the frame last rendered, read back on first use after renderStep: a
+  // window reads them every frame, offscreen only a screenshot does.
+  const std::vector<std::uint32_t>& shownBytes();
   // The object under window pixel (x, y), from the primitive AOV; -1 for none.
   int pick(double x, double y);
   void moveObject(std::size_t object, glm::vec3 translate, FrameRecord& record);
@@ -83,16 +86,12 @@ private:
   void writeLog(const FrameRecord& record);
   // The frame shown, linear (the AOVs of an obscurance frame; combined for path tracing).
   io::Image shownImage();
-  void takeScreenshot(const std::string& path, const std::vector<std::uint32_t>& shown,
-                      const std::vector<std::uint32_t>& captured, vk::Extent2D capturedExtent);
+  void takeScreenshot(const std::string& path, const std::vector<std::uint32_t>& captured,
+                      vk::Extent2D capturedExtent);
 
   ViewerConfig config_;
-  GlfwWindow window_;
+  std::unique_ptr<FrameTarget> target_; // detached in ~Viewer, before the context goes
   gpu::Context context_;
-  vk::raii::SurfaceKHR surface_ = nullptr;
-  Swapchain swapchain_;
-  std::unique_ptr<UiOverlay> overlay_;
-  FramePresenter presenter_;
   std::ofstream log_;
 
   // The scene as edited so far (the renderers keep pointers to the newest).
@@ -120,6 +119,10 @@ private:
   bool previewShown_ = false;
   bool needsCompose_ = true;
   bool idleLastFrame_ = false; // nothing traced or changed: the next poll may wait for input
+  // Where the shown frame's display bytes are until shownBytes() reads them back: on the device
+  // (the renderer's or the denoiser's display buffer), or already in shown_.
+  enum class ShownAt { Host, Renderer, Denoiser };
+  ShownAt shownAt_ = ShownAt::Host;
   std::vector<std::uint32_t> shown_;
   std::size_t frame_ = 0;
   std::string status_; // the last edit's outcome, shown on the panel
