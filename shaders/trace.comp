@@ -64,8 +64,11 @@ void main() {
   }
   uint count = 0u;
   while (count < kRaysPerLane && rayIndex(count) < pc.params.x) ++count;
-  uint truncated = kBinaryLayout ? traverseBinaryStream(count, pc.params.y != 0u, kMaxTraversalSteps)
-                                 : traverseStream(count, pc.params.y != 0u, kMaxTraversalSteps);
+  // An if, not ?: — glslang evaluates both sides of a ?: whose condition is a specialisation
+  // constant (then selects), which ran both loops over one layout.
+  uint truncated;
+  if (kBinaryLayout) truncated = traverseBinaryStream(count, pc.params.y != 0u, kMaxTraversalSteps);
+  else truncated = traverseStream(count, pc.params.y != 0u, kMaxTraversalSteps);
   if (truncated != 0u) atomicAdd(status[kStatusTruncated], truncated);
   for (uint k = 0u; k < count; ++k) {
     uvec2 stored = sHits[hitSlot(k)];

@@ -324,13 +324,14 @@ private:
 
 void runConverge(const ConvergeOptions& o) {
   checkBackground(o.background);
-  LoadedScene loaded = loadScene(o.scenePath); // first: a bad scene leaves no folder behind
+  LoadedScene loaded = loadScene(o.scenePath, "node", std::nullopt); // first: a bad scene leaves no folder behind
   if (!o.background.empty()) loaded.scene.background = glm::vec3(o.background[0], o.background[1], o.background[2]);
   std::error_code ec;
   fs::create_directories(o.outputDir, ec);
   if (ec || !fs::is_directory(o.outputDir))
     throw InputError(fmt::format("{}: cannot create the output folder{}", o.outputDir, ec ? ": " + ec.message() : ""));
   gpu::Context context(o.device.contextOptions());
+  buildTreeFor(loaded, context);
   fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
   warnIfUnlit(loaded);
   Study study(o, loaded, context);

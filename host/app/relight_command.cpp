@@ -123,7 +123,7 @@ void relightScene(RelightOptions& o) {
   if (o.render.method != "obscurance")
     throw InputError("--method: relighting keeps per-light transport, which only the obscurance method has");
   checkRenderOptions(o.render);
-  LoadedScene loaded = loadScene(o.input, o.render.lightGroups);
+  LoadedScene loaded = loadScene(o.input, o.render.lightGroups, std::nullopt);
   applyBackground(o.render, loaded);
   const render::LightSet sceneLights = render::buildLightSet(loaded.scene);
   std::vector<bool> area;
@@ -142,6 +142,7 @@ void relightScene(RelightOptions& o) {
   const scene::Camera camera = chooseCamera(loaded.scene, o.render.camera);
   chooseSize(o.render, camera);
   gpu::Context context(o.render.device.contextOptions());
+  buildTreeFor(loaded, context);
   render::ObscuranceSettings settings = obscuranceSettings(o.render, camera);
   settings.spareLightSlots = static_cast<std::uint32_t>(std::count_if(
       edits.begin(), edits.end(), [](const relight::Edit& e) {

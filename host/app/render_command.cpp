@@ -131,15 +131,16 @@ void runRender(RenderOptions& o) {
   checkRenderOptions(o);
   if (!o.metrics.empty()) checkWritable(o.metrics);
 
-  LoadedScene loaded = loadScene(o.scenePath, o.lightGroups);
+  LoadedScene loaded = loadScene(o.scenePath, o.lightGroups, std::nullopt);
   applyBackground(o, loaded);
   scene::Camera camera = chooseCamera(loaded.scene, o.camera);
   chooseSize(o, camera);
-  fmt::print(stderr, "{}\n", sceneSummary(loaded));
   warnIfUnlit(loaded);
 
   gpu::Context context(o.device.contextOptions());
   fmt::print(stderr, "device: {} ({})\n", context.info().name, context.info().driver);
+  buildTreeFor(loaded, context);
+  fmt::print(stderr, "{}\n", sceneSummary(loaded));
 
   render::ObscuranceSettings settings = obscuranceSettings(o, camera);
   settings.editableGeometry = false; // rendered, written out, done

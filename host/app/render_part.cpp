@@ -97,17 +97,18 @@ void renderPart(RenderOptions& o) {
                                  part.samples.end, o.spp, o.spp));
   if (o.spp > (1u << 24)) throw InputError("--spp above 2^24: a part's sample counts are kept as floats");
   part.tile = o.partTile.empty() ? farm::Tile{} : farm::parseTile(o.partTile);
-  LoadedScene loaded = loadScene(o.scenePath, o.lightGroups);
+  LoadedScene loaded = loadScene(o.scenePath, o.lightGroups, std::nullopt);
   applyBackground(o, loaded);
   const scene::Camera camera = chooseCamera(loaded.scene, o.camera);
   chooseSize(o, camera); // the tile's rows need the image's height
   part.rows = farm::tileRows(part.tile, o.height);
   part.job = jobIdentity(o);
-  fmt::print(stderr, "{}\n", sceneSummary(loaded));
   warnIfUnlit(loaded);
 
   gpu::Context context(o.device.contextOptions());
   fmt::print(stderr, "device: {} ({})\n", context.info().name, context.info().driver);
+  buildTreeFor(loaded, context);
+  fmt::print(stderr, "{}\n", sceneSummary(loaded));
   render::ObscuranceSettings settings = obscuranceSettings(o, camera);
   settings.editableGeometry = false;
   settings.firstSample = part.samples.begin;

@@ -4,6 +4,7 @@
 
 #include <fmt/core.h>
 
+#include "render/scene/bvh_layout.h"
 #include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
 #include "scene/light_groups.h"
@@ -11,7 +12,8 @@
 
 namespace obscura::app {
 
-LoadedScene loadScene(const std::string& path, const std::string& lightGroups, const bvh::BuildOptions& tree) {
+LoadedScene loadScene(const std::string& path, const std::string& lightGroups,
+                      const std::optional<bvh::BuildOptions>& tree) {
   LoadedScene loaded;
   auto start = std::chrono::steady_clock::now();
   loaded.scene = scene::loadGltf(path);
@@ -20,8 +22,12 @@ LoadedScene loadScene(const std::string& path, const std::string& lightGroups, c
   scene::makeLightNamesUnique(loaded.scene);
   scene::makeObjectNamesUnique(loaded.scene);
   loaded.loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  loaded.bvh = bvh::build(render::triangleSoup(loaded.scene), tree);
+  if (tree) loaded.bvh = bvh::build(render::triangleSoup(loaded.scene), *tree);
   return loaded;
+}
+
+void buildTreeFor(LoadedScene& loaded, const gpu::Context& context) {
+  loaded.bvh = bvh::build(render::triangleSoup(loaded.scene), render::treeOptionsFor(render::traversalFor(context)));
 }
 
 nlohmann::json sceneJson(const LoadedScene& loaded) {

@@ -1,10 +1,12 @@
 // scene_setup.h — loading a scene and building its BVH, with the figures every command reports.
 #pragma once
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "bvh/bvh.h"
+#include "gpu/context.h"
 #include "scene/scene.h"
 
 namespace obscura::app {
@@ -17,9 +19,14 @@ struct LoadedScene {
 
 // `lightGroups`: "node" (one light per emissive mesh node, the default), "material" (one per
 // emissive material) or a JSON file of groups (scene/light_groups.h). Light names are made unique.
-// `tree`: how the BVH is built (the renderer's default; bench-rays may ask for spatial splits).
+// `tree`: how the BVH is built (the renderer's default; bench-rays may ask for spatial splits);
+// nullopt leaves it to buildTreeFor, once the device is known.
 LoadedScene loadScene(const std::string& path, const std::string& lightGroups = "node",
-                      const bvh::BuildOptions& tree = {});
+                      const std::optional<bvh::BuildOptions>& tree = bvh::BuildOptions{});
+
+// Builds loaded.bvh as the traversal `context` runs wants it (render::treeOptionsFor: spatial
+// splits for a GPU's binary layout).
+void buildTreeFor(LoadedScene& loaded, const gpu::Context& context);
 
 // Scene statistics and BVH figures for the metrics JSON.
 nlohmann::json sceneJson(const LoadedScene& loaded);

@@ -30,7 +30,10 @@ Box unite(const Box& a, const Box& b) {
 
 // The exact box of every slot of every wide node, bottom-up (a node's interior children follow
 // it, so walking the nodes backwards meets children first). The quantised boxes of the wide
-// nodes are looser; the binary nodes keep exact ones.
+// nodes are looser; the binary nodes keep exact ones. A leaf's box is its triangles' box clipped
+// to the slot's (decoded) box: with spatial splits a leaf holds a piece of a triangle that
+// reaches far outside it, and the builder's box bounds the piece (without them, the clip
+// changes nothing, the decoded box holding the triangles).
 std::vector<std::array<Box, gpu::kBvhWidth>> exactSlotBoxes(const Bvh& bvh) {
   std::vector<std::array<Box, gpu::kBvhWidth>> slots(bvh.nodes.size());
   std::vector<Box> nodeBox(bvh.nodes.size());
@@ -48,6 +51,9 @@ std::vector<std::array<Box, gpu::kBvhWidth>> exactSlotBoxes(const Bvh& bvh) {
         for (std::uint32_t t = first; t < first + (meta & 3u); ++t)
           for (const gpu::vec4* v : {&bvh.triangles[t].v0, &bvh.triangles[t].v1, &bvh.triangles[t].v2})
             box.grow(glm::vec3(*v));
+        const Box slot = decodedBox(node, s);
+        box.lo = glm::max(box.lo, slot.lo);
+        box.hi = glm::min(box.hi, slot.hi);
       }
       nodeBox[n].grow(box);
     }

@@ -5,16 +5,19 @@
 # OUT_DIR gets log.txt (everything printed) and a few images and JSON files, at most 8 files.
 # "quick" shrinks every size so that the script itself can be tried on lavapipe first.
 #
-#   bench-rays, both scenes, with the device's own traversal (render/scene/bvh_layout.h) and with
-#     each other one (--traversal): closest-hit and shadow rays per second (4M random rays, the
-#     best of 5 timed repeats, the first 100k checked against the CPU traversal, on Sponza the
-#     first 1M), on modern-hall the paper's budget at 800x600 per pass (--passes) with the
-#     device's traversal and the wide one, and on Sponza the binary traversal's refilling shapes
-#     (several rays per invocation, --trace-shape) and
-#     its BVH read as an SSBO (--bvh-items storage), without its cull on pop (--no-cull-on-pop) and
-#     every traversal over a tree with spatial splits (--spatial-splits 0.1)
+#   bench-rays, both scenes, with the device's own traversal and tree (render/scene/bvh_layout.h)
+#     and with each other traversal (--traversal): closest-hit and shadow rays per second (4M random
+#     rays, the best of 5 timed repeats, the first 100k checked against the CPU traversal, on
+#     Sponza the first 1M), on modern-hall the paper's budget at 800x600 per pass (--passes) with
+#     the device's traversal and the wide one; the device's traversal without spatial splits
+#     (--spatial-splits 0), and on Sponza with its BVH read as an SSBO (--bvh-items storage),
+#     without its cull on pop (--no-cull-on-pop) and through the refilling loop (--trace-shape)
 #   render: the paper's budget (8 spp), modern-hall 800x600 (the device's traversal, then the
 #     wide one) and Sponza 1920x1080 under a uniform sky (Sponza has no lights), --metrics
+#   view --offscreen: the window's frame loop without a display, modern-hall 1280x720, 1 spp,
+#     denoised, through tools/gpu/view_benchmark_script.json (camera moves, a light added and
+#     dragged, a light's intensity dragged, an object dragged): view.jsonl, frames/s wall per
+#     segment (tools/view_log_summary.py)
 #   relight: modern-hall 800x600, 1 spp: a light's scale and colour, add and remove a point light,
 #     move an object, add an emissive quad (edits.jsonl: GPU and wall ms per edit)
 # STEP_LIMIT (seconds, default 150) bounds each step, so that a hang cannot eat the lease.
@@ -30,8 +33,11 @@ export LD_LIBRARY_PATH=$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-rays=4194304 verify=1000000 passes=800x600 hall=(800 600) sponza=(1920 1080) limit=${STEP_LIMIT:-150}
-if [ "$quick" = quick ]; then rays=65536 verify=65536 passes=80x60 hall=(80 60) sponza=(96 54) limit=300; fi
+tools=$(cd "$(dirname "$0")" && pwd)
+rays=4194304 verify=1000000 passes=800x600 hall=(800 600) sponza=(1920 1080) view=(1280 720) limit=${STEP_LIMIT:-150}
+if [ "$quick" = quick ]; then
+  rays=65536 verify=65536 passes=80x60 hall=(80 60) sponza=(96 54) view=(64 36) limit=300
+fi
 
 step() { # name command...: runs it under a time limit, everything into log.txt
   local name=$1 start rc
@@ -54,26 +60,18 @@ step() { # name command...: runs it under a time limit, everything into log.txt
     --passes "$passes" --traversal wide
   step bench-hall-binary "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify 100000 \
     --traversal binary
+  step bench-hall-no-splits "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --spatial-splits 0
   step bench-sponza "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$verify"
   step bench-sponza-wide "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify 100000 \
     --traversal wide
   step bench-sponza-binary "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify 100000 \
     --traversal binary
+  step bench-sponza-no-splits "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --spatial-splits 0
   step bench-sponza-storage "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --bvh-items storage
   step bench-sponza-no-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --no-cull-on-pop
-  step bench-sponza-binary-no-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 \
-    --traversal binary --no-cull-on-pop
-  for traversal in binary-while-while binary wide; do
-    step "bench-sponza-splits-$traversal" "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 \
-      --spatial-splits 0.1 --traversal "$traversal"
-  done
-  step bench-hall-splits "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --spatial-splits 0.1
-  for shape in 32x8 64x4 32x16; do # several rays per invocation: the binary refilling loop
-    step "bench-sponza-$shape" "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 \
-      --traversal binary --trace-shape "$shape"
-  done
-  step bench-hall-32x8 "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --traversal binary \
-    --trace-shape 32x8
+  # Several rays per invocation: the binary refilling loop (slower than one ray each on an H200).
+  step bench-sponza-64x4 "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --traversal binary \
+    --trace-shape 64x4 --verify 100000
   step render-hall "$obscura" render "$hall_scene" --width "${hall[0]}" \
     --height "${hall[1]}" --spp 8 -o "$out/modern-hall.png" --metrics "$out/modern-hall.metrics.json"
   step render-hall-wide "$obscura" render "$hall_scene" --width "${hall[0]}" \
@@ -91,6 +89,9 @@ step() { # name command...: runs it under a time limit, everything into log.txt
  {"add_light": {"type": "quad", "name": "bench_panel", "corner": [0.0, 3.0, 1.0], "edge1": [0.5, 0, 0],
                 "edge2": [0, 0, 0.5], "emission": [4, 4, 4]}}]
 JSON
+  step view-offscreen "$obscura" view "$hall_scene" --offscreen --width "${view[0]}" --height "${view[1]}" --spp 1 \
+    --script "$tools/view_benchmark_script.json" --log "$out/view.jsonl" --screenshot "$out/view.png"
+  python3 "$tools/../view_log_summary.py" "$out/view.jsonl"
   step relight-hall "$obscura" relight "$scenes/modern-hall/modern-hall.gltf" --edits "$work/edits.json" \
     -o "$work/relight" --width "${hall[0]}" --height "${hall[1]}" --spp 1 --png
   cat "$work/relight/edits.jsonl"

@@ -15,6 +15,16 @@ Traversal traversalForDevice(const gpu::DeviceInfo& device) {
   return device.type == "cpu" ? Traversal::Wide : Traversal::BinaryWhileWhile;
 }
 
+Traversal traversalFor(const gpu::Context& context) {
+  return parseTraversal(context.traversalRequest()).value_or(traversalForDevice(context.info()));
+}
+
+bvh::BuildOptions treeOptionsFor(Traversal traversal) {
+  bvh::BuildOptions options;
+  if (traversal != Traversal::Wide) options.spatialSplitBudget = 0.1f;
+  return options;
+}
+
 std::optional<Traversal> parseTraversal(std::string_view name) {
   if (name.empty() || name == "auto") return std::nullopt;
   if (name == "wide") return Traversal::Wide;

@@ -27,6 +27,13 @@ enum class Traversal : std::uint32_t {
 
 // The traversal for a device: Wide on a CPU (lavapipe), BinaryWhileWhile on a GPU.
 Traversal traversalForDevice(const gpu::DeviceInfo& device);
+// The traversal kernels use on `context`: its request (--traversal), else its device's.
+Traversal traversalFor(const gpu::Context& context);
+
+// The tree each traversal is fastest on: the binary layout over a tree with spatial splits
+// (a budget of 10 % more references), the wide one without (measured: docs/BENCHMARKS.md,
+// "Traversal per device"; on lavapipe the splits made shadow rays slower).
+bvh::BuildOptions treeOptionsFor(Traversal traversal);
 
 // "wide", "binary", "binary-while-while"; "auto" (or empty) is nullopt: the device's. Throws
 // std::invalid_argument naming the accepted values otherwise.
