@@ -54,7 +54,7 @@ struct BenchOptions {
   std::string traceShape;          // WxR: trace.comp's workgroup size and rays per invocation
   std::optional<std::uint32_t> stackRegisters; // the kernel's compact-stack registers (0: the general kernel)
   std::string bvhItems = "texel";              // how trace.comp reads the BVH: "texel" view or "storage" buffer
-  bool noCullOnPop = false;                    // the binary traversal without its cull on pop
+  bool cullOnPop = false;                      // the binary traversal with its cull on pop
   std::optional<float> spatialSplits; // the tree's spatial splits (bvh::BuildOptions::spatialSplitBudget); unset: the device's tree
   render::ObscuranceFrameWork frameWork; // its spp, rays per hit, dmax, seed
   DeviceOptions device;
@@ -375,10 +375,10 @@ void runBench(const BenchOptions& o) {
   if (!o.json) fmt::print("traversal: {}\n", render::traversalName(buffers.traversal()));
   std::optional<render::TraceShape> shape;
   if (!o.traceShape.empty()) shape = parseTraceShape(o.traceShape, context);
-  if (o.bvhItems == "storage" || o.noCullOnPop) {
+  if (o.bvhItems == "storage" || o.cullOnPop) {
     if (!shape) shape = render::TraceShape::forDevice(context, buffers.traversal());
     shape->bvhItemsFromStorage = o.bvhItems == "storage";
-    shape->binaryCullOnPop = !o.noCullOnPop;
+    shape->binaryCullOnPop = o.cullOnPop;
   }
   if (o.stackRegisters && !bvh::compactStackHolds(*o.stackRegisters, buffers.compactStackVectors()))
     throw InputError(fmt::format("--stack-registers {}: this BVH (depth {}) needs {} (or 0, the general kernel)",
@@ -562,8 +562,8 @@ void addBenchRaysCommand(CLI::App& app) {
                   "how trace.comp reads the BVH's nodes and triangles: through the texel view the passes use "
                   "(texel, the default) or from the same buffer bound as an SSBO (storage)")
       ->check(CLI::IsMember({"texel", "storage"}));
-  cmd->add_flag("--no-cull-on-pop", o->noCullOnPop,
-                "the binary traversal's closest-hit rays without dropping popped children beyond their hit");
+  cmd->add_flag("--cull-on-pop", o->cullOnPop,
+                "the binary traversal's closest-hit rays drop popped children beyond their hit (off in the passes)");
   cmd->add_option("--spatial-splits", o->spatialSplits,
                   "SHARE: build the BVH with spatial splits (SBVH), adding at most this share of the triangle "
                   "count as clipped references (default: the tree the renderer builds for the device's traversal, "

@@ -28,9 +28,9 @@ struct TraceShape {
   std::uint32_t raysPerLane = gpu::kTraceRaysPerLane;
   // The BVH read from its buffer bound as an SSBO, not through the texel view (the passes' path).
   bool bvhItemsFromStorage = false;
-  // The binary traversal's closest-hit rays drop popped children beyond their hit (the passes'
-  // default; kSpecConstantBinaryCullOnPop): false measures without.
-  bool binaryCullOnPop = true;
+  // The binary traversal's closest-hit rays drop popped children beyond their hit
+  // (kSpecConstantBinaryCullOnPop; off, as in the passes).
+  bool binaryCullOnPop = false;
   static TraceShape forCpu() { return {}; }
   static TraceShape forGpu() { return {gpu::kTraceGpuWorkgroupSize, gpu::kTraceGpuRaysPerLane}; }
   // The binary traversal: one ray per invocation, straight through traverseBvh (what a pass's

@@ -284,10 +284,12 @@ const bool kBinaryLayout = kBvhLayout == kBvhLayoutBinary;
 // the leaf's triangles, inside an outer loop), for GPUs, which have no loop limiter: its step
 // count bounds each lane's passes, not the passes of lavapipe's 8-lane group.
 layout(constant_id = kSpecConstantBinaryLoop) const bool kBinaryWhileWhile = false;
-// A closest-hit ray keeps each pushed child's entry distance beside it and drops the child when
-// it is popped beyond the hit found since, instead of fetching its node to find that out
-// (kSpecConstantBinaryCullOnPop; bench-rays --no-cull-on-pop measures without).
-layout(constant_id = kSpecConstantBinaryCullOnPop) const bool kBinaryCullOnPop = true;
+// Where on, a closest-hit ray keeps each pushed child's entry distance beside it and drops the
+// child when it is popped beyond the hit found since, instead of fetching its node to find that
+// out (kSpecConstantBinaryCullOnPop). Off by default: on an H200 it was 2-3 % slower (the second
+// array's stores cost more than the node fetches saved; docs/BENCHMARKS.md); bench-rays
+// --cull-on-pop measures it.
+layout(constant_id = kSpecConstantBinaryCullOnPop) const bool kBinaryCullOnPop = false;
 
 // One node: x = the child to visit next (the nearer one met), y = the other one met, to push;
 // kInvalidIndex where none. `farNear` gets the pushed child's entry distance.

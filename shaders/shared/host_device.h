@@ -466,7 +466,7 @@ OBS_CONST uint kSpecConstantBvhLayout = 15u;
 // true, Aila & Laine's while-while (lib/bvh.glsl, traverseBinary).
 OBS_CONST uint kSpecConstantBinaryLoop = 16u;
 // A closest-hit ray of the binary traversal drops a popped child that lies beyond its hit (a bool,
-// on by default; bench-rays --no-cull-on-pop measures without).
+// off by default; bench-rays --cull-on-pop measures it).
 OBS_CONST uint kSpecConstantBinaryCullOnPop = 17u;
 OBS_CONST uint kPerLightRays = 4u;
 OBS_CONST uint kPerLightMaxRays = 64u;

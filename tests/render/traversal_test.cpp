@@ -163,6 +163,9 @@ TEST_F(GpuTraversal, BinaryLayoutMatchesBruteForceAndCpuAnyHit) {
     expectAgreement(traceAndCompare(soup, 100000, 1, {}, {}, traversal), ("random soup, " + name).c_str());
     expectAgreement(traceAndCompare(soup, 100000, 2, {}, splits, traversal), ("spatial splits, " + name).c_str());
     expectAgreement(traceAndCompare(cornell, 100000, 11, {}, {}, traversal), ("cornell-box, " + name).c_str());
+    render::TraceShape culling = render::TraceShape::forBinary(); // bench-rays --cull-on-pop
+    culling.binaryCullOnPop = true;
+    expectAgreement(traceAndCompare(soup, 100000, 4, culling, splits, traversal), ("cull on pop, " + name).c_str());
 
     const bvh::Bvh tree = bvh::build(render::triangleSoup(cornell));
     render::SceneBuffers buffers(context(), cornell, tree, traversal);

@@ -11,7 +11,7 @@
 #     Sponza the first 1M), on modern-hall the paper's budget at 800x600 per pass (--passes) with
 #     the device's traversal and the wide one; the device's traversal without spatial splits
 #     (--spatial-splits 0), and on Sponza with its BVH read as an SSBO (--bvh-items storage),
-#     without its cull on pop (--no-cull-on-pop) and through the refilling loop (--trace-shape)
+#     with its cull on pop (--cull-on-pop) and through the refilling loop (--trace-shape)
 #   render: the paper's budget (8 spp), modern-hall 800x600 (the device's traversal, then the
 #     wide one) and Sponza 1920x1080 under a uniform sky (Sponza has no lights), --metrics
 #   view --offscreen: the window's frame loop without a display, modern-hall 1280x720, 1 spp,
@@ -68,7 +68,7 @@ step() { # name command...: runs it under a time limit, everything into log.txt
     --traversal binary
   step bench-sponza-no-splits "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --spatial-splits 0
   step bench-sponza-storage "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --bvh-items storage
-  step bench-sponza-no-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --no-cull-on-pop
+  step bench-sponza-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --cull-on-pop
   # Several rays per invocation: the binary refilling loop (slower than one ray each on an H200).
   step bench-sponza-64x4 "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --traversal binary \
     --trace-shape 64x4 --verify 100000
