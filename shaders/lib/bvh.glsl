@@ -310,6 +310,14 @@ uvec2 visitBinaryNode(uint node, vec3 origin, vec3 invDir, float tmin, float tma
 
 bool isBinaryLeaf(uint ref) { return (ref & kBinaryLeafBit) != 0u; }
 
+// The rest of leaf `ref` once its first triangle is tested: the same leaf one triangle shorter,
+// or kInvalidIndex where that was its last (the one-loop traversals test one triangle a pass).
+uint restOfLeaf(uint ref) {
+  uint left = ((ref >> kBinaryLeafCountShift) & 7u) - 1u;
+  return left == 0u ? kInvalidIndex
+                    : kBinaryLeafBit | (left << kBinaryLeafCountShift) | ((ref & kBinaryLeafTexelMask) + kTexelsPerTriangle);
+}
+
 // The triangle at `texel`, tested as every loop tests one.
 bool testBinaryTriangle(uint texel, WatertightRay wr, float tmin, float tmax, bool anyHit, inout RayHit hit) {
   int i = int(texel);
@@ -389,11 +397,8 @@ RayHit traverseBinary(vec3 origin, vec3 direction, float tmin, float tmax, bool 
       }
       next = children.x;
     } else {
-      uint texel = ref & kBinaryLeafTexelMask;
-      if (testBinaryTriangle(texel, wr, tmin, tmax, anyHit, hit) && anyHit) break;
-      uint left = ((ref >> kBinaryLeafCountShift) & 7u) - 1u;
-      next = left == 0u ? kInvalidIndex
-                        : kBinaryLeafBit | (left << kBinaryLeafCountShift) | (texel + kTexelsPerTriangle);
+      if (testBinaryTriangle(ref & kBinaryLeafTexelMask, wr, tmin, tmax, anyHit, hit) && anyHit) break;
+      next = restOfLeaf(ref);
     }
     if (next == kInvalidIndex) {
       if (sp == 0u) break;

@@ -165,11 +165,8 @@ uint traverseBinaryStream(uint count, bool anyHit, uint maxSteps) {
         }
         next = children.x;
       } else {
-        uint texel = ref & kBinaryLeafTexelMask;
-        done = testBinaryTriangle(texel, wr, tmin, tmax, anyHit, hit) && anyHit;
-        uint left = ((ref >> kBinaryLeafCountShift) & 7u) - 1u;
-        next = left == 0u ? kInvalidIndex
-                          : kBinaryLeafBit | (left << kBinaryLeafCountShift) | (texel + kTexelsPerTriangle);
+        done = testBinaryTriangle(ref & kBinaryLeafTexelMask, wr, tmin, tmax, anyHit, hit) && anyHit;
+        next = restOfLeaf(ref);
       }
       if (!done && next == kInvalidIndex) {
         if (sp == 0u) {
