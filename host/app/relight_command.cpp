@@ -6,8 +6,6 @@
 //       any edit) and DIR/edits.jsonl (per edit: kind, pixels retraced, rays and ms per pass).
 #include <algorithm>
 #include <chrono>
-#include <deque>
-#include <map>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -23,10 +21,10 @@
 #include "io/image_io.h"
 #include "relight/light_edits.h"
 #include "relight/relight_state.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene/bvh_layout.h"
+#include "render/scene/light_set.h"
 #include "render/transport.h"
-#include "scene/gltf_loader.h"
-#include "scene/scene_edit.h"
+#include "session/edit_session.h"
 
 namespace obscura::app {
 namespace {
@@ -105,19 +103,6 @@ void relightState(const RelightOptions& o) {
              ms(loaded, composed), ms(start, Clock::now()), o.output);
 }
 
-nlohmann::json passFigures(const render::RenderStats& before, const render::RenderStats& after) {
-  nlohmann::json rays = nlohmann::json::object(), ms = nlohmann::json::object();
-  for (const auto& [name, pass] : after.passes) {
-    const auto it = before.passes.find(name);
-    const double gpuMs = pass.gpuMs - (it == before.passes.end() ? 0.0 : it->second.gpuMs);
-    const auto n = pass.rays - (it == before.passes.end() ? 0 : it->second.rays);
-    if (gpuMs <= 0.0 && n == 0) continue;
-    rays[name] = n;
-    ms[name] = gpuMs;
-  }
-  return {{"rays", rays}, {"gpu_ms", ms}};
-}
-
 void relightScene(RelightOptions& o) {
   if (o.edits.empty()) throw InputError(fmt::format("{}: relighting a scene needs --edits edits.json", o.input));
   if (o.render.method != "obscurance")
@@ -131,10 +116,6 @@ void relightScene(RelightOptions& o) {
   std::vector<std::string> objectNames;
   for (const auto& obj : loaded.scene.objects) objectNames.push_back(obj.name);
   const std::vector<relight::Edit> edits = relight::readEdits(o.edits, sceneLights.names, area, objectNames);
-  // Inserted glTFs are loaded (and so checked) before anything is rendered.
-  std::map<std::size_t, scene::Scene> inserts;
-  for (const auto& e : edits)
-    if (e.kind == relight::Edit::Kind::Insert) inserts[e.entry] = scene::loadGltf(e.path);
   std::error_code ec;
   fs::create_directories(o.output, ec);
   if (ec || !fs::is_directory(o.output)) throw InputError(fmt::format("{}: cannot create the output folder", o.output));
@@ -143,61 +124,15 @@ void relightScene(RelightOptions& o) {
   chooseSize(o.render, camera);
   gpu::Context context(o.render.device.contextOptions());
   buildTreeFor(loaded, context);
-  render::ObscuranceSettings settings = obscuranceSettings(o.render, camera);
-  settings.spareLightSlots = static_cast<std::uint32_t>(std::count_if(
-      edits.begin(), edits.end(), [](const relight::Edit& e) {
-        return e.kind == relight::Edit::Kind::AddLight || e.kind == relight::Edit::Kind::AddQuad;
-      }));
-  // An added light and a geometry edit's probes follow the frame's kept rays (shadow rays, lobe hits).
-  settings.keptRaySamples = settings.spp;
-  // Each geometry edit makes the next scene; the renderer keeps a pointer to the current one.
-  std::deque<scene::Scene> scenes;
-  std::deque<bvh::Bvh> trees;
-  render::ObscuranceRenderer renderer(context, loaded.scene, loaded.bvh, settings);
-  renderer.prepareForEdits();
-  const scene::Scene* current = &loaded.scene;
-  const bvh::Bvh* currentBvh = &loaded.bvh;
-  nlohmann::json bvhUpdate; // how the last geometry edit updated the BVH, for edits.jsonl
-  auto geometryEdit = [&](const relight::Edit& e) {
-    scene::Scene next = *current;
-    const std::string where = fmt::format("{}: entry {}", o.edits, e.entry);
-    std::vector<scene::Bounds> changed;
-    if (e.kind == relight::Edit::Kind::Insert) {
-      const std::size_t i = scene::insertObject(next, inserts.at(e.entry), e.name, e.translate);
-      changed.push_back(scene::objectBounds(next, i));
-    } else if (e.kind == relight::Edit::Kind::AddQuad) {
-      const std::size_t i = scene::insertEmissiveQuad(next, e.quad);
-      changed.push_back(scene::objectBounds(next, i));
-    } else {
-      const std::size_t i = scene::objectIndex(next, e.name, where);
-      changed.push_back(scene::objectBounds(next, i));
-      if (e.kind == relight::Edit::Kind::Move) {
-        scene::moveObject(next, i, e.translate, e.rotateDegrees);
-        changed.push_back(scene::objectBounds(next, i));
-      } else {
-        scene::removeObject(next, i);
-      }
-    }
-    scenes.push_back(std::move(next));
-    // A move or a removal keeps every triangle: the BVH is refitted; an insert (or a quad) adds
-    // triangles and rebuilds it.
-    const auto start = Clock::now();
-    const bool refit = e.kind == relight::Edit::Kind::Move || e.kind == relight::Edit::Kind::Remove;
-    if (refit) {
-      trees.push_back(*currentBvh);
-      bvh::refit(trees.back(), render::triangleSoup(scenes.back()));
-    } else {
-      trees.push_back(bvh::build(render::triangleSoup(scenes.back())));
-    }
-    bvhUpdate = {{"kind", refit ? "refit" : "rebuild"},
-                 {"ms", std::chrono::duration<double, std::milli>(Clock::now() - start).count()}};
-    current = &scenes.back();
-    currentBvh = &trees.back();
-    if (e.kind == relight::Edit::Kind::AddQuad) return renderer.addEmitter(scenes.back(), trees.back(), changed);
-    return renderer.updateGeometry(scenes.back(), trees.back(), changed);
-  };
-  // After renderer.composeDisplay(): the PNG from the fast path's display bytes, then the full
-  // compose for the EXR's AOVs and light layers.
+  const auto spareLights = static_cast<std::uint32_t>(std::count_if(edits.begin(), edits.end(), [](const relight::Edit& e) {
+    return e.kind == relight::Edit::Kind::AddLight || e.kind == relight::Edit::Kind::AddQuad;
+  }));
+  session::EditSession session(context, std::move(loaded.scene), std::move(loaded.bvh),
+                               session::editSettings(obscuranceSettings(o.render, camera), spareLights),
+                               render::treeOptionsFor(render::traversalFor(context)));
+  render::ObscuranceRenderer& renderer = session.renderer();
+  // After composeDisplay: the PNG from the fast path's display bytes, then the full compose for
+  // the EXR's AOVs and light layers.
   auto writeFrame = [&](std::size_t n) {
     if (renderer.stats().truncatedTraversals > 0)
       throw DeviceError("traversals ran out of steps (kMaxTraversalSteps); the frame would be wrong");
@@ -216,79 +151,17 @@ void relightScene(RelightOptions& o) {
   renderer.composeDisplay(o.exposure);
   writeFrame(0);
 
-  // The scene's own emissions, and each light's intensity and colour multipliers.
-  std::vector<glm::vec3> base = renderer.emissions();
-  std::vector<float> scale(base.size(), 1.0f);
-  std::vector<glm::vec3> color(base.size(), glm::vec3(1.0f));
-  auto emissionsNow = [&] {
-    std::vector<glm::vec3> e;
-    for (std::size_t i = 0; i < base.size(); ++i) e.push_back(base[i] * scale[i] * color[i]);
-    return e;
-  };
   std::ofstream log(fs::path(o.output) / "edits.jsonl");
   for (std::size_t n = 0; n < edits.size(); ++n) {
     const relight::Edit& e = edits[n];
-    const render::RenderStats before = renderer.stats();
-    const auto start = Clock::now();
-    std::uint64_t retraced = 0;
-    switch (e.kind) {
-      case relight::Edit::Kind::Scale: scale[renderer.lightIndex(e.name)] = e.scale; break;
-      case relight::Edit::Kind::Color: color[renderer.lightIndex(e.name)] = e.color; break;
-      case relight::Edit::Kind::AddLight: {
-        // Compose's emissions first: addLight appends the new light's own.
-        renderer.setEmissions(emissionsNow());
-        renderer.addLight(e.light);
-        base.push_back(renderer.emissions().back());
-        scale.push_back(1.0f);
-        color.push_back(glm::vec3(1.0f));
-        retraced = renderer.layout().pixels();
-        break;
-      }
-      case relight::Edit::Kind::AddQuad: {
-        // An area light: it goes before the punctual lights, at its light group's index.
-        renderer.setEmissions(emissionsNow());
-        retraced = geometryEdit(e);
-        const auto i = static_cast<std::ptrdiff_t>(renderer.lightIndex(e.name));
-        base.insert(base.begin() + i, renderer.emissions()[static_cast<std::size_t>(i)]);
-        scale.insert(scale.begin() + i, 1.0f);
-        color.insert(color.begin() + i, glm::vec3(1.0f));
-        break;
-      }
-      case relight::Edit::Kind::RemoveLight: {
-        const std::size_t i = renderer.lightIndex(e.name);
-        const bool areaLight = renderer.lights().lights[i].info.x == gpu::kLightArea;
-        renderer.setEmissions(emissionsNow());
-        renderer.removeLight(i);
-        if (areaLight) {
-          scale[i] = 0.0f;
-        } else {
-          base.erase(base.begin() + static_cast<std::ptrdiff_t>(i));
-          scale.erase(scale.begin() + static_cast<std::ptrdiff_t>(i));
-          color.erase(color.begin() + static_cast<std::ptrdiff_t>(i));
-        }
-        break;
-      }
-      case relight::Edit::Kind::Move:
-      case relight::Edit::Kind::Remove:
-      case relight::Edit::Kind::Insert: retraced = geometryEdit(e); break;
-    }
-    renderer.setEmissions(emissionsNow());
-    renderer.composeDisplay(o.exposure);
-    const double totalMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-    nlohmann::json line = {{"edit", n}, {"kind", e.kindName()}, {"name", e.name}, {"pixels_retraced", retraced}};
-    line.update(passFigures(before, renderer.stats()));
-    if (!bvhUpdate.is_null()) line["bvh"] = std::exchange(bvhUpdate, nlohmann::json());
-    if (!line["bvh"].is_null() || e.kind == relight::Edit::Kind::AddLight) {
-      // What the lights reach (CPU rays of the Reached ambient model), measured again for the edit
-      // (an added light: its own, on a thread beside its GPU work).
-      const auto reach = renderer.lastReachUpdate();
-      line["reach"] = {{"rays", reach.rays}, {"ms", reach.ms}};
-    }
-    line["total_ms"] = totalMs;
+    session::EditReport report = session.apply(e, fmt::format("{}: entry {}", o.edits, e.entry));
+    session.composeDisplay(report, o.exposure);
+    nlohmann::json line = report.json();
+    line["edit"] = n;
     log << line.dump() << "\n";
     writeFrame(n + 1);
-    fmt::print(stderr, "relight: edit {} ({} {}): {} pixels retraced, {:.1f} ms\n", n, e.kindName(), e.name, retraced,
-               totalMs);
+    fmt::print(stderr, "relight: edit {} ({} {}): {} pixels retraced, {:.1f} ms\n", n, report.kind, report.name,
+               report.pixelsRetraced, report.totalMs);
   }
 }
 

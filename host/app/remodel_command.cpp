@@ -29,6 +29,8 @@
 #include "recover/recovery_scene.h"
 #include "recover/remodel.h"
 #include "relight/light_edits.h"
+#include "session/light_controls.h"
+#include "session/scene_history.h"
 #include "render/scene/scene_buffers.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene_edit.h"
@@ -128,66 +130,50 @@ void runRemodel(const RemodelCommandOptions& o) {
   std::vector<std::string> lightNames, objectNames;
   for (const auto& l : folder.lamps) lightNames.push_back(l.name);
   for (const auto& obj : loaded.scene.objects) objectNames.push_back(obj.name);
-  const std::vector<relight::Edit> edits =
+  const std::vector<session::Edit> edits =
       relight::readEdits(o.edits, lightNames, std::vector<bool>(lightNames.size(), false), objectNames);
-  scene::Scene edited = loaded.scene;
-  std::vector<NamedLamp> lamps = folder.lamps;
-  std::vector<float> scale(lamps.size(), 1.0f);
-  std::vector<glm::vec3> colour(lamps.size(), glm::vec3(1.0f));
-  bool geometryChanged = false;
-  auto lampIndex = [&](const std::string& name) {
-    return static_cast<std::size_t>(
-        std::find_if(lamps.begin(), lamps.end(), [&](const NamedLamp& l) { return l.name == name; }) - lamps.begin());
-  };
-  for (const relight::Edit& e : edits) {
+  // The room's objects and lamps as the edits leave them: the same bookkeeping as an edit
+  // session's, without a renderer (this frame is rendered once, at the end).
+  session::SceneHistory room(loaded.scene, loaded.bvh);
+  session::LightControls lamps;
+  for (const auto& l : folder.lamps) {
+    scene::PunctualLight lamp{.name = l.name, .type = scene::PunctualType::Point, .color = l.lamp.color,
+                              .intensity = l.lamp.intensity, .position = l.lamp.position};
+    lamps.insert(lamps.size(), {.name = l.name, .light = lamp});
+  }
+  for (const session::Edit& e : edits) {
     const std::string where = fmt::format("{}: entry {}", o.edits, e.entry);
     switch (e.kind) {
-      case relight::Edit::Kind::Scale: scale[lampIndex(e.name)] = e.scale; break;
-      case relight::Edit::Kind::Color: colour[lampIndex(e.name)] = e.color; break;
-      case relight::Edit::Kind::AddLight: {
+      case session::Edit::Kind::Scale: lamps.at(e.name).scale = e.scale; break;
+      case session::Edit::Kind::Color: lamps.at(e.name).color = e.color; break;
+      case session::Edit::Kind::AddLight:
         if (e.light.type != scene::PunctualType::Point)
           throw InputError(fmt::format("{}: remodel adds point lamps only (the photographs' lamp model)", where));
-        recover::Shot lamp;
-        lamp.position = e.light.position;
-        lamp.intensity = e.light.intensity;
-        lamp.color = e.light.color;
-        lamps.push_back({e.name, lamp});
-        scale.push_back(1.0f);
-        colour.push_back(glm::vec3(1.0f));
+        lamps.insert(lamps.size(), {.name = e.name, .added = true, .light = e.light});
         break;
-      }
-      case relight::Edit::Kind::RemoveLight: {
-        const std::size_t i = lampIndex(e.name);
-        lamps.erase(lamps.begin() + static_cast<std::ptrdiff_t>(i));
-        scale.erase(scale.begin() + static_cast<std::ptrdiff_t>(i));
-        colour.erase(colour.begin() + static_cast<std::ptrdiff_t>(i));
-        break;
-      }
-      case relight::Edit::Kind::Remove:
-        scene::removeObject(edited, scene::objectIndex(edited, e.name, where));
-        geometryChanged = true;
-        break;
-      case relight::Edit::Kind::Insert:
-        scene::insertObject(edited, scene::loadGltf(e.path), e.name, e.translate);
-        geometryChanged = true;
-        break;
-      case relight::Edit::Kind::Move:
+      case session::Edit::Kind::RemoveLight: lamps.remove(e.name); break;
+      case session::Edit::Kind::MoveLight: lamps.at(e.name).light.position = e.position; break;
+      case session::Edit::Kind::Remove:
+      case session::Edit::Kind::Insert: room.apply(e, where); break;
+      case session::Edit::Kind::Move:
         throw InputError(fmt::format("{}: moving a photographed object is not supported (its reflectance would "
                                      "have to be re-projected); remove it and insert a model instead",
                                      where));
-      case relight::Edit::Kind::AddQuad:
+      case session::Edit::Kind::AddQuad:
         throw InputError(fmt::format("{}: remodel adds point lamps only (the photographs' lamp model)", where));
     }
   }
   std::vector<recover::Shot> on;
-  for (std::size_t i = 0; i < lamps.size(); ++i) {
-    recover::Shot lamp = lamps[i].lamp;
-    lamp.intensity *= scale[i];
-    lamp.color *= colour[i];
+  for (const session::LightControl& l : lamps) {
+    recover::Shot lamp;
+    lamp.position = l.light.position;
+    lamp.intensity = l.light.intensity * l.scale;
+    lamp.color = l.light.color * l.color;
     if (lamp.intensity > 0.0f && glm::any(glm::greaterThan(lamp.color, glm::vec3(0.0f)))) on.push_back(lamp);
   }
   if (on.empty()) throw InputError(fmt::format("{}: no lamp is left on", o.edits));
-  const bvh::Bvh editedBvh = geometryChanged ? bvh::build(render::triangleSoup(edited)) : loaded.bvh;
+  const scene::Scene& edited = room.scene();
+  const bvh::Bvh& editedBvh = room.bvh();
   recover::PhotoSet lampSet;
   lampSet.file = o.edits;
   lampSet.shots = on;

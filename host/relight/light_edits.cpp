@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "io/json_file.h"
 #include "io/json_fields.h"
+#include "scene/gltf_loader.h"
 
 namespace obscura::relight {
 namespace {
@@ -70,20 +71,6 @@ scene::EmissiveQuad addedQuad(const json& j, const EntryContext& at) {
 
 } // namespace
 
-std::string Edit::kindName() const {
-  switch (kind) {
-    case Kind::Scale: return "scale";
-    case Kind::Color: return "color";
-    case Kind::AddLight:
-    case Kind::AddQuad: return "add_light";
-    case Kind::RemoveLight: return "remove_light";
-    case Kind::Move: return "move";
-    case Kind::Remove: return "remove";
-    case Kind::Insert: return "insert";
-  }
-  return "?";
-}
-
 namespace {
 
 void requireObject(const std::vector<std::string>& names, const std::string& name, const EntryContext& at) {
@@ -93,85 +80,122 @@ void requireObject(const std::vector<std::string>& names, const std::string& nam
 
 } // namespace
 
+Edit readEdit(const json& j, const io::JsonEntry& at) {
+  if (!j.is_object()) at.fail("an edit must be an object");
+  Edit e;
+  e.entry = at.entry;
+  if (j.contains("light")) {
+    e.name = text(j, "light", at);
+    if (j.contains("scale")) {
+      e.kind = Edit::Kind::Scale;
+      e.scale = number(j, "scale", at);
+      if (e.scale < 0.0f) at.fail("'scale' must not be negative");
+    } else if (j.contains("color")) {
+      e.kind = Edit::Kind::Color;
+      e.color = vec3(j, "color", at);
+      if (glm::any(glm::lessThan(e.color, glm::vec3(0.0f)))) at.fail("'color' must not be negative");
+    } else {
+      at.fail("a light edit needs 'scale' or 'color'");
+    }
+  } else if (j.contains("add_light")) {
+    const json& light = j.at("add_light");
+    if (light.is_object() && light.contains("type") && light.at("type") == "quad") {
+      e.kind = Edit::Kind::AddQuad;
+      e.quad = addedQuad(light, at);
+      e.name = e.quad.name;
+    } else {
+      e.kind = Edit::Kind::AddLight;
+      e.light = readAddedLight(light, at);
+      e.name = e.light.name;
+    }
+  } else if (j.contains("remove_light")) {
+    e.kind = Edit::Kind::RemoveLight;
+    e.name = text(j, "remove_light", at);
+  } else if (j.contains("move_light")) {
+    e.kind = Edit::Kind::MoveLight;
+    e.name = text(j, "move_light", at);
+    e.position = vec3(j, "position", at);
+  } else if (j.contains("move")) {
+    e.kind = Edit::Kind::Move;
+    if (!j.at("move").is_string()) at.fail("'move' must be an object's name");
+    e.name = j.at("move").get<std::string>();
+    e.translate = j.contains("translate") ? vec3(j, "translate", at) : glm::vec3(0.0f);
+    e.rotateDegrees = j.contains("rotate_deg") ? vec3(j, "rotate_deg", at) : glm::vec3(0.0f);
+  } else if (j.contains("remove")) {
+    e.kind = Edit::Kind::Remove;
+    e.name = text(j, "remove", at);
+  } else if (j.contains("insert")) {
+    e.kind = Edit::Kind::Insert;
+    e.path = text(j, "insert", at);
+    e.name = text(j, "name", at);
+    e.translate = j.contains("translate") ? vec3(j, "translate", at) : glm::vec3(0.0f);
+  } else {
+    at.fail("unknown edit (known: light, add_light, remove_light, move_light, move, remove, insert)");
+  }
+  return e;
+}
+
 std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> lightNames,
                             std::vector<bool> areaLights, std::vector<std::string> objectNames) {
   const json list = io::readJsonFile(path, "cannot read the edits file");
   if (!list.is_array()) throw InputError(fmt::format("{}: the edits must be a JSON list", path));
+  std::vector<std::string> addedPunctual; // lights a move_light may move
+  auto taken = [](const std::vector<std::string>& names, const std::string& name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
   std::vector<Edit> edits;
   for (std::size_t i = 0; i < list.size(); ++i) {
     const EntryContext at{path, i};
-    const json& j = list[i];
-    if (!j.is_object()) at.fail("an edit must be an object");
-    Edit e;
-    e.entry = i;
-    if (j.contains("light")) {
-      e.name = text(j, "light", at);
-      requireLight(lightNames, e.name, at);
-      if (j.contains("scale")) {
-        e.kind = Edit::Kind::Scale;
-        e.scale = number(j, "scale", at);
-        if (e.scale < 0.0f) at.fail("'scale' must not be negative");
-      } else if (j.contains("color")) {
-        e.kind = Edit::Kind::Color;
-        e.color = vec3(j, "color", at);
-        if (glm::any(glm::lessThan(e.color, glm::vec3(0.0f)))) at.fail("'color' must not be negative");
-      } else {
-        at.fail("a light edit needs 'scale' or 'color'");
+    Edit e = readEdit(list[i], at);
+    // The names each edit refers to must exist at its point of the sequence.
+    switch (e.kind) {
+      case Edit::Kind::Scale:
+      case Edit::Kind::Color: requireLight(lightNames, e.name, at); break;
+      case Edit::Kind::AddQuad:
+      case Edit::Kind::AddLight: {
+        const bool quad = e.kind == Edit::Kind::AddQuad;
+        if (quad) {
+          // The quad is an object too: later edits may move or remove it.
+          if (taken(objectNames, e.name)) at.fail(fmt::format("an object named '{}' exists already", e.name));
+          objectNames.push_back(e.name);
+        } else {
+          addedPunctual.push_back(e.name);
+        }
+        if (taken(lightNames, e.name)) at.fail(fmt::format("a light named '{}' exists already", e.name));
+        // Area lights come before punctual ones; only a punctual light's name goes on removal.
+        lightNames.push_back(e.name);
+        areaLights.push_back(quad);
+        break;
       }
-    } else if (j.contains("add_light")) {
-      const json& light = j.at("add_light");
-      const bool quad = light.is_object() && light.contains("type") && light.at("type") == "quad";
-      if (quad) {
-        e.kind = Edit::Kind::AddQuad;
-        e.quad = addedQuad(light, at);
-        e.name = e.quad.name;
-        // The quad is an object too: later edits may move or remove it.
-        if (std::find(objectNames.begin(), objectNames.end(), e.name) != objectNames.end())
-          at.fail(fmt::format("an object named '{}' exists already", e.name));
+      case Edit::Kind::RemoveLight: {
+        requireLight(lightNames, e.name, at);
+        const auto k = static_cast<std::size_t>(std::find(lightNames.begin(), lightNames.end(), e.name) - lightNames.begin());
+        if (!areaLights[k]) {
+          lightNames.erase(lightNames.begin() + static_cast<std::ptrdiff_t>(k));
+          areaLights.erase(areaLights.begin() + static_cast<std::ptrdiff_t>(k));
+          std::erase(addedPunctual, e.name);
+        }
+        break;
+      }
+      case Edit::Kind::MoveLight:
+        requireLight(lightNames, e.name, at);
+        if (!taken(addedPunctual, e.name))
+          at.fail(fmt::format("'{}' is not a point or spot light added by an earlier edit (only those move)", e.name));
+        break;
+      case Edit::Kind::Move: requireObject(objectNames, e.name, at); break;
+      case Edit::Kind::Remove:
+        requireObject(objectNames, e.name, at);
+        objectNames.erase(std::find(objectNames.begin(), objectNames.end(), e.name));
+        break;
+      case Edit::Kind::Insert:
+        if (std::filesystem::path(e.path).is_relative())
+          e.path = (std::filesystem::path(path).parent_path() / e.path).string();
+        if (!std::filesystem::exists(e.path)) at.fail(fmt::format("'{}': no such file", e.path));
+        if (taken(objectNames, e.name)) at.fail(fmt::format("an object named '{}' exists already", e.name));
         objectNames.push_back(e.name);
-      } else {
-        e.kind = Edit::Kind::AddLight;
-        e.light = readAddedLight(light, at);
-        e.name = e.light.name;
-      }
-      if (std::find(lightNames.begin(), lightNames.end(), e.name) != lightNames.end())
-        at.fail(fmt::format("a light named '{}' exists already", e.name));
-      // Area lights come before punctual ones; only a punctual light's name goes on removal.
-      lightNames.push_back(e.name);
-      areaLights.push_back(quad);
-    } else if (j.contains("remove_light")) {
-      e.kind = Edit::Kind::RemoveLight;
-      e.name = text(j, "remove_light", at);
-      requireLight(lightNames, e.name, at);
-      const auto k = static_cast<std::size_t>(std::find(lightNames.begin(), lightNames.end(), e.name) - lightNames.begin());
-      if (!areaLights[k]) {
-        lightNames.erase(lightNames.begin() + static_cast<std::ptrdiff_t>(k));
-        areaLights.erase(areaLights.begin() + static_cast<std::ptrdiff_t>(k));
-      }
-    } else if (j.contains("move")) {
-      e.kind = Edit::Kind::Move;
-      e.name = text(j, "move", at);
-      requireObject(objectNames, e.name, at);
-      e.translate = j.contains("translate") ? vec3(j, "translate", at) : glm::vec3(0.0f);
-      e.rotateDegrees = j.contains("rotate_deg") ? vec3(j, "rotate_deg", at) : glm::vec3(0.0f);
-    } else if (j.contains("remove")) {
-      e.kind = Edit::Kind::Remove;
-      e.name = text(j, "remove", at);
-      requireObject(objectNames, e.name, at);
-      objectNames.erase(std::find(objectNames.begin(), objectNames.end(), e.name));
-    } else if (j.contains("insert")) {
-      e.kind = Edit::Kind::Insert;
-      e.path = text(j, "insert", at);
-      e.name = text(j, "name", at);
-      if (std::filesystem::path(e.path).is_relative())
-        e.path = (std::filesystem::path(path).parent_path() / e.path).string();
-      if (!std::filesystem::exists(e.path)) at.fail(fmt::format("'{}': no such file", e.path));
-      if (std::find(objectNames.begin(), objectNames.end(), e.name) != objectNames.end())
-        at.fail(fmt::format("an object named '{}' exists already", e.name));
-      objectNames.push_back(e.name);
-      e.translate = j.contains("translate") ? vec3(j, "translate", at) : glm::vec3(0.0f);
-    } else {
-      at.fail("unknown edit (known: light, add_light, remove_light, move, remove, insert)");
+        // Loaded (and so checked) before anything is rendered.
+        e.inserted = std::make_shared<const scene::Scene>(scene::loadGltf(e.path));
+        break;
     }
     edits.push_back(std::move(e));
   }

@@ -7,6 +7,7 @@
 //   {"add_light": {"type": "quad", "name": N, "corner": [..], "edge1": [..], "edge2": [..],
 //                  "emission": [r, g, b]}}     an emissive quad: a light and an object named N
 //   {"remove_light": NAME}
+//   {"move_light": NAME, "position": [..]}  a point or spot light an earlier edit added
 //   {"move": NODE, "translate": [..], "rotate_deg": [..]}, {"remove": NODE},
 //   {"insert": "other.gltf", "name": N, "translate": [..]}   (the path relative to the edits file)
 // A light's emission is E_s = (scene's E_s) x scale x color, as if the glTF's emissive strength
@@ -22,34 +23,25 @@
 #include "scene/scene.h"
 #include "scene/scene_edit.h"
 #include "io/json_fields.h"
+#include "session/edit.h"
 
 namespace obscura::relight {
 
-struct Edit {
-  enum class Kind { Scale, Color, AddLight, AddQuad, RemoveLight, Move, Remove, Insert };
-  Kind kind = Kind::Scale;
-  std::size_t entry = 0;       // index in the file, for messages
-  std::string name;            // the light or node it names
-  float scale = 1.0f;
-  glm::vec3 color{1.0f};
-  scene::PunctualLight light;  // AddLight
-  scene::EmissiveQuad quad;    // AddQuad
-  glm::vec3 translate{0.0f};   // Move, Insert
-  glm::vec3 rotateDegrees{0.0f};
-  std::string path;            // Insert: the other glTF
-
-  std::string kindName() const;
-};
+using session::Edit;
 
 // Reads and checks the whole file before anything is rendered: malformed entries and names
 // that do not exist at that point of the sequence (lights added or removed before it counted)
 // are InputErrors naming the file and the entry. `lightNames` are the scene's lights, `areaLights`
 // which of them are emissive meshes (removing one switches it off; its name stays), `objectNames`
-// its objects. An insert's path is made absolute here and must exist.
+// its objects. An insert's path is made absolute here and its glTF loaded (Edit::inserted).
 // An added point or spot light: {"type": "point"|"spot", "name", "position", "color", "intensity",
 // "direction", "inner_cone", "outer_cone"} in glTF KHR_lights_punctual units (also the view
 // script's and panel's). InputError naming `at` when malformed.
 scene::PunctualLight readAddedLight(const nlohmann::json& j, const io::JsonEntry& at);
+
+// One entry's syntax, without checking that the names it uses exist: the edits file's entries
+// and the window script's "panel" edits. InputError naming `at` when malformed.
+Edit readEdit(const nlohmann::json& j, const io::JsonEntry& at);
 
 std::vector<Edit> readEdits(const std::string& path, std::vector<std::string> lightNames,
                             std::vector<bool> areaLights, std::vector<std::string> objectNames);

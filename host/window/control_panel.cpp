@@ -10,10 +10,20 @@ namespace obscura::window {
 namespace {
 
 using Kind = ViewerAction::Kind;
+using session::Edit;
 
 ViewerAction action(Kind kind) {
   ViewerAction a;
   a.kind = kind;
+  return a;
+}
+
+// A change to the scene, applied by the viewer's edit session.
+ViewerAction edit(const Edit& e) {
+  ViewerAction a;
+  a.kind = Kind::Edit;
+  a.edit = e;
+  a.name = e.name;
   return a;
 }
 
@@ -110,42 +120,30 @@ std::vector<ViewerAction> drawControlPanel(const PanelState& s) {
       ImGui::TextUnformatted(light.name.c_str());
       float scale = light.scale;
       if (ImGui::SliderFloat("intensity", &scale, 0.0f, 16.0f, "x %.2f", ImGuiSliderFlags_Logarithmic)) {
-        auto a = action(Kind::LightScale);
-        a.name = light.name;
-        a.value = scale;
-        out.push_back(a);
+        out.push_back(edit({.kind = Edit::Kind::Scale, .name = light.name, .scale = scale}));
       }
       float color[3] = {light.color.x, light.color.y, light.color.z};
       if (ImGui::ColorEdit3("colour", color, ImGuiColorEditFlags_Float | ImGuiColorEditFlags_HDR)) {
-        auto a = action(Kind::LightColor);
-        a.name = light.name;
-        a.vector = {color[0], color[1], color[2]};
-        out.push_back(a);
+        out.push_back(edit({.kind = Edit::Kind::Color, .name = light.name, .color = {color[0], color[1], color[2]}}));
       }
       if (light.added) {
         float p[3] = {light.position.x, light.position.y, light.position.z};
         if (ImGui::DragFloat3("position", p, 0.005f * s.sceneSize)) {
-          auto a = action(Kind::MoveLight);
-          a.name = light.name;
-          a.vector = {p[0], p[1], p[2]};
-          out.push_back(a);
+          out.push_back(edit({.kind = Edit::Kind::MoveLight, .name = light.name, .position = {p[0], p[1], p[2]}}));
         }
         if (ImGui::Button("remove")) {
-          auto a = action(Kind::RemoveLight);
-          a.name = light.name;
-          out.push_back(a);
+          out.push_back(edit({.kind = Edit::Kind::RemoveLight, .name = light.name}));
         }
       }
       ImGui::PopID();
     }
     if (ImGui::Button("add point light in front of the camera")) {
-      auto a = action(Kind::AddLight);
-      a.light.type = scene::PunctualType::Point;
-      a.light.position = s.newLightPosition;
-      a.light.intensity = s.newLightIntensity;
-      a.light.name = fmt::format("point{}", s.lights.size());
-      a.name = a.light.name;
-      out.push_back(a);
+      Edit add{.kind = Edit::Kind::AddLight, .name = fmt::format("point{}", s.lights.size())};
+      add.light.type = scene::PunctualType::Point;
+      add.light.position = s.newLightPosition;
+      add.light.intensity = s.newLightIntensity;
+      add.light.name = add.name;
+      out.push_back(edit(add));
     }
   }
 
@@ -157,9 +155,8 @@ std::vector<ViewerAction> drawControlPanel(const PanelState& s) {
       static float offset[3] = {0.0f, 0.0f, 0.0f};
       ImGui::DragFloat3("offset", offset, 0.002f * s.sceneSize);
       if (ImGui::Button("move by offset")) {
-        auto a = action(Kind::MoveObject);
-        a.vector = {offset[0], offset[1], offset[2]};
-        out.push_back(a);
+        // No name: the selected object.
+        out.push_back(edit({.kind = Edit::Kind::Move, .translate = {offset[0], offset[1], offset[2]}}));
       }
       ImGui::SameLine();
       if (ImGui::Button("deselect")) out.push_back(action(Kind::SelectObject));

@@ -58,37 +58,16 @@ ViewerAction panelAction(const json& p, const io::JsonEntry& at) {
   using Kind = ViewerAction::Kind;
   if (!p.is_object() || p.empty()) at.fail("'panel' must be an object naming one change");
   ViewerAction a;
-  if (p.contains("light")) {
-    a.name = io::jsonText(p, "light", at);
-    if (p.contains("scale")) {
-      a.kind = Kind::LightScale;
-      a.value = io::jsonNumber(p, "scale", at);
-      if (a.value < 0.0f) at.fail("'scale' must not be negative");
-    } else {
-      a.kind = Kind::LightColor;
-      a.vector = io::jsonVec3(p, "color", at);
-      if (glm::any(glm::lessThan(a.vector, glm::vec3(0.0f)))) at.fail("'color' must not be negative");
-    }
-  } else if (p.contains("add_light")) {
-    a.kind = Kind::AddLight;
-    a.light = relight::readAddedLight(p.at("add_light"), at);
-    a.name = a.light.name;
-  } else if (p.contains("remove_light")) {
-    a.kind = Kind::RemoveLight;
-    a.name = io::jsonText(p, "remove_light", at);
-  } else if (p.contains("move_light")) {
-    a.kind = Kind::MoveLight;
-    a.name = io::jsonText(p, "move_light", at);
-    a.vector = io::jsonVec3(p, "position", at);
+  if (p.contains("light") || p.contains("add_light") || p.contains("remove_light") || p.contains("move_light") ||
+      p.contains("move") || p.contains("remove")) {
+    // A scene edit, in the words of `relight --edits` (relight/light_edits.h).
+    a.kind = Kind::Edit;
+    a.edit = relight::readEdit(p, at);
+    a.name = a.edit.name;
   } else if (p.contains("select")) {
     a.kind = Kind::SelectObject;
     if (!p.at("select").is_string()) at.fail("'select' must be an object's name");
     a.name = p.at("select").get<std::string>();
-  } else if (p.contains("move")) {
-    a.kind = Kind::MoveObject;
-    if (!p.at("move").is_string()) at.fail("'move' must be an object's name (\"\" = the selected one)");
-    a.name = p.at("move").get<std::string>();
-    a.vector = io::jsonVec3(p, "translate", at);
   } else if (p.contains("exposure")) {
     a.kind = Kind::Exposure;
     a.value = io::jsonNumber(p, "exposure", at);

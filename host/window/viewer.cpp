@@ -68,24 +68,17 @@ Viewer::Viewer(std::unique_ptr<FrameTarget> target, const gpu::ContextOptions& d
     log_.open(config_.log);
     if (!log_) throw InputError(fmt::format("{}: cannot write the frame log", config_.log));
   }
-  scenes_.push_back(std::move(scene));
-  bvhs_.push_back(std::move(bvh));
-  const scene::Bounds& b = scenes_.back().bounds;
+  const scene::Bounds& b = scene.bounds;
   sceneSize_ = std::max(glm::length(b.hi - b.lo), 1e-3f);
 
-  render::ObscuranceSettings settings = config_.obscurance;
-  settings.spareLightSlots = kSpareLightSlots;
-  settings.keptRaySamples = settings.spp; // as many as fit: added lights and moves follow them
+  // As many samples' rays kept as fit: added lights and moves follow them.
+  render::ObscuranceSettings settings = session::editSettings(config_.obscurance, kSpareLightSlots);
   settings.primaryAovs = true; // picking reads the primitive AOV; the AOV list shows them
   settings.composedAovs = true;
   config_.obscurance = settings;
-  renderer_ = std::make_unique<render::ObscuranceRenderer>(context_, scenes_.back(), bvhs_.back(), settings);
-  renderer_->configure(fullSettings());
-  renderer_->prepareForEdits(); // light drags and object moves are what the window is for
-  denoiser_ = std::make_unique<render::Denoiser>(context_, *renderer_);
-  const auto& names = renderer_->lights().names;
-  for (std::size_t i = 0; i < names.size(); ++i)
-    lights_.push_back({.name = names[i], .base = renderer_->emissions()[i]});
+  session_ = std::make_unique<session::EditSession>(context_, std::move(scene), std::move(bvh), settings);
+  session_->renderer().configure(fullSettings());
+  denoiser_ = std::make_unique<render::Denoiser>(context_, session_->renderer());
   lastFrameStart_ = Clock::now();
 }
 
@@ -109,50 +102,47 @@ void Viewer::restart(bool preview, bool cameraOnly) {
     s.shadowRays = std::min(s.shadowRays, 1u);
     s.obscuranceRays = std::min(s.obscuranceRays, 1u);
   }
-  renderer_->configure(s);
+  session_->renderer().configure(s);
   pathTracer_.reset(); // made again with the new camera when shown
   previewShown_ = preview;
   needsCompose_ = true;
 }
 
-std::size_t Viewer::lightIndex(const std::string& name) const {
-  for (std::size_t i = 0; i < lights_.size(); ++i)
-    if (lights_[i].name == name) return i;
-  std::vector<std::string> names;
-  for (const auto& l : lights_) names.push_back(l.name);
-  throw InputError(fmt::format("no light named '{}' (lights: {})", name, fmt::join(names, ", ")));
-}
-
-void Viewer::updateEmissions() {
-  forgetHistory_ = true;
-  std::vector<glm::vec3> emissions;
-  for (const auto& l : lights_) emissions.push_back(l.base * l.scale * l.color);
-  renderer_->setEmissions(emissions);
-  needsCompose_ = true;
-}
-
-void Viewer::moveObject(std::size_t object, glm::vec3 translate, FrameRecord& record) {
-  scene::Scene next = scenes_.back();
-  std::vector<scene::Bounds> changed{scene::objectBounds(next, object)};
-  scene::moveObject(next, object, translate, glm::vec3(0.0f));
-  changed.push_back(scene::objectBounds(next, object));
-  bvh::Bvh tree = bvhs_.back();
-  bvh::refit(tree, render::triangleSoup(next));
-  scenes_.push_back(std::move(next));
-  bvhs_.push_back(std::move(tree));
-  // The renderer now points at the newest scene; the path tracer is made again when shown.
-  pathTracer_.reset();
-  // With the preview's rays in the frame, the retrace must use the same; after it the older scenes
-  // are no longer referenced.
-  record.retraced = renderer_->updateGeometry(scenes_.back(), bvhs_.back(), changed);
-  forgetHistory_ = true;
-  while (scenes_.size() > 1) {
-    scenes_.pop_front();
-    bvhs_.pop_front();
+void Viewer::applyEdit(session::Edit edit, FrameRecord& record) {
+  using EditKind = session::Edit::Kind;
+  if (edit.kind == EditKind::Move && edit.name.empty()) {
+    if (selected_ < 0) throw InputError("move: no object is selected");
+    edit.name = session_->scene().objects[static_cast<std::size_t>(selected_)].name;
   }
+  if (edit.kind == EditKind::Insert) throw InputError("insert: not in the window (relight --edits inserts objects)");
+  const session::EditReport report = session_->apply(edit, edit.kindName());
+  forgetHistory_ = true; // the image itself changed
   needsCompose_ = true;
-  status_ = fmt::format("moved {}: {} pixels retraced ({:.1f} %)", scenes_.back().objects[object].name, record.retraced,
-                        100.0 * double(record.retraced) / (double(config_.obscurance.width) * config_.obscurance.height));
+  if (edit.changesGeometry()) {
+    pathTracer_.reset(); // it points at the scene before the edit; made again when shown
+    record.retraced = report.pixelsRetraced;
+  }
+  const char* action = "";
+  switch (edit.kind) {
+  case EditKind::Scale: action = "light_scale"; break;
+  case EditKind::Color: action = "light_color"; break;
+  case EditKind::AddLight:
+  case EditKind::AddQuad:
+    action = "add_light";
+    status_ = fmt::format("added {}: its rays alone were traced", edit.name);
+    break;
+  case EditKind::RemoveLight: action = "remove_light"; break;
+  case EditKind::MoveLight: action = "move_light"; break;
+  case EditKind::Move:
+    action = "move_object";
+    status_ = fmt::format("moved {}: {} pixels retraced ({:.1f} %)", edit.name, report.pixelsRetraced,
+                          100.0 * double(report.pixelsRetraced) /
+                              (double(config_.obscurance.width) * config_.obscurance.height));
+    break;
+  case EditKind::Remove: action = "remove_object"; break;
+  case EditKind::Insert: break;
+  }
+  record.actions.push_back(action);
 }
 
 void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
@@ -164,61 +154,13 @@ void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
     record.actions.push_back(action);
   };
   switch (a.kind) {
-  case Kind::LightScale:
-    lights_[lightIndex(a.name)].scale = a.value;
-    updateEmissions();
-    record.actions.push_back("light_scale");
+  case Kind::Edit:
+    applyEdit(a.edit, record);
     break;
-  case Kind::LightColor:
-    lights_[lightIndex(a.name)].color = a.vector;
-    updateEmissions();
-    record.actions.push_back("light_color");
-    break;
-  case Kind::AddLight: {
-    for (const auto& l : lights_)
-      if (l.name == a.light.name) throw InputError(fmt::format("a light named '{}' exists", a.light.name));
-    const std::size_t index = renderer_->addLight(a.light);
-    LightControl control{.name = a.light.name, .base = renderer_->emissions()[index], .added = true, .light = a.light};
-    lights_.insert(lights_.begin() + static_cast<std::ptrdiff_t>(index), control);
-    updateEmissions();
-    record.actions.push_back("add_light");
-    status_ = fmt::format("added {}: its rays alone were traced", a.light.name);
-    break;
-  }
-  case Kind::RemoveLight: {
-    const std::size_t index = lightIndex(a.name);
-    renderer_->removeLight(index);
-    if (lights_[index].added) lights_.erase(lights_.begin() + static_cast<std::ptrdiff_t>(index));
-    else lights_[index].scale = 0.0f; // an area light is switched off, its slot stays
-    updateEmissions();
-    record.actions.push_back("remove_light");
-    break;
-  }
-  case Kind::MoveLight: {
-    const std::size_t index = lightIndex(a.name);
-    if (!lights_[index].added) throw InputError(fmt::format("'{}' is not a light added in the window", a.name));
-    LightControl control = lights_[index];
-    control.light.position = a.vector;
-    renderer_->removeLight(index);
-    lights_.erase(lights_.begin() + static_cast<std::ptrdiff_t>(index));
-    const std::size_t at = renderer_->addLight(control.light);
-    lights_.insert(lights_.begin() + static_cast<std::ptrdiff_t>(at), control);
-    updateEmissions();
-    record.actions.push_back("move_light");
-    break;
-  }
   case Kind::SelectObject:
-    selected_ = a.name.empty() ? -1 : static_cast<int>(scene::objectIndex(scenes_.back(), a.name, "select"));
+    selected_ = a.name.empty() ? -1 : static_cast<int>(scene::objectIndex(session_->scene(), a.name, "select"));
     record.actions.push_back("select");
     break;
-  case Kind::MoveObject: {
-    if (a.name.empty() && selected_ < 0) throw InputError("move: no object is selected");
-    const std::size_t object = a.name.empty() ? static_cast<std::size_t>(selected_)
-                                              : scene::objectIndex(scenes_.back(), a.name, "move");
-    moveObject(object, a.vector, record);
-    record.actions.push_back("move_object");
-    break;
-  }
   case Kind::Exposure:
     config_.exposure = a.value;
     needsCompose_ = true;
@@ -255,7 +197,7 @@ void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
     restartFor("obscurance_rays", false);
     break;
   case Kind::Camera: {
-    const auto& cameras = scenes_.back().cameras;
+    const auto& cameras = session_->scene().cameras;
     if (a.count >= cameras.size())
       throw InputError(fmt::format("camera {}: the scene has {} camera(s)", a.count, cameras.size()));
     camera_.setCamera(cameras[a.count]);
@@ -289,14 +231,14 @@ int Viewer::pick(double x, double y) {
   if (u < 0.0 || u >= 1.0 || v < 0.0 || v >= 1.0) return -1;
   const int px = static_cast<int>(u * config_.obscurance.width), py = static_cast<int>(v * config_.obscurance.height);
   shownBytes(); // compose() writes the display bytes too: keep the frame shown as the light mix made it
-  renderer_->compose(config_.exposure);
-  const io::Image image = renderer_->image();
+  session_->renderer().compose(config_.exposure);
+  const io::Image image = session_->renderer().image();
   const int channel = image.channelIndex(render::aovChannels("primitive").front());
   if (channel < 0) return -1;
   const float primitive = image.at(px, py, channel);
   if (!(primitive >= 0.0f)) return -1; // background
   const auto triangle = static_cast<std::uint32_t>(std::lround(primitive));
-  const auto& objects = scenes_.back().objects;
+  const auto& objects = session_->scene().objects;
   for (std::size_t i = 0; i < objects.size(); ++i)
     if (triangle >= objects[i].firstTriangle && triangle < objects[i].firstTriangle + objects[i].triangleCount)
       return static_cast<int>(i);
@@ -315,7 +257,7 @@ void Viewer::renderStep(FrameRecord& record) {
       s.maxDepth = config_.pathDepth;
       s.spp = maxSamples;
       s.lightSampling = config_.obscurance.lightSampling;
-      pathTracer_ = std::make_unique<render::PathTracer>(context_, scenes_.back(), bvhs_.back(), s,
+      pathTracer_ = std::make_unique<render::PathTracer>(context_, session_->scene(), session_->bvh(), s,
                                                          config_.obscurance.maxBufferBytes);
       record.restarted = true;
     }
@@ -335,8 +277,8 @@ void Viewer::renderStep(FrameRecord& record) {
     restart(false, true); // the preview is over: full rays from sample 0, the same view
     record.restarted = true;
   }
-  if (renderer_->samples() < maxSamples) {
-    renderer_->iterate(1);
+  if (session_->renderer().samples() < maxSamples) {
+    session_->renderer().iterate(1);
     needsCompose_ = true;
   }
 
@@ -345,16 +287,16 @@ void Viewer::renderStep(FrameRecord& record) {
   if (config_.aov == "combined" && config_.denoise) {
     if (forgetHistory_) denoiser_->reset();
     forgetHistory_ = false;
-    renderer_->compose(config_.exposure);
-    denoiser_->denoise(*renderer_, config_.exposure);
+    session_->renderer().compose(config_.exposure);
+    denoiser_->denoise(session_->renderer(), config_.exposure);
     record.denoiseMs = denoiser_->lastGpuMs();
     shownAt_ = ShownAt::Denoiser;
   } else if (config_.aov == "combined") {
-    renderer_->composeDisplay(config_.exposure);
+    session_->renderer().composeDisplay(config_.exposure);
     shownAt_ = ShownAt::Renderer;
   } else {
-    renderer_->compose(config_.exposure);
-    const io::Image image = renderer_->image();
+    session_->renderer().compose(config_.exposure);
+    const io::Image image = session_->renderer().image();
     const auto channels = render::aovChannels(config_.aov);
     shown_ = io::encodeRgba8(image, image.channelIndex(channels.front()), config_.exposure,
                              static_cast<int>(channels.size()));
@@ -364,14 +306,14 @@ void Viewer::renderStep(FrameRecord& record) {
 
 const std::vector<std::uint32_t>& Viewer::shownBytes() {
   if (shownAt_ == ShownAt::Denoiser) shown_ = denoiser_->display();
-  else if (shownAt_ == ShownAt::Renderer) shown_ = renderer_->display();
+  else if (shownAt_ == ShownAt::Renderer) shown_ = session_->renderer().display();
   shownAt_ = ShownAt::Host; // until the next compose
   return shown_;
 }
 
 render::RenderStats Viewer::currentStats() const {
   if (config_.method == "pathtrace") return pathTracer_ ? pathTracer_->stats() : render::RenderStats{};
-  return renderer_->stats();
+  return session_->renderer().stats();
 }
 
 PanelState Viewer::panelState() const {
@@ -383,11 +325,11 @@ PanelState Viewer::panelState() const {
     if (name != "combined") s.aovs.push_back(name);
   s.rho = render::rhoKindName(config_.obscurance.rho);
   s.exposure = config_.exposure;
-  s.dMax = renderer_->dMax();
+  s.dMax = session_->renderer().dMax();
   s.shadowRays = config_.obscurance.shadowRays;
   s.obscuranceRays = config_.obscurance.obscuranceRays;
   s.denoise = config_.denoise;
-  s.samples = config_.method == "pathtrace" && pathTracer_ ? pathTracer_->samples() : renderer_->samples();
+  s.samples = config_.method == "pathtrace" && pathTracer_ ? pathTracer_->samples() : session_->renderer().samples();
   s.maxSamples = std::max(config_.obscurance.spp, 1u);
   s.preview = previewShown_;
   s.frameMs = lastFrameMs_;
@@ -396,9 +338,10 @@ PanelState Viewer::panelState() const {
   if (config_.denoise && config_.method == "obscurance") s.passes["denoise (last frame)"] = {denoiser_->lastGpuMs(), 0};
   const double ms = totalGpuMs(stats);
   s.raysPerSecond = ms > 0 ? double(totalRays(stats)) / (ms * 1e-3) : 0.0;
-  for (const auto& l : lights_) s.lights.push_back({l.name, l.scale, l.color, l.added, l.light.position});
-  for (const auto& c : scenes_.back().cameras) s.cameras.push_back(c.name);
-  if (selected_ >= 0) s.selected = scenes_.back().objects[static_cast<std::size_t>(selected_)].name;
+  for (const auto& l : session_->lights())
+    s.lights.push_back({l.name, l.scale, l.color, l.added && !l.area, l.light.position});
+  for (const auto& c : session_->scene().cameras) s.cameras.push_back(c.name);
+  if (selected_ >= 0) s.selected = session_->scene().objects[static_cast<std::size_t>(selected_)].name;
   const scene::Camera& cam = camera_.camera();
   s.newLightPosition = cam.position + cam.forward * (0.15f * sceneSize_);
   s.newLightIntensity = 0.05f * sceneSize_ * sceneSize_;
@@ -413,7 +356,7 @@ void Viewer::writeLog(const FrameRecord& r) {
   nlohmann::json line = {{"frame", r.frame},
                          {"method", config_.method},
                          {"samples", config_.method == "pathtrace" && pathTracer_ ? pathTracer_->samples()
-                                                                                   : renderer_->samples()},
+                                                                                   : session_->renderer().samples()},
                          {"restarted", r.restarted},
                          {"preview", r.preview},
                          {"presented", r.presented},
@@ -436,8 +379,8 @@ io::Image Viewer::shownImage() {
   if (config_.method == "pathtrace") return pathTracer_->image();
   if (config_.aov == "combined" && config_.denoise) return denoiser_->image();
   shownBytes(); // as in pick(): compose() overwrites the display bytes not yet read back
-  renderer_->compose(config_.exposure);
-  return renderer_->image();
+  session_->renderer().compose(config_.exposure);
+  return session_->renderer().image();
 }
 
 void Viewer::takeScreenshot(const std::string& path, const std::vector<std::uint32_t>& captured,
@@ -494,7 +437,7 @@ void Viewer::run() {
       for (int key : input.keysPressed) {
         if (key == GLFW_KEY_ESCAPE) target_->requestClose();
         if (key == GLFW_KEY_TAB) panelVisible = !panelVisible;
-        if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && std::size_t(key - GLFW_KEY_1) < scenes_.back().cameras.size()) {
+        if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && std::size_t(key - GLFW_KEY_1) < session_->scene().cameras.size()) {
           ViewerAction a;
           a.kind = Kind::Camera;
           a.count = static_cast<std::size_t>(key - GLFW_KEY_1);
@@ -512,7 +455,7 @@ void Viewer::run() {
       for (const auto& click : input.clicks) {
         const int object = pick(click[0], click[1]);
         selected_ = object;
-        status_ = object >= 0 ? fmt::format("selected {}", scenes_.back().objects[std::size_t(object)].name)
+        status_ = object >= 0 ? fmt::format("selected {}", session_->scene().objects[std::size_t(object)].name)
                               : "nothing selected";
         record.actions.push_back("pick");
       }

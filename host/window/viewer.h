@@ -13,7 +13,6 @@
 #pragma once
 #include <chrono>
 #include <cstdint>
-#include <deque>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -29,6 +28,7 @@
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
 #include "scene/scene.h"
+#include "session/edit_session.h"
 #include "window/camera_controller.h"
 #include "window/control_panel.h"
 #include "window/event_script.h"
@@ -76,9 +76,8 @@ private:
   const std::vector<std::uint32_t>& shownBytes();
   // The object under window pixel (x, y), from the primitive AOV; -1 for none.
   int pick(double x, double y);
-  void moveObject(std::size_t object, glm::vec3 translate, FrameRecord& record);
-  void updateEmissions();
-  std::size_t lightIndex(const std::string& name) const;
+  // A scene edit, through the session; what the window shows follows.
+  void applyEdit(session::Edit edit, FrameRecord& record);
   render::ObscuranceSettings fullSettings() const;
   PanelState panelState() const;
   // The shown method's counters since its last restart.
@@ -94,27 +93,16 @@ private:
   gpu::Context context_;
   std::ofstream log_;
 
-  // The scene as edited so far (the renderers keep pointers to the newest).
-  std::deque<scene::Scene> scenes_;
-  std::deque<bvh::Bvh> bvhs_;
   float sceneSize_ = 1.0f;
   CameraController camera_;
-  std::unique_ptr<render::ObscuranceRenderer> renderer_;
+  // The scene as edited so far, its renderer and its lights (session/edit_session.h).
+  std::unique_ptr<session::EditSession> session_;
   std::unique_ptr<render::PathTracer> pathTracer_; // made when first shown, again after edits
   // The denoiser of the obscurance frame (on by default): its history follows the camera; any
   // other change forgets it (forgetHistory_).
   std::unique_ptr<render::Denoiser> denoiser_;
   bool forgetHistory_ = true;
 
-  struct LightControl {
-    std::string name;
-    glm::vec3 base{1.0f}; // the light's own emission (E_s at scale 1, colour 1)
-    float scale = 1.0f;
-    glm::vec3 color{1.0f};
-    bool added = false;   // added in the window (can be dragged)
-    scene::PunctualLight light;
-  };
-  std::vector<LightControl> lights_;
   int selected_ = -1;
   bool previewShown_ = false;
   bool needsCompose_ = true;

@@ -1,24 +1,21 @@
 // viewer_action.h — one change a person asks of the viewer, from the panel or a script: both go
-// through Viewer::apply, so a scripted run exercises exactly what a click does.
+// through Viewer::apply, so a scripted run exercises exactly what a click does. A change to the
+// scene (a light, an object) is an Edit, the same as `relight --edits` applies, through the same
+// EditSession (session/edit_session.h); the others change what the window shows or samples.
 #pragma once
 #include <cstddef>
 #include <string>
 
 #include <glm/glm.hpp>
 
-#include "scene/scene.h"
+#include "session/edit.h"
 
 namespace obscura::window {
 
 struct ViewerAction {
   enum class Kind {
-    LightScale,    // light `name`: intensity multiplier `value` (compose only)
-    LightColor,    // light `name`: RGB multipliers `vector` (compose only)
-    AddLight,      // `light` (point or spot): traces that light alone
-    RemoveLight,   // light `name`
-    MoveLight,     // added light `name` to `vector` (dragged): its rays alone, traced again
+    Edit,          // `edit` (session/edit.h); a Move naming no object moves the selected one
     SelectObject,  // object `name` ("" = none)
-    MoveObject,    // object `name` (or the selected one when empty) by `vector`: dirty pixels only
     Exposure,      // `value` stops (display only)
     Aov,           // show AOV `name`
     Method,        // "obscurance" or "pathtrace"
@@ -34,9 +31,8 @@ struct ViewerAction {
   Kind kind = Kind::Exposure;
   std::string name;
   float value = 0.0f;
-  glm::vec3 vector{0.0f};
   std::size_t count = 0;
-  scene::PunctualLight light;
+  session::Edit edit;
 };
 
 } // namespace obscura::window

@@ -131,8 +131,9 @@ TEST(ViewBenchmarkScript, ParsesAndRunsItsSegmentsToFrame145) {
   std::size_t drags = 0, moves = 0;
   for (const auto& e : script.events()) {
     EXPECT_NE(e.kind, window::ScriptEvent::Kind::Window) << "it must run --offscreen";
-    drags += e.kind == window::ScriptEvent::Kind::Panel && e.action.kind == window::ViewerAction::Kind::MoveLight;
-    moves += e.kind == window::ScriptEvent::Kind::Panel && e.action.kind == window::ViewerAction::Kind::MoveObject;
+    const bool edit = e.kind == window::ScriptEvent::Kind::Panel && e.action.kind == window::ViewerAction::Kind::Edit;
+    drags += edit && e.action.edit.kind == session::Edit::Kind::MoveLight;
+    moves += edit && e.action.edit.kind == session::Edit::Kind::Move;
   }
   EXPECT_EQ(drags, 30u);
   EXPECT_EQ(moves, 30u);

@@ -1,0 +1,61 @@
+#include "session/scene_history.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "render/scene/scene_buffers.h"
+#include "scene/scene_edit.h"
+
+namespace obscura::session {
+
+SceneHistory::SceneHistory(scene::Scene scene, bvh::Bvh bvh, bvh::BuildOptions rebuildOptions)
+    : rebuildOptions_(rebuildOptions) {
+  scenes_.push_back(std::move(scene));
+  trees_.push_back(std::move(bvh));
+}
+
+GeometryChange SceneHistory::apply(const Edit& e, const std::string& where) {
+  using Kind = Edit::Kind;
+  if (!e.changesGeometry()) throw std::logic_error("SceneHistory::apply: not a geometry edit");
+  scene::Scene next = scenes_.back();
+  GeometryChange change;
+  if (e.kind == Kind::Insert) {
+    if (!e.inserted) throw std::logic_error("SceneHistory::apply: an insert without its scene");
+    change.object = scene::insertObject(next, *e.inserted, e.name, e.translate);
+    change.changed.push_back(scene::objectBounds(next, change.object));
+  } else if (e.kind == Kind::AddQuad) {
+    change.object = scene::insertEmissiveQuad(next, e.quad);
+    change.changed.push_back(scene::objectBounds(next, change.object));
+  } else {
+    change.object = scene::objectIndex(next, e.name, where);
+    change.changed.push_back(scene::objectBounds(next, change.object));
+    if (e.kind == Kind::Move) {
+      scene::moveObject(next, change.object, e.translate, e.rotateDegrees);
+      change.changed.push_back(scene::objectBounds(next, change.object));
+    } else {
+      scene::removeObject(next, change.object);
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  change.bvh.refit = e.kind == Kind::Move || e.kind == Kind::Remove;
+  bvh::Bvh tree;
+  if (change.bvh.refit) {
+    tree = trees_.back();
+    bvh::refit(tree, render::triangleSoup(next));
+  } else {
+    tree = bvh::build(render::triangleSoup(next), rebuildOptions_);
+  }
+  change.bvh.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  scenes_.push_back(std::move(next));
+  trees_.push_back(std::move(tree));
+  return change;
+}
+
+void SceneHistory::dropPrevious() {
+  while (scenes_.size() > 1) {
+    scenes_.pop_front();
+    trees_.pop_front();
+  }
+}
+
+} // namespace obscura::session

@@ -1,0 +1,50 @@
+// scene_history.h — the scene being edited and its BVH, one version per geometry edit, and the
+// choice of how the BVH follows an edit: a move or a removal keeps every triangle, so the tree is
+// refitted (bvh/refit.cpp); an insert or an emissive quad adds triangles, so it is rebuilt with
+// the options the device's traversal wants (render/scene/bvh_layout.h). A renderer holds
+// pointers to the newest version; the one before stays until dropPrevious(), once the renderer
+// has moved on to the new one.
+#pragma once
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "bvh/bvh.h"
+#include "scene/scene.h"
+#include "session/edit.h"
+
+namespace obscura::session {
+
+struct BvhUpdate {
+  bool refit = false; // refitted (true) or rebuilt
+  double ms = 0.0;    // host wall time of the update
+};
+
+// What a geometry edit changed.
+struct GeometryChange {
+  std::vector<scene::Bounds> changed; // world boxes of the object's old and new places
+  std::size_t object = 0;             // the object it edited (inserted: the new one)
+  BvhUpdate bvh;
+};
+
+class SceneHistory {
+public:
+  SceneHistory(scene::Scene scene, bvh::Bvh bvh, bvh::BuildOptions rebuildOptions = {});
+
+  const scene::Scene& scene() const { return scenes_.back(); }
+  const bvh::Bvh& bvh() const { return trees_.back(); }
+
+  // Applies a geometry edit (Edit::changesGeometry: Move, Remove, Insert, AddQuad) to a copy of
+  // the current scene, which becomes current with its BVH updated. InputError naming `where` for
+  // an object that does not exist or a name taken.
+  GeometryChange apply(const Edit& edit, const std::string& where);
+  // Forgets every version but the current one (nothing may point at them any more).
+  void dropPrevious();
+
+private:
+  std::deque<scene::Scene> scenes_; // a deque: its elements stay where they are as it grows
+  std::deque<bvh::Bvh> trees_;
+  bvh::BuildOptions rebuildOptions_;
+};
+
+} // namespace obscura::session
