@@ -1,4 +1,5 @@
 #include "gpu/context.h"
+#include "gpu/pipeline_cache.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -255,7 +256,10 @@ Context::Context(const ContextOptions& options) : traversal_(options.traversal) 
   commandPool_ = device_.createCommandPool(
       {.flags = vk::CommandPoolCreateFlagBits::eResetCommandBuffer, .queueFamilyIndex = queueFamily_});
   fence_ = device_.createFence({});
+  pipelines_ = std::make_unique<PipelineCache>(device_);
 }
+
+Context::~Context() = default;
 
 void Context::setObjectName(vk::ObjectType type, std::uint64_t handle, const std::string& name) const {
   if (!debugUtils_) return;

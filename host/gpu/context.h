@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,11 +49,14 @@ struct ContextOptions {
   std::string traversal;
 };
 
+class PipelineCache;
+
 class Context {
 public:
   explicit Context(const ContextOptions& options = {});
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
+  ~Context();
 
   // Every device the loader reports, with the one automatic selection would choose marked.
   static std::vector<DeviceInfo> listDevices(std::uint32_t* automaticChoice = nullptr);
@@ -76,6 +80,9 @@ public:
   vk::MemoryPropertyFlags memoryTypeFlags(std::uint32_t type) const;
 
   bool validationEnabled() const { return validation_; }
+  // The compute pipelines made on this device, shared by kernels of the same shape
+  // (gpu/pipeline_cache.h).
+  PipelineCache& pipelines() const { return *pipelines_; }
   // Validation warnings and errors seen so far (by this process, all contexts together).
   static std::uint64_t validationMessageCount();
   static std::vector<std::string> validationMessages();
@@ -99,6 +106,7 @@ private:
   vk::raii::PhysicalDevice physicalDevice_ = nullptr;
   std::uint32_t queueFamily_ = 0;
   vk::raii::Device device_ = nullptr;
+  std::unique_ptr<PipelineCache> pipelines_; // after device_: destroyed before it
   vk::raii::Queue queue_ = nullptr;
   vk::raii::CommandPool commandPool_ = nullptr;
   vk::raii::Fence fence_ = nullptr;

@@ -5,6 +5,8 @@
 
 #include <fmt/core.h>
 
+#include "gpu/pipeline_cache.h"
+
 namespace obscura::gpu {
 namespace {
 vk::DescriptorType descriptorType(BindingKind kind) {
@@ -36,21 +38,9 @@ Kernel::Kernel(const Context& context, const KernelDesc& desc)
     : context_(&context), name_(desc.name), bindings_(desc.bindings), pushBytes_(desc.pushConstantBytes),
       spirv_(desc.spirv), specConstants_(desc.specConstants) {
   const auto& device = context.device();
-  std::vector<vk::DescriptorSetLayoutBinding> layoutBindings;
-  for (std::uint32_t i = 0; i < bindings_.size(); ++i)
-    layoutBindings.push_back({.binding = i,
-                              .descriptorType = descriptorType(bindings_[i]),
-                              .descriptorCount = 1,
-                              .stageFlags = vk::ShaderStageFlagBits::eCompute});
-  setLayout_ = device.createDescriptorSetLayout(
-      {.bindingCount = static_cast<std::uint32_t>(layoutBindings.size()), .pBindings = layoutBindings.data()});
-
-  vk::PushConstantRange range{.stageFlags = vk::ShaderStageFlagBits::eCompute, .offset = 0, .size = pushBytes_};
-  vk::DescriptorSetLayout rawLayout = *setLayout_;
-  pipelineLayout_ = device.createPipelineLayout({.setLayoutCount = 1,
-                                                 .pSetLayouts = &rawLayout,
-                                                 .pushConstantRangeCount = pushBytes_ ? 1u : 0u,
-                                                 .pPushConstantRanges = pushBytes_ ? &range : nullptr});
+  // The layouts and pipeline are the device's, shared with every kernel of the same shape.
+  shared_ = context.pipelines().find(spirv_, bindings_, pushBytes_, specConstants_);
+  vk::DescriptorSetLayout rawLayout = *shared_->setLayout;
 
   if (!desc.deferCompile) compile();
 
@@ -74,18 +64,13 @@ Kernel& Kernel::operator=(Kernel&& other) noexcept {
   if (this == &other) return *this;
   sets_.clear();
   pool_ = nullptr;
-  pipeline_ = nullptr;
-  pipelineLayout_ = nullptr;
-  setLayout_ = nullptr;
   context_ = other.context_;
   name_ = std::move(other.name_);
   bindings_ = std::move(other.bindings_);
   pushBytes_ = other.pushBytes_;
-  setLayout_ = std::move(other.setLayout_);
-  pipelineLayout_ = std::move(other.pipelineLayout_);
+  shared_ = std::move(other.shared_);
   spirv_ = other.spirv_;
   specConstants_ = std::move(other.specConstants_);
-  pipeline_ = std::move(other.pipeline_);
   pool_ = std::move(other.pool_);
   sets_ = std::move(other.sets_);
   return *this;
@@ -99,29 +84,8 @@ std::uint32_t Kernel::specConstant(std::uint32_t id) const {
 
 void Kernel::compile() const {
   if (compiled()) return;
-  const auto& device = context_->device();
-  vk::raii::ShaderModule module = device.createShaderModule(
-      {.codeSize = spirv_.size_bytes(), .pCode = spirv_.data()});
-  std::vector<vk::SpecializationMapEntry> entries;
-  std::vector<std::uint32_t> values;
-  for (std::size_t i = 0; i < specConstants_.size(); ++i) {
-    entries.push_back({.constantID = specConstants_[i].id,
-                       .offset = static_cast<std::uint32_t>(i * 4),
-                       .size = 4});
-    values.push_back(specConstants_[i].value);
-  }
-  vk::SpecializationInfo specialization{.mapEntryCount = static_cast<std::uint32_t>(entries.size()),
-                                        .pMapEntries = entries.data(),
-                                        .dataSize = values.size() * 4,
-                                        .pData = values.data()};
-  vk::ComputePipelineCreateInfo pipelineInfo{
-      .stage = {.stage = vk::ShaderStageFlagBits::eCompute,
-                .module = *module,
-                .pName = "main",
-                .pSpecializationInfo = entries.empty() ? nullptr : &specialization},
-      .layout = *pipelineLayout_};
-  pipeline_ = vk::raii::Pipeline(device, nullptr, pipelineInfo);
-  context_->setName(pipeline_, name_);
+  context_->pipelines().compile(*shared_, spirv_, specConstants_);
+  context_->setName(shared_->pipeline, name_);
 }
 
 const vk::raii::DescriptorSet& Kernel::descriptorSet(std::uint32_t set) const {
@@ -158,11 +122,11 @@ void Kernel::bind(std::uint32_t binding, const TexelBuffer& buffer, std::uint32_
 
 void Kernel::bindCommon(const vk::raii::CommandBuffer& cmd, const void* push, std::uint32_t set) const {
   compile();
-  cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_);
-  cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipelineLayout_, 0, {*descriptorSet(set)}, {});
+  cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *shared_->pipeline);
+  cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *shared_->layout, 0, {*descriptorSet(set)}, {});
   if (pushBytes_) {
     if (!push) throw std::logic_error(fmt::format("{}: push constants missing", name_));
-    cmd.pushConstants<std::uint8_t>(*pipelineLayout_, vk::ShaderStageFlagBits::eCompute, 0,
+    cmd.pushConstants<std::uint8_t>(*shared_->layout, vk::ShaderStageFlagBits::eCompute, 0,
                                     vk::ArrayProxy<const std::uint8_t>(pushBytes_, static_cast<const std::uint8_t*>(push)));
   }
 }

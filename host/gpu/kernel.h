@@ -2,6 +2,7 @@
 // constants. Each pass owns its Kernel(s); nothing is rebuilt per dispatch.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 
 #include "gpu/buffer.h"
 #include "gpu/context.h"
+#include "gpu/pipeline_cache.h"
 
 namespace obscura::gpu {
 
@@ -64,7 +66,7 @@ public:
 
   // Creates the pipeline now if its compile was deferred (KernelDesc::deferCompile).
   void compile() const;
-  bool compiled() const { return static_cast<bool>(*pipeline_); }
+  bool compiled() const { return static_cast<bool>(*shared_->pipeline); }
   // The value of specialisation constant `id` (0 where the kernel does not set it: the default
   // of every boolean specialisation constant here).
   std::uint32_t specConstant(std::uint32_t id) const;
@@ -80,12 +82,11 @@ private:
   std::string name_;
   std::vector<BindingKind> bindings_;
   std::uint32_t pushBytes_ = 0;
-  vk::raii::DescriptorSetLayout setLayout_ = nullptr;
-  vk::raii::PipelineLayout pipelineLayout_ = nullptr;
+  // Layouts and pipeline, the device's (gpu/pipeline_cache.h).
+  std::shared_ptr<SharedPipeline> shared_;
   // What a deferred compile needs: the shader (static, embedded) and its specialisation.
   std::span<const std::uint32_t> spirv_;
   std::vector<SpecConstant> specConstants_;
-  mutable vk::raii::Pipeline pipeline_ = nullptr;
   vk::raii::DescriptorPool pool_ = nullptr;
   std::vector<vk::raii::DescriptorSet> sets_;
 };

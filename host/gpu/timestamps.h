@@ -22,6 +22,12 @@ public:
   void reset(const vk::raii::CommandBuffer& cmd);
   void begin(const vk::raii::CommandBuffer& cmd, const std::string& label);
   void end(const vk::raii::CommandBuffer& cmd, const std::string& label);
+  // Records `work()` between begin(label) and end(label): the pair is written once, here.
+  template <class Work> void time(const vk::raii::CommandBuffer& cmd, const std::string& label, Work&& work) {
+    begin(cmd, label);
+    work();
+    end(cmd, label);
+  }
 
   // Reads the queries written since reset() and adds them to the running totals.
   void collect();

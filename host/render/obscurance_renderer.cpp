@@ -426,44 +426,42 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
   if ((primaryFlags & gpu::kPrimaryFlagGBufferOnly) == 0 && settings_.emissionSamples > 1)
     primaryFlags |= settings_.emissionSamples << gpu::kPrimaryEmissionSamplesShift;
   if (tracePrimary) {
-    timestamps_.begin(cmd, label("primary"));
-    for (std::uint32_t b = 0; b < bands; ++b)
+    recordBands(cmd, label("primary"), [&](std::uint32_t b) {
       primary_.record(cmd, b, layout, camera, {.index = settings_.firstSample + s, .first = settings_.firstSample},
                       settings_.seed, lightCount, primaryFlags, dirtyOf);
-    timestamps_.end(cmd, label("primary"));
+    });
     gpu::computeBarrier(cmd);
   }
   if (settings_.shadowSampling == ShadowSampling::PerLight) {
-    timestamps_.begin(cmd, label("shadow"));
-    for (std::uint32_t light = 0; light < lightCount; ++light) recordShadowForLight(cmd, push, light);
-    timestamps_.end(cmd, label("shadow"));
+    timestamps_.time(cmd, label("shadow"), [&] {
+      for (std::uint32_t light = 0; light < lightCount; ++light) recordShadowForLight(cmd, push, light);
+    });
   } else if (lights_.anySampled() && settings_.shadowRays > 0) {
-    timestamps_.begin(cmd, label("shadow"));
-    for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, layout, push, dirtyOf);
-    timestamps_.end(cmd, label("shadow"));
+    recordBands(cmd, label("shadow"), [&](std::uint32_t b) { shadow_.record(cmd, b, layout, push, dirtyOf); });
   }
   if (settings_.obscuranceRays > 0) {
-    timestamps_.begin(cmd, label("obscurance"));
-    for (std::uint32_t b = 0; b < bands; ++b) obscurance_.record(cmd, b, layout, push, dirtyOf);
-    timestamps_.end(cmd, label("obscurance"));
+    recordBands(cmd, label("obscurance"), [&](std::uint32_t b) { obscurance_.record(cmd, b, layout, push, dirtyOf); });
   }
   if (runSpecular_) {
     if (probe) gpu::computeBarrier(cmd); // the costly specular probe skips what the others found
-    timestamps_.begin(cmd, label("specular"));
-    if (settings_.shadowSampling == ShadowSampling::PerLight) {
-      // The ambient along the paths once, then every light alone along the same paths: each
-      // light's S_s is as independent of the others' powers as its D_s.
-      gpu::ShadePush ambientOnly = push;
-      ambientOnly.band.z |= gpu::kShadeFlagNoDirect;
-      for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, ambientOnly);
-      for (std::uint32_t light = 0; light < lightCount; ++light) {
-        gpu::computeBarrier(cmd);
-        for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, forLight(push, light));
+    timestamps_.time(cmd, label("specular"), [&] {
+      const auto specularBands = [&](const gpu::ShadePush& p) {
+        for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, p);
+      };
+      if (settings_.shadowSampling == ShadowSampling::PerLight) {
+        // The ambient along the paths once, then every light alone along the same paths: each
+        // light's S_s is as independent of the others' powers as its D_s.
+        gpu::ShadePush ambientOnly = push;
+        ambientOnly.band.z |= gpu::kShadeFlagNoDirect;
+        specularBands(ambientOnly);
+        for (std::uint32_t light = 0; light < lightCount; ++light) {
+          gpu::computeBarrier(cmd);
+          specularBands(forLight(push, light));
+        }
+      } else {
+        specularBands(push);
       }
-    } else {
-      for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, push);
-    }
-    timestamps_.end(cmd, label("specular"));
+    });
   }
 }
 
@@ -574,20 +572,20 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
   };
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
-    timestamps_.begin(cmd, "dirty");
-    for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.record(cmd, b, layout);
-    if (!probe) clear(cmd);
-    timestamps_.end(cmd, "dirty");
+    timestamps_.time(cmd, "dirty", [&] {
+      for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.record(cmd, b, layout);
+      if (!probe) clear(cmd);
+    });
   });
   timestamps_.collect();
   if (probe) {
     probeCandidates();
     stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
       timestamps_.reset(cmd);
-      timestamps_.begin(cmd, "dirty");
-      for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.recordList(cmd, b, layout);
-      clear(cmd);
-      timestamps_.end(cmd, "dirty");
+      timestamps_.time(cmd, "dirty", [&] {
+        for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.recordList(cmd, b, layout);
+        clear(cmd);
+      });
     });
     timestamps_.collect();
   }
@@ -666,15 +664,13 @@ void ObscuranceRenderer::compose(float exposureStops) {
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
-    timestamps_.begin(cmd, "compose");
-    for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+    recordBands(cmd, "compose", [&](std::uint32_t b) {
       compose_.record(cmd, b, layout, lightCount, ia, runSpecular_, frame_.contents().composedSlots);
-    timestamps_.end(cmd, "compose");
+    });
     gpu::computeBarrier(cmd);
-    timestamps_.begin(cmd, "tonemap");
-    for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+    recordBands(cmd, "tonemap", [&](std::uint32_t b) {
       tonemap_.record(cmd, b, layout, gpu::kComposeCombined, 3, exposureStops, frame_.contents().composedSlots);
-    timestamps_.end(cmd, "tonemap");
+    });
   });
   timestamps_.collect();
   wallSeconds_ += secondsSince(start);
@@ -691,16 +687,14 @@ void ObscuranceRenderer::composeDisplay(float exposureStops) {
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
     if (resolve || resolveDirty) {
-      timestamps_.begin(cmd, "resolve");
-      for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+      recordBands(cmd, "resolve", [&](std::uint32_t b) {
         resolve_.record(cmd, b, layout, lightCount, slots, runSpecular_, resolveDirty ? 0u : resolveFrom_,
                         resolveDirty || resolveAmbient_, resolveDirty);
-      timestamps_.end(cmd, "resolve");
+      });
       gpu::computeBarrier(cmd);
     }
-    timestamps_.begin(cmd, "lightmix");
-    for (std::uint32_t b = 0; b < layout.bandCount(); ++b) lightMix_.record(cmd, b, layout, lightCount, slots, ia, exposureStops);
-    timestamps_.end(cmd, "lightmix");
+    recordBands(cmd, "lightmix",
+                [&](std::uint32_t b) { lightMix_.record(cmd, b, layout, lightCount, slots, ia, exposureStops); });
   });
   timestamps_.collect();
   resolveFrom_ = lightCount;
@@ -900,24 +894,18 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
         const std::uint32_t s = order[k];
         if (k > first) gpu::computeBarrier(cmd);
         if (s != gbufferSample_) {
-          timestamps_.begin(cmd, "primary");
-          for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
+          recordBands(cmd, "primary", [&](std::uint32_t b) {
             primary_.record(cmd, b, layout, camera, {.index = settings_.firstSample + s, .first = settings_.firstSample},
                             settings_.seed, lightCount, gpu::kPrimaryFlagGBufferOnly);
-          timestamps_.end(cmd, "primary");
+          });
           gpu::computeBarrier(cmd);
           primaryPixels += layout.pixels();
         }
         gpu::ShadePush push = forLight(shadePush(s), light);
         push.band.z |= keptRaysFlag(s, true); // the specular paths by their kept hits
-        timestamps_.begin(cmd, "shadow");
-        for (std::uint32_t b = 0; b < layout.bandCount(); ++b) shadow_.record(cmd, b, layout, push);
-        timestamps_.end(cmd, "shadow");
-        if (runSpecular_) {
-          timestamps_.begin(cmd, "specular");
-          for (std::uint32_t b = 0; b < layout.bandCount(); ++b) specularPass_.record(cmd, b, layout, frame_, push);
-          timestamps_.end(cmd, "specular");
-        }
+        recordBands(cmd, "shadow", [&](std::uint32_t b) { shadow_.record(cmd, b, layout, push); });
+        if (runSpecular_)
+          recordBands(cmd, "specular", [&](std::uint32_t b) { specularPass_.record(cmd, b, layout, frame_, push); });
       }
     });
     timestamps_.collect();

@@ -272,6 +272,13 @@ private:
   // them after.
   void makeTracingPasses(const SceneSpecialisation& scene);
   void uploadLights();
+  // Records `record(band)` for every band of the frame, timed as one pass named `label`.
+  template <class Record>
+  void recordBands(const vk::raii::CommandBuffer& cmd, const std::string& label, Record&& record) {
+    timestamps_.time(cmd, label, [&] {
+      for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) record(b);
+    });
+  }
   // The Reached ambient model: what every light reaches in `scene`. After a geometry edit that
   // kept the lights, `changed` (the edited objects' old and new boxes) lets each light re-trace
   // only the rays the edit can change (ReachedSurfaces::remeasure: the same numbers).

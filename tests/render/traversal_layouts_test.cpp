@@ -59,7 +59,9 @@ TEST_F(TraversalLayouts, BinaryLayoutRendersTheWideLayoutsFramesBitForBit) {
     settings.camera = s.cameras.at(0);
     const ObscuranceResult wide = renderObscurances(context(), s, tree, settings);
     const bvh::Bvh splitTree = bvh::build(render::triangleSoup(s), render::treeOptionsFor(render::Traversal::Binary));
-    if (hall) EXPECT_GT(splitTree.stats.spatialSplits, 0u);
+    if (hall) {
+      EXPECT_GT(splitTree.stats.spatialSplits, 0u);
+    }
     for (const render::Traversal traversal : kBinaryTraversals) {
       if (hall && traversal != render::Traversal::BinaryWhileWhile) continue;
       ASSERT_EQ(render::SceneBuffers(contextFor(traversal), s, tree).traversal(), traversal);
