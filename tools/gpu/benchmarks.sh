@@ -3,7 +3,8 @@
 # frame speed) on whatever Vulkan device the bundle finds first by rank (a discrete GPU before a
 # CPU), in one run that fits a 15-minute device lease. BUNDLE_DIR comes from make_bundle.sh.
 # OUT_DIR gets log.txt (everything printed) and a few images and JSON files, at most 8 files.
-# "quick" shrinks every size so that the script itself can be tried on lavapipe first.
+# "quick" shrinks every size (and lets modern-hall stand in for Sponza) so that the script itself
+# can be tried on lavapipe first, as tests/scripts/gpu_benchmarks_smoke.sh does.
 #
 #   bench-rays, both scenes, with the device's own traversal and tree (render/scene/bvh_layout.h)
 #     and with each other traversal (--traversal): closest-hit and shadow rays per second (4M random
@@ -34,9 +35,14 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 tools=$(cd "$(dirname "$0")" && pwd)
-rays=4194304 verify=1000000 passes=800x600 hall=(800 600) sponza=(1920 1080) view=(1280 720) limit=${STEP_LIMIT:-150}
+rays=4194304 verify=1000000 check=100000 passes=800x600 hall=(800 600) sponza=(1920 1080) view=(1280 720)
+limit=${STEP_LIMIT:-150}
+hall_scene=$scenes/modern-hall/modern-hall.gltf sponza_scene=$scenes/sponza/sponza.gltf
 if [ "$quick" = quick ]; then
-  rays=65536 verify=65536 passes=80x60 hall=(80 60) sponza=(96 54) view=(64 36) limit=300
+  # Every step as the GPU runs it, but small: modern-hall stands in for Sponza (whose load and
+  # BVH build alone take 3 s a step on 2 cores).
+  rays=65536 verify=16384 check=16384 passes=80x60 hall=(80 60) sponza=(96 54) view=(64 36) limit=300
+  sponza_scene=$hall_scene
 fi
 
 step() { # name command...: runs it under a time limit, everything into log.txt
@@ -54,31 +60,30 @@ step() { # name command...: runs it under a time limit, everything into log.txt
   command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
   ldd "$obscura" | grep 'not found' && echo "LIBRARIES MISSING"
   step info "$obscura" info
-  hall_scene=$scenes/modern-hall/modern-hall.gltf sponza_scene=$scenes/sponza/sponza.gltf
-  step bench-hall "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify 100000 --passes "$passes"
-  step bench-hall-wide "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify 100000 \
+  step bench-hall "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify "$check" --passes "$passes"
+  step bench-hall-wide "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify "$check" \
     --passes "$passes" --traversal wide
-  step bench-hall-binary "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify 100000 \
+  step bench-hall-binary "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify "$check" \
     --traversal binary
   step bench-hall-no-splits "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --spatial-splits 0
   step bench-sponza "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$verify"
-  step bench-sponza-wide "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify 100000 \
+  step bench-sponza-wide "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$check" \
     --traversal wide
-  step bench-sponza-binary "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify 100000 \
+  step bench-sponza-binary "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$check" \
     --traversal binary
   step bench-sponza-no-splits "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --spatial-splits 0
   step bench-sponza-storage "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --bvh-items storage
   step bench-sponza-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --cull-on-pop
   # Several rays per invocation: the binary refilling loop (slower than one ray each on an H200).
   step bench-sponza-64x4 "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --traversal binary \
-    --trace-shape 64x4 --verify 100000
+    --trace-shape 64x4 --verify "$check"
   step render-hall "$obscura" render "$hall_scene" --width "${hall[0]}" \
     --height "${hall[1]}" --spp 8 -o "$out/modern-hall.png" --metrics "$out/modern-hall.metrics.json"
   step render-hall-wide "$obscura" render "$hall_scene" --width "${hall[0]}" \
     --height "${hall[1]}" --spp 8 -o "$work/modern-hall-wide.png" --metrics "$work/modern-hall-wide.metrics.json" \
     --traversal wide
   cat "$work/modern-hall-wide.metrics.json"; echo
-  step render-sponza "$obscura" render "$scenes/sponza/sponza.gltf" --width "${sponza[0]}" --height "${sponza[1]}" \
+  step render-sponza "$obscura" render "$sponza_scene" --width "${sponza[0]}" --height "${sponza[1]}" \
     --spp 8 --background 2,2,2 -o "$out/sponza.png" --metrics "$out/sponza.metrics.json"
   cat > "$work/edits.json" <<'JSON'
 [{"light": "light_rectangle_6", "scale": 0.3},
@@ -92,7 +97,7 @@ JSON
   step view-offscreen "$obscura" view "$hall_scene" --offscreen --width "${view[0]}" --height "${view[1]}" --spp 1 \
     --script "$tools/view_benchmark_script.json" --log "$out/view.jsonl" --screenshot "$out/view.png"
   python3 "$tools/../view_log_summary.py" "$out/view.jsonl"
-  step relight-hall "$obscura" relight "$scenes/modern-hall/modern-hall.gltf" --edits "$work/edits.json" \
+  step relight-hall "$obscura" relight "$hall_scene" --edits "$work/edits.json" \
     -o "$work/relight" --width "${hall[0]}" --height "${hall[1]}" --spp 1 --png
   cat "$work/relight/edits.jsonl"
   cp "$work/relight/frame-006.png" "$out/relight-last-frame.png"
