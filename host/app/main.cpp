@@ -7,19 +7,7 @@
 
 #include "app/commands.h"
 #include "core/error.h"
-#include "render/scene/bvh_layout.h"
 
-namespace obscura::app {
-void addDeviceOptions(CLI::App& command, DeviceOptions& options) {
-  command.add_option("--device", options.device, "Vulkan device: index or part of its name (see 'obscura info')");
-  command.add_flag("--validate", options.validate, "enable the Khronos validation layer");
-  command.add_option("--traversal", options.traversal,
-                     fmt::format("BVH layout and traversal loop: {} (default auto: wide on a CPU device such as "
-                                 "lavapipe, binary-while-while on a GPU)",
-                                 render::kTraversalNames))
-      ->check(CLI::IsMember({"auto", "wide", "binary", "binary-while-while"}));
-}
-} // namespace obscura::app
 
 int main(int argc, char** argv) {
   CLI::App app{"obscura: ray-traced obscurances and interactive relighting (Vulkan compute)"};

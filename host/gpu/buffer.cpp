@@ -1,6 +1,5 @@
 #include "gpu/buffer.h"
 
-#include <atomic>
 #include <cstring>
 
 #include <fmt/core.h>
@@ -9,13 +8,9 @@
 
 namespace obscura::gpu {
 namespace {
-std::atomic<std::uint64_t> gAllocatedBytes{0};
-
 constexpr vk::BufferUsageFlags kTransfer =
     vk::BufferUsageFlagBits::eTransferSrc | vk::BufferUsageFlagBits::eTransferDst;
 } // namespace
-
-std::uint64_t allocatedDeviceBytes() { return gAllocatedBytes.load(); }
 
 Buffer::Buffer(const Context& context, vk::DeviceSize size, vk::BufferUsageFlags usage,
                const std::string& name, Residence residence)
@@ -43,7 +38,6 @@ Buffer::Buffer(const Context& context, vk::DeviceSize size, vk::BufferUsageFlags
       mapped_ = memory_.mapMemory(0, VK_WHOLE_SIZE);
       hostCached_ = bool(flags & vk::MemoryPropertyFlagBits::eHostCached);
     }
-    gAllocatedBytes += requirements.size;
   } catch (const vk::OutOfDeviceMemoryError&) {
     throw DeviceError(fmt::format("out of device memory: buffer '{}' needs {:.1f} MiB", name,
                                   static_cast<double>(size) / (1024.0 * 1024.0)));

@@ -97,8 +97,4 @@ Buffer uploadArray(const Context& context, const std::vector<T>& data, const std
   return buffer;
 }
 
-// Bytes of device memory allocated through Buffer so far in this process (cumulative), for the
-// metrics.
-std::uint64_t allocatedDeviceBytes();
-
 } // namespace obscura::gpu

@@ -79,7 +79,6 @@ public:
                                vk::MemoryPropertyFlags preferred = {}) const;
   vk::MemoryPropertyFlags memoryTypeFlags(std::uint32_t type) const;
 
-  bool validationEnabled() const { return validation_; }
   // The compute pipelines made on this device, shared by kernels of the same shape
   // (gpu/pipeline_cache.h).
   PipelineCache& pipelines() const { return *pipelines_; }

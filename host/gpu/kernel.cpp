@@ -8,7 +8,6 @@
 #include "gpu/pipeline_cache.h"
 
 namespace obscura::gpu {
-namespace {
 vk::DescriptorType descriptorType(BindingKind kind) {
   switch (kind) {
   case BindingKind::StorageBuffer: return vk::DescriptorType::eStorageBuffer;
@@ -17,7 +16,6 @@ vk::DescriptorType descriptorType(BindingKind kind) {
   }
   return vk::DescriptorType::eStorageBuffer;
 }
-} // namespace
 
 KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
                              std::uint32_t pushConstantBytes, std::uint32_t setCount) {

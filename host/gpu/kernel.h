@@ -16,6 +16,7 @@
 namespace obscura::gpu {
 
 enum class BindingKind { StorageBuffer, UniformTexelBuffer, StorageTexelBuffer };
+vk::DescriptorType descriptorType(BindingKind kind);
 
 struct SpecConstant {
   std::uint32_t id;

@@ -10,15 +10,6 @@
 namespace obscura::gpu {
 namespace {
 
-vk::DescriptorType descriptorType(BindingKind kind) {
-  switch (kind) {
-  case BindingKind::StorageBuffer: return vk::DescriptorType::eStorageBuffer;
-  case BindingKind::UniformTexelBuffer: return vk::DescriptorType::eUniformTexelBuffer;
-  case BindingKind::StorageTexelBuffer: return vk::DescriptorType::eStorageTexelBuffer;
-  }
-  return vk::DescriptorType::eStorageBuffer;
-}
-
 // The shader by its words' hash and length (embedded arrays; a 64-bit hash, so two shaders of the
 // same length that collide are out of reach), then everything else that shapes the pipeline.
 std::string keyOf(std::span<const std::uint32_t> spirv, const std::vector<BindingKind>& bindings,

@@ -1,17 +1,22 @@
 // obscurance_renderer.h — ray-traced obscurances [RTO] as a renderer that lives across frames.
 //
 // Made once per scene and view; it holds resources by lifetime:
-//   scene  SceneBuffers (geometry, BVH, materials, textures), the light set and its GPU buffers
-//   frame  ObscuranceFrame (G-buffer, basis buffers D_s and M_s per light, ambient A, specular
-//          buffers, queue, composed AOVs, display bytes, ray counters), split into bands
-//   pass   one small class per pass owning its kernel: primary, shadow, obscurance, specular,
-//          compose, tonemap
-// and offers what a frame loop needs: reset(), iterate(n), compose(), image(), plus edits.
+//   scene  SceneBuffers (geometry, BVH, materials, textures), the light set and its GPU buffers,
+//          the ambient term (what each light reaches, for I_a)
+//   frame  ObscuranceFrame (G-buffer, basis sums D_s, M_s, S_s per light, ambient sums A, the
+//          specular paths and queue, kept rays, composed AOVs, resolved transport, display bytes,
+//          ray counters), split into bands
+//   pass   one small class per pass owning its kernel (render/passes/): primary, shadow,
+//          obscurance, specular, dirty (geometry edits), compose, tonemap, resolve, light mix
+// and offers what a frame loop needs: reset(), iterate(n), compose() / composeDisplay(), image(),
+// plus the edits an EditSession (session/edit_session.h) drives: lights added and removed,
+// emissions, geometry replaced with only the pixels it can change retraced.
 //
 //   iterate: primary.comp -> G-buffer -> shadow.comp     -> D_s (per light, unit E_s)
 //                                     -> obscurance.comp -> A, W
-//                                     -> specular passes -> D_s, A along specular paths
-//   compose: C = sum_s E_s (D_s + M_s) + I_a(E) A  [SPEC §3] — a light edit reruns this alone.
+//                                     -> specular passes -> S_s, A^spec along specular paths
+//   compose: C = sum_s E_s (D_s + M_s + S_s) + I_a(E) (A + A^spec)  [SPEC §3] — a light edit
+//            reruns this alone (composeDisplay: resolve once, then the light mix).
 #pragma once
 #include <cstdint>
 #include <future>

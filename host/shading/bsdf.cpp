@@ -55,11 +55,6 @@ float triangleArea(glm::vec3 v0, glm::vec3 v1, glm::vec3 v2) {
   return 0.5f * glm::length(glm::cross(v1 - v0, v2 - v0));
 }
 
-glm::vec3 sampleUniformTriangle(glm::vec2 u, glm::vec3 v0, glm::vec3 v1, glm::vec3 v2) {
-  float r = std::sqrt(u.x);
-  return (1.0f - r) * v0 + (r * (1.0f - u.y)) * v1 + (r * u.y) * v2;
-}
-
 float sphericalTriangleArea(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
   return 2.0f * std::atan2(std::abs(glm::dot(a, glm::cross(b, c))), 1.0f + glm::dot(a, b) + glm::dot(b, c) + glm::dot(c, a));
 }

@@ -5,7 +5,7 @@
 // tests can compare the GPU with it and the host can use the same model (light power, R_ave).
 // The model, the frame convention (local, z = shading normal, wo and wi pointing away, wo.z > 0:
 // callers flip for two-sided reflection) and the citations are documented in the GLSL files;
-// tests/shaders/sampling_test.cpp, tests/shaders/bsdf_test.cpp and host/render/bsdf_test.cpp check
+// tests/shaders/sampling_test.cpp, tests/shaders/bsdf_test.cpp and host/shading/bsdf_test.cpp check
 // them.
 #pragma once
 #include <cstdint>
@@ -42,9 +42,8 @@ glm::vec2 invertCosineHemisphereSample(glm::vec3 w);
 glm::uvec2 systematicGrid(std::uint32_t n);
 glm::vec3 sampleSystematic(std::uint32_t i, glm::uvec2 grid, glm::vec2 offset);
 
-// Area-uniform point (Osada et al., "Shape Distributions", 2002); pdf = 1 / triangleArea.
+// A triangle's area (the pdf of lib/sampling.glsl's area-uniform point is its inverse).
 float triangleArea(glm::vec3 v0, glm::vec3 v1, glm::vec3 v2);
-glm::vec3 sampleUniformTriangle(glm::vec2 u, glm::vec3 v0, glm::vec3 v1, glm::vec3 v2);
 
 // Spherical triangles seen from a point (a, b, c: unit directions to the vertices): the solid
 // angle (Van Oosterom & Strackee 1983) and a direction uniform in it (Arvo 1995), pdf 1 / area.
