@@ -29,8 +29,6 @@ nlohmann::json EditReport::json() const {
                          {"gpu_ms", gpuMs},
                          {"host_ms", hostMs()},
                          {"total_ms", totalMs}};
-  if (line["rays"].is_null()) line["rays"] = nlohmann::json::object();
-  if (line["gpu_ms"].is_null()) line["gpu_ms"] = nlohmann::json::object();
   if (bvh) line["bvh"] = {{"kind", bvh->refit ? "refit" : "rebuild"}, {"ms", bvh->ms}};
   if (reach) line["reach"] = {{"rays", reach->rays}, {"ms", reach->ms}};
   return line;
