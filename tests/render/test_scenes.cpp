@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <string_view>
 #include <thread>
 
 #include "bvh/wide_node.h"
@@ -103,7 +107,28 @@ scene::Scene soupScene(const bvh::TriangleSoup& soup) {
   return s;
 }
 
+namespace {
+
+template <typename T> std::size_t hashOfBytes(const std::vector<T>& values) {
+  return std::hash<std::string_view>{}(
+      std::string_view(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)));
+}
+
+} // namespace
+
 std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vector<gpu::GpuRay>& rays) {
+  // The oracle's answers by their question. A suite runs in one process (CTest runs suites) and
+  // traces the same soup and rays through several layouts, loops and trace shapes; the brute
+  // force, not the GPU, is most of its time. Keyed by the contents (four 64-bit hashes and the
+  // sizes), so a different soup or ray set is always computed afresh.
+  static std::mutex mutex;
+  static std::map<std::array<std::size_t, 6>, std::vector<bvh::Hit>> answers;
+  const std::array<std::size_t, 6> key{hashOfBytes(soup.v0), hashOfBytes(soup.v1), hashOfBytes(soup.v2),
+                                       hashOfBytes(rays), soup.size(), rays.size()};
+  {
+    std::lock_guard lock(mutex);
+    if (auto found = answers.find(key); found != answers.end()) return found->second;
+  }
   std::vector<bvh::Hit> out(rays.size());
   unsigned threads = std::max(1u, std::thread::hardware_concurrency());
   std::vector<std::thread> pool;
@@ -115,6 +140,8 @@ std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vecto
       }
     });
   for (auto& t : pool) t.join();
+  std::lock_guard lock(mutex);
+  answers.emplace(key, out);
   return out;
 }
 
