@@ -28,8 +28,7 @@ gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::
                             {gpu::kSpecConstantBvhItemsFromStorage, shape.bvhItemsFromStorage ? 1u : 0u},
                             {gpu::kSpecConstantBvhLayout, bvhLayoutOf(traversal)},
                             {gpu::kSpecConstantBinaryLoop, binaryWhileWhile(traversal) ? 1u : 0u},
-                            {gpu::kSpecConstantBinaryCullOnPop, shape.binaryCullOnPop ? 1u : 0u}},
-          .deferCompile = recordSteps};
+                            {gpu::kSpecConstantBinaryCullOnPop, shape.binaryCullOnPop ? 1u : 0u}}};
 }
 } // namespace
 

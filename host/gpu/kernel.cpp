@@ -40,8 +40,6 @@ Kernel::Kernel(const Context& context, const KernelDesc& desc)
   shared_ = context.pipelines().find(spirv_, bindings_, pushBytes_, specConstants_);
   vk::DescriptorSetLayout rawLayout = *shared_->setLayout;
 
-  if (!desc.deferCompile) compile();
-
   const std::uint32_t setCount = std::max(desc.setCount, 1u);
   std::vector<vk::DescriptorPoolSize> sizes;
   for (auto kind : {BindingKind::StorageBuffer, BindingKind::UniformTexelBuffer, BindingKind::StorageTexelBuffer}) {

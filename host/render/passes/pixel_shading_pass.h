@@ -52,7 +52,7 @@ public:
     if (probeReplay_) bindShadingInputs(*probeReplay_, band, in);
   }
 
-  // Compiles now the kernels only edits dispatch (deferred: KernelDesc::deferCompile): the probe
+  // Compiles now the kernels only edits dispatch (else compiled at their first dispatch): the probe
   // that tests the kept rays where the frame keeps them (`keptRays`), else the one that draws them.
   void compileEditKernels(bool keptRays) const {
     (keptRays && probeReplay_ ? *probeReplay_ : probe_).compile();

@@ -32,7 +32,7 @@ gpu::KernelDesc primaryKernelDesc(std::uint32_t bands, std::uint32_t v, const Sc
                        .specConstants = {{gpu::kSpecConstantPrimaryAovs, v & 1u},
                                          {gpu::kSpecConstantEmissionRays, (v >> 1) & 1u},
                                          {gpu::kSpecConstantPrimaryHitBounds, hitBounds ? 1u : 0u}},
-                       .setCount = bands, .deferCompile = true};
+                       .setCount = bands};
   scene.addTo(desc);
   return desc;
 }

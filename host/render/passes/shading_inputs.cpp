@@ -26,7 +26,6 @@ gpu::KernelDesc shadingKernelDesc(const char* name, std::span<const std::uint32_
 gpu::KernelDesc probingKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
   gpu::KernelDesc desc = shadingKernelDesc(name, spirv, s);
   desc.name += ".probe";
-  desc.deferCompile = true; // edits only
   desc.specConstants.push_back({.id = gpu::kSpecConstantProbe, .value = 1u});
   return desc;
 }
@@ -41,7 +40,6 @@ gpu::KernelDesc reflectorKernelDesc(const char* name, std::span<const std::uint3
 gpu::KernelDesc greyObscuranceKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
   gpu::KernelDesc desc = shadingKernelDesc(name, spirv, s);
   desc.name += ".grey";
-  desc.deferCompile = true; // renders without colour bleeding only
   desc.specConstants.push_back({.id = gpu::kSpecConstantGreyObscurance, .value = 1u});
   return desc;
 }
@@ -49,14 +47,12 @@ gpu::KernelDesc greyObscuranceKernelDesc(const char* name, std::span<const std::
 gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32_t> spirv, const ShadingSpecialisation& s) {
   gpu::KernelDesc desc = shadingKernelDesc(name, spirv, s);
   desc.name += ".perlight";
-  desc.deferCompile = true; // added lights only (and per-light shadow sampling)
   desc.specConstants.push_back({.id = gpu::kSpecConstantPerLight, .value = 1u});
   return desc;
 }
 
 gpu::KernelDesc replayingKeptRaysKernelDesc(gpu::KernelDesc desc) {
   desc.name += ".replay";
-  desc.deferCompile = true;
   desc.specConstants.push_back({.id = gpu::kSpecConstantReplayRays, .value = 1u});
   return desc;
 }

@@ -12,7 +12,7 @@ public:
   SpecularPass(const gpu::Context& context, const ShadingSpecialisation& s);
 
   void bind(std::uint32_t band, const ShadingInputs& in);
-  // Compiles now the kernels only edits dispatch (deferred: KernelDesc::deferCompile): those
+  // Compiles now the kernels only edits dispatch (else compiled at their first dispatch): those
   // that replay the kept lobe hits where the frame keeps them, else those that trace.
   void compileEditKernels(bool keptHits) const {
     (keptHits ? probeReplay_ : probe_).compile();
