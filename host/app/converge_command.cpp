@@ -33,6 +33,7 @@
 #include "analysis/convergence.h"
 #include "analysis/image_error.h"
 #include "render/denoise/denoiser.h"
+#include "render/method.h"
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
 
@@ -219,7 +220,8 @@ public:
                                     theirs.dump(), ours.dump()));
     };
     if (!job.is_object() || !job.contains("method")) throw InputError(fmt::format("{}: its job description is malformed", file));
-    if (job.at("method") != "pathtrace") throw mismatch("method", job.at("method"), "pathtrace");
+    const std::string pathTrace = nameString(render::kMethodNames, render::Method::PathTrace);
+    if (job.at("method") != pathTrace) throw mismatch("method", job.at("method"), pathTrace);
     if (job.at("scene") != farm::sceneHash(o_.scenePath)) throw mismatch("scene", job.at("scene"), o_.scenePath);
     if (job.at("width") != width_ || job.at("height") != height_)
       throw mismatch("size", {job.at("width"), job.at("height")}, {width_, height_});
@@ -244,7 +246,7 @@ public:
                                           "emission_samples={} light_sampling={}{}{}",
                                           o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
                                           m.pathTrace ? o_.pathEmissionSamples : o_.emissionSamples,
-                                          m.lightSampling == render::LightSampling::Area ? "area" : "spatial",
+                                          nameOf(render::kLightSamplingNames, m.lightSampling),
                                           m.pathTrace ? "" : fmt::format(" ambient=seen+reached+global dmax={} secondary_reflectors={}",
                                                                          o_.dMax, m.secondaryReflectors),
                                           o_.background.empty() ? "" : fmt::format(" background={}", fmt::join(o_.background, ",")));

@@ -57,7 +57,7 @@ void printScene(const InfoOptions& o) {
     const auto& e = lights.emission[i];
     const std::size_t triangles = i < s.lightGroups.size() ? s.lightGroups[i].triangles.size() : 0;
     fmt::print("  {:<28} {:<11} E ({:.4g}, {:.4g}, {:.4g})  power {:.4g}{}\n", lights.names[i],
-               relight::lightTypeName(lights.lights[i].info.x), e.x, e.y, e.z, lights.power[i],
+               nameOf(render::kLightTypeNames, lights.type(i)), e.x, e.y, e.z, lights.power[i],
                triangles ? fmt::format("  ({} triangles)", triangles) : std::string());
   }
   fmt::print("objects ({}; names for move, remove):\n", s.objects.size());

@@ -55,9 +55,9 @@ void runMerge(const MergeOptions& o) {
                                  files.size(), missingList(merged)));
   const std::string stateDir = stateOnly ? o.output : o.saveState;
   if (!stateDir.empty()) {
-    if (merged.method() != "obscurance")
+    if (merged.method() != render::Method::Obscurance)
       throw InputError(fmt::format("{}: a relighting state needs parts of --method obscurance (these are {})", stateDir,
-                                   merged.method()));
+                                   nameOf(render::kMethodNames, merged.method())));
     if (!merged.missing.empty())
       throw InputError(fmt::format("{}: a relighting state needs every part (missing:{})", stateDir, missingList(merged)));
   }
@@ -80,7 +80,7 @@ void runMerge(const MergeOptions& o) {
   fmt::print(stderr, "merge: {} part(s), {:.1f} MiB, {}x{} {} {} spp{}; parts {:.1f} ms GPU, {:.2f} s wall; merged in "
                      "{:.2f} s -> {}{}\n",
              files.size(), static_cast<double>(bytes) / 1048576.0, merged.sums.width, merged.sums.height,
-             merged.method(), merged.spp(), merged.missing.empty() ? "" : " (PREVIEW: parts missing)",
+             nameOf(render::kMethodNames, merged.method()), merged.spp(), merged.missing.empty() ? "" : " (PREVIEW: parts missing)",
              merged.partGpuMs, merged.partWallSeconds, seconds, stateOnly ? stateDir : o.output,
              !stateOnly && !stateDir.empty() ? " and " + stateDir : "");
   if (!merged.missing.empty()) fmt::print(stderr, "merge: missing:{}\n", missingList(merged));

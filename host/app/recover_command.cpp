@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/named_option.h"
 #include "app/render_options.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
@@ -32,8 +33,6 @@ namespace fs = std::filesystem;
 struct RecoverOptions {
   std::string scene, photos, output;
   int camera = -1;
-  std::string indirect = "gather";
-  std::string ambient = "reached";
   bool noMin = false, noLowerSmoothing = false, noOutlier = false, noFinalSmoothing = false;
   bool debug = false, png = false;
   std::string truth; // an answer key (synthetic photographs): accuracy in recover.json
@@ -141,7 +140,7 @@ void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const rec
                            {"photos", photos.shots.size()},
                                  {"width", r.width},
                                  {"height", r.height},
-                                 {"indirect", o.indirect},
+                                 {"indirect", nameString(recover::kIndirectModelNames, o.recovery.indirect)},
                                  {"surface_pixels", surface},
                                  {"filled_from_visibility", r.filledFromVisibility},
                                  {"filled_from_object_mean", r.filledFromObject},
@@ -155,10 +154,6 @@ void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const rec
 
 void runRecover(RecoverOptions& o) {
   recover::RecoveryOptions& rec = o.recovery;
-  rec.indirect = o.indirect == "constant"     ? recover::IndirectModel::Constant
-                 : o.indirect == "obscurance" ? recover::IndirectModel::Obscurance
-                                              : recover::IndirectModel::Gather;
-  rec.ambient = o.ambient == "global" ? render::AmbientModel::Global : render::AmbientModel::Reached;
   rec.filters.minFilter = !o.noMin;
   rec.filters.lowerSmoothing = !o.noLowerSmoothing;
   rec.filters.outlier = !o.noOutlier;
@@ -220,10 +215,9 @@ void addRecoverCommand(CLI::App& app) {
   cmd->add_option("--obs-rays", o->recovery.obscuranceRays, "obscurance rays per sample")->check(CLI::Range(1u, 256u));
   cmd->add_option("--seed", o->recovery.seed, "random seed");
   cmd->add_option("--dmax", o->recovery.dMax, "obscurance distance (0: the renderer's default)");
-  cmd->add_option("--indirect", o->indirect,
-                  "the indirect light B: gather (from the photographs, iterated), obscurance (the obscurance term with "
-                  "the estimate, iterated) or constant (the paper's ambient)")
-      ->check(CLI::IsMember({"gather", "obscurance", "constant"}));
+  addNamedOption(*cmd, "--indirect", o->recovery.indirect, recover::kIndirectModelNames,
+                 "the indirect light B: gather (from the photographs, iterated), obscurance (the obscurance term with "
+                 "the estimate, iterated) or constant (the paper's ambient)");
   cmd->add_option("--iterations", o->recovery.iterations, "estimates after the constant start (gather, obscurance)")
       ->check(CLI::Range(1u, 50u));
   cmd->add_option("--gather-rays", o->recovery.gatherRays, "gather: rays per pixel")->check(CLI::Range(1u, 4096u));
@@ -232,7 +226,7 @@ void addRecoverCommand(CLI::App& app) {
       ->check(CLI::Range(0, 32));
   cmd->add_option("--ambient-reflectance", o->recovery.constantReflectance,
                   "k of the constant ambient B = k x mean photo colour");
-  cmd->add_option("--ambient", o->ambient, "I_a model: reached or global")->check(CLI::IsMember({"reached", "global"}));
+  addNamedOption(*cmd, "--ambient", o->recovery.ambient, recover::kRecoveryAmbientNames, "I_a model: reached or global");
   cmd->add_option("--eps1", o->recovery.filters.outlierConfidence, "outlier test: confidence a photo needs to vote")
       ->check(CLI::Range(0.0f, 1.0f));
   cmd->add_option("--eps2", o->recovery.filters.outlierDistance, "outlier test: distance from the median that rejects")

@@ -105,14 +105,14 @@ void relightState(const RelightOptions& o) {
 
 void relightScene(RelightOptions& o) {
   if (o.edits.empty()) throw InputError(fmt::format("{}: relighting a scene needs --edits edits.json", o.input));
-  if (o.render.method != "obscurance")
+  if (o.render.method != render::Method::Obscurance)
     throw InputError("--method: relighting keeps per-light transport, which only the obscurance method has");
   checkRenderOptions(o.render);
   LoadedScene loaded = loadScene(o.input, o.render.lightGroups, std::nullopt);
   applyBackground(o.render, loaded);
   const render::LightSet sceneLights = render::buildLightSet(loaded.scene);
   std::vector<bool> area;
-  for (const auto& l : sceneLights.lights) area.push_back(l.info.x == gpu::kLightArea);
+  for (std::size_t i = 0; i < sceneLights.lights.size(); ++i) area.push_back(sceneLights.type(i) == render::LightType::Area);
   std::vector<std::string> objectNames;
   for (const auto& obj : loaded.scene.objects) objectNames.push_back(obj.name);
   const std::vector<relight::Edit> edits = relight::readEdits(o.edits, sceneLights.names, area, objectNames);

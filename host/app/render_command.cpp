@@ -118,11 +118,11 @@ void runRender(RenderOptions& o) {
   std::string ext = io::extensionOf(o.output);
   if (ext != "exr" && ext != "png")
     throw InputError(fmt::format("{}: the output must be .exr or .png", o.output));
-  if (o.denoise && o.method == "pathtrace")
+  if (o.denoise && o.method == render::Method::PathTrace)
     throw InputError("--denoise with --method pathtrace: the denoiser filters the obscurance method's direct and "
                      "ambient terms divided by the albedo, which path tracing does not keep; use --method obscurance");
   static const std::vector<std::string> pathAovs = {"combined"};
-  std::vector<std::string> known = o.method == "pathtrace" ? pathAovs : render::obscuranceAovNames();
+  std::vector<std::string> known = o.method == render::Method::PathTrace ? pathAovs : render::obscuranceAovNames();
   if (o.denoise) known.push_back("denoised");
   for (const auto& aov : o.aovs)
     if (std::find(known.begin(), known.end(), aov) == known.end())
@@ -150,7 +150,7 @@ void runRender(RenderOptions& o) {
   const render::ProgressFn progress =
       tty ? render::ProgressFn([&](auto d, auto t, auto s) { printProgress(d, t, s, raysPerSample); })
           : render::ProgressFn();
-  if (o.method == "pathtrace") {
+  if (o.method == render::Method::PathTrace) {
     if (!o.saveState.empty())
       throw InputError("--save-state: only the obscurance method keeps per-light transport (--method obscurance)");
     render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
@@ -160,7 +160,7 @@ void runRender(RenderOptions& o) {
     render::PathTracer tracer(context, loaded.scene, loaded.bvh, pt);
     tracer.render(progress);
     writeOutputs(o, tracer.image(), tracer.stats(), context, loaded,
-                 {{"method", "pathtrace"}, {"max_depth", pt.maxDepth}, {"emission_samples", pt.emissionSamples}});
+                 {{"method", nameString(render::kMethodNames, o.method)}, {"max_depth", pt.maxDepth}, {"emission_samples", pt.emissionSamples}});
     return;
   }
   // Only what the output shows is kept: a PNG of combined needs neither the primary AOVs nor the
@@ -207,10 +207,13 @@ void runRender(RenderOptions& o) {
   fmt::print(stderr, "obscurance: dmax {:.4g}, rho {}, {} sampling, {}; R_ave ({:.4f}, {:.4f}, {:.4f}), "
                      "I_a ({:.4g}, {:.4g}, {:.4g}) from {} (the paper's whole-scene formula: ({:.4g}, {:.4g}, {:.4g})); "
                      "{} lights; frame in {} band(s)\n",
-             renderer.dMax(), o.rho, o.sampling, o.noBleed ? "grey" : "colour bleeding", rAve.x, rAve.y, rAve.z,
-             ia.x, ia.y, ia.z, o.ambient == "global" ? "the whole scene"
-             : o.ambient == "seen" ? "the surfaces the lights reach, first bounce fitted to the camera's view"
-                                   : "the surfaces the lights reach",
+             renderer.dMax(), nameOf(render::kRhoKindNames, settings.rho),
+             nameOf(render::kObscuranceSamplingNames, settings.systematic), o.noBleed ? "grey" : "colour bleeding",
+             rAve.x, rAve.y, rAve.z, ia.x, ia.y, ia.z,
+             settings.ambient == render::AmbientModel::Global ? "the whole scene"
+             : settings.ambient == render::AmbientModel::Seen
+                 ? "the surfaces the lights reach, first bounce fitted to the camera's view"
+                 : "the surfaces the lights reach",
              iaGlobal.x, iaGlobal.y, iaGlobal.z, renderer.lights().size(), renderer.layout().bandCount());
   if (settings.secondaryReflectors > 0.0f)
     fmt::print(stderr, "secondary reflectors: {} of {} triangles marked (threshold {:g} x each light's mean direct "
@@ -220,10 +223,13 @@ void runRender(RenderOptions& o) {
     fmt::print(stderr, "note: the average reflectance reaches 1; it was clamped to 0.999 (I_a would be infinite)\n");
   if (!o.saveState.empty()) relight::saveState(o.saveState, renderer, o.scenePath);
   writeOutputs(o, image, stats, context, loaded,
-               {{"method", o.method}, {"dmax", renderer.dMax()}, {"rho", o.rho}, {"tau", settings.tau},
-                {"sampling", o.sampling}, {"colour_bleeding", !o.noBleed}, {"max_depth", settings.maxDepth},
-                {"vertex_rays", o.vertexRays},
-                {"light_sampling", o.lightSampling}, {"ambient", o.ambient},
+               {{"method", nameString(render::kMethodNames, o.method)}, {"dmax", renderer.dMax()},
+                {"rho", nameString(render::kRhoKindNames, settings.rho)}, {"tau", settings.tau},
+                {"sampling", nameString(render::kObscuranceSamplingNames, settings.systematic)},
+                {"colour_bleeding", !o.noBleed}, {"max_depth", settings.maxDepth},
+                {"vertex_rays", nameString(render::kVertexRaysNames, settings.vertexRaysByThroughput)},
+                {"light_sampling", nameString(render::kLightSamplingNames, settings.lightSampling)},
+                {"ambient", nameString(render::kAmbientModelNames, settings.ambient)},
                 {"secondary_reflectors", settings.secondaryReflectors},
                 {"secondary_reflector_triangles", renderer.secondaryReflectors()},
                 {"i_a", {ia.x, ia.y, ia.z}}, {"i_a_global", {iaGlobal.x, iaGlobal.y, iaGlobal.z}},

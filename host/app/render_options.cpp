@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "app/named_option.h"
 #include "core/error.h"
 
 namespace obscura::app {
@@ -43,8 +44,8 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--seed", o.seed, "random seed (same seed, same image)");
   cmd.add_option("--camera", o.camera, "index of the glTF camera to use (default: the first)")
       ->check(CLI::NonNegativeNumber);
-  cmd.add_option("--method", o.method, "obscurance (ray-traced obscurances) or pathtrace (the reference)")
-      ->check(CLI::IsMember({"obscurance", "pathtrace"}));
+  addNamedOption(cmd, "--method", o.method, render::kMethodNames,
+                 "obscurance (ray-traced obscurances) or pathtrace (the reference)");
   cmd.add_option("--max-depth", o.obscurance.maxDepth,
                   "path depth in scattering vertices (specular paths; path tracing), default 6")
       ->check(CLI::Range(1u, 1024u));
@@ -52,38 +53,33 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
       ->check(CLI::Range(0u, 1024u));
   cmd.add_option("--obs-rays", o.obscurance.obscuranceRays, "obscurance rays per hit (N_obs)")
       ->check(CLI::Range(0u, 1024u));
-  cmd.add_option("--vertex-rays", o.vertexRays,
+  addNamedOption(cmd, "--vertex-rays", o.obscurance.vertexRaysByThroughput, render::kVertexRaysNames,
                  "shadow and obscurance rays at a specular path's vertices: throughput (default: N_s and N_obs scaled "
                  "by the path's throughput there, at least one each; the same mean for fewer rays) or per-hit (N_s and "
-                 "N_obs at every vertex)")
-      ->check(CLI::IsMember({"throughput", "per-hit"}));
-  cmd.add_option("--rho", o.rho, "rho(d): sqrt (the paper's), exp, ao")->check(CLI::IsMember({"sqrt", "exp", "ao"}));
+                 "N_obs at every vertex)");
+  addNamedOption(cmd, "--rho", o.obscurance.rho, render::kRhoKindNames, "rho(d): sqrt (the paper's), exp, ao");
   cmd.add_option("--tau", o.obscurance.tau, "tau of --rho exp")->check(CLI::PositiveNumber);
   cmd.add_option("--dmax", o.dMax, "dmax in scene units (default: half the median distance between the surfaces the camera sees and "
                  "the next ones; 'obscura info' prints it)")
       ->each([&o](const std::string&) { o.dMaxGiven = true; });
-  cmd.add_option("--sampling", o.sampling, "obscurance rays: systematic (default) or random")
-      ->check(CLI::IsMember({"systematic", "random"}));
+  addNamedOption(cmd, "--sampling", o.obscurance.systematic, render::kObscuranceSamplingNames,
+                 "obscurance rays: systematic (default) or random");
   cmd.add_flag("--no-bleed", o.noBleed, "grey obscurance W instead of colour bleeding W_c");
-  cmd.add_option("--shadow-sampling", o.shadowSampling,
+  addNamedOption(cmd, "--shadow-sampling", o.obscurance.shadowSampling, render::kShadowSamplingNames,
                  "selection (N_s rays per hit to lights chosen by power, default) or per-light (every light "
-                 "alone, 4 rays per hit, up to 64 in penumbrae, one to a point light: relit images stay as clean as fresh ones)")
-      ->check(CLI::IsMember({"selection", "per-light"}));
-  cmd.add_option("--light-sampling", o.lightSampling,
+                 "alone, 4 rays per hit, up to 64 in penumbrae, one to a point light: relit images stay as clean as fresh ones)");
+  addNamedOption(cmd, "--light-sampling", o.obscurance.lightSampling, render::kLightSamplingNames,
                  "how shadow rays pick lights (both methods): spatial (default: by importance at the point, "
-                 "triangles by solid angle, MIS on glossy lobes) or area (the paper's: by power, uniform by area)")
-      ->check(CLI::IsMember({"spatial", "area"}));
-  cmd.add_option("--ambient", o.ambient,
+                 "triangles by solid angle, MIS on glossy lobes) or area (the paper's: by power, uniform by area)");
+  addNamedOption(cmd, "--ambient", o.obscurance.ambient, render::kAmbientModelNames,
                  "which surfaces share a light's flux in I_a: reached (default: those its light reaches, directly or "
                  "after one bounce), seen (reached, with the first bounce fitted to what the light's landing points send to "
-                 "the surfaces the camera sees) or global (the paper's: the whole scene)")
-      ->check(CLI::IsMember({"reached", "seen", "global"}));
-  cmd.add_option("--dirty-test", o.dirtyTest,
+                 "the surfaces the camera sees) or global (the paper's: the whole scene)");
+  addNamedOption(cmd, "--dirty-test", o.obscurance.dirtyTest, render::kDirtyTestNames,
                  "which pixels a geometry edit (relight --edits: move, remove, insert) retraces: bounds (those whose "
                  "rays' bounding boxes and shafts may meet the object's old or new place), probe (of those, the ones "
                  "one of whose rays does, found by replaying their rays) or auto (default: probe where the scene has "
-                 "glossy surfaces, else bounds)")
-      ->check(CLI::IsMember({"auto", "probe", "bounds"}));
+                 "glossy surfaces, else bounds)");
   cmd.add_option("--secondary-reflectors", o.obscurance.secondaryReflectors,
                  "T: important secondary reflectors (the paper's future work): surfaces a light lights at least T "
                  "times its mean direct irradiance are marked, and an obscurance ray that lands on one traces the "
@@ -115,7 +111,7 @@ void checkRenderOptions(const RenderOptions& o) {
   if (!(std::isfinite(o.obscurance.secondaryReflectors) && o.obscurance.secondaryReflectors >= 0.0f))
     throw InputError(fmt::format("--secondary-reflectors {}: must be a finite threshold >= 0 (0: off)",
                                  o.obscurance.secondaryReflectors));
-  if (o.obscurance.secondaryReflectors > 0.0f && o.shadowSampling == "per-light")
+  if (o.obscurance.secondaryReflectors > 0.0f && o.obscurance.shadowSampling == render::ShadowSampling::PerLight)
     throw InputError("--secondary-reflectors with --shadow-sampling per-light: the reflectors choose among all lights "
                      "by importance, so each light's transport would depend on the others' power; use one or the other");
   if (o.dMaxGiven && !(std::isfinite(o.dMax) && o.dMax > 0.0f))
@@ -130,19 +126,7 @@ render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scen
   settings.seed = o.seed;
   settings.camera = camera;
   settings.dMax = o.dMax;
-  settings.rho = render::rhoKindNamed(o.rho);
-  settings.systematic = o.sampling == "systematic";
   settings.colourBleeding = !o.noBleed;
-  settings.vertexRaysByThroughput = o.vertexRays == "throughput";
-  settings.shadowSampling = o.shadowSampling == "per-light" ? render::ShadowSampling::PerLight
-                                                            : render::ShadowSampling::Selection;
-  settings.lightSampling = lightSampling(o);
-  settings.ambient = o.ambient == "global" ? render::AmbientModel::Global
-                     : o.ambient == "seen"  ? render::AmbientModel::Seen
-                                            : render::AmbientModel::Reached;
-  settings.dirtyTest = o.dirtyTest == "bounds"  ? render::DirtyTest::Bounds
-                       : o.dirtyTest == "probe" ? render::DirtyTest::Probe
-                                                : render::DirtyTest::Auto;
   return settings;
 }
 
@@ -155,10 +139,6 @@ void warnIfUnlit(const LoadedScene& loaded) {
              "what emits. Give it a sky with --background R,G,B, add a light to the scene, or relight it: obscura "
              "relight SCENE --edits EDITS.json with an add_light edit\n",
              loaded.scene.sourcePath);
-}
-
-render::LightSampling lightSampling(const RenderOptions& o) {
-  return o.lightSampling == "area" ? render::LightSampling::Area : render::LightSampling::Spatial;
 }
 
 } // namespace obscura::app

@@ -9,6 +9,7 @@
 
 #include "app/commands.h"
 #include "app/scene_setup.h"
+#include "render/method.h"
 #include "render/obscurance_renderer.h"
 #include "scene/scene.h"
 
@@ -24,20 +25,16 @@ struct RenderOptions {
   std::vector<std::string> aovs;
   std::string metrics;
   float exposure = 0.0f;
-  std::string method = "obscurance";
+  render::Method method = render::Method::Obscurance;
   std::string saveState;
+  // The obscurance method's settings, the named options (--rho, --sampling, --vertex-rays,
+  // --shadow-sampling, --light-sampling, --ambient, --dirty-test) parsed straight into them;
+  // obscuranceSettings() adds the size, camera and samples.
   render::ObscuranceSettings obscurance;
-  std::string rho = "sqrt";
-  std::string sampling = "systematic";
-  std::string vertexRays = "throughput";
   bool noBleed = false;
   float dMax = 0.0f;
   bool dMaxGiven = false;
   std::string lightGroups = "node";
-  std::string shadowSampling = "selection";
-  std::string lightSampling = "spatial";
-  std::string ambient = "reached";
-  std::string dirtyTest = "auto";
   std::vector<float> background; // R,G,B radiance of the sky; empty: none
   bool denoise = false;          // render only: the denoised combined image too (render/denoise/)
   // render only: a farm's part (host/farm/part.h): samples "A:B" of --spp and tile "I/T"; empty:
@@ -63,7 +60,5 @@ void checkBackground(const std::vector<float>& background);
 // Warns (stderr) when no light of the scene emits anything: the image would be black but for
 // seen emission, and a user deserves to know why.
 void warnIfUnlit(const LoadedScene& loaded);
-// The light sampling --light-sampling names.
-render::LightSampling lightSampling(const RenderOptions& o);
 
 } // namespace obscura::app

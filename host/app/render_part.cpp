@@ -36,8 +36,6 @@ void checkPartOptions(const RenderOptions& o) {
   if (!o.saveState.empty())
     throw InputError("--save-state with --samples or --tile: every part keeps its per-light transport; give "
                      "--save-state DIR to 'obscura merge' to write the merged relighting state");
-  if (o.method != "obscurance" && o.method != "pathtrace")
-    throw InputError(fmt::format("--method {}: a part is rendered by obscurance or pathtrace", o.method));
 }
 
 // Appends a channel per value of `values` (pixels x components) named `names`.
@@ -65,22 +63,22 @@ bool isPartRender(const RenderOptions& o) { return !o.partSamples.empty() || !o.
 
 nlohmann::json jobIdentity(const RenderOptions& o) {
   nlohmann::json job = {
-      {"method", o.method}, {"width", o.width}, {"height", o.height}, {"spp", o.spp}, {"seed", o.seed},
+      {"method", nameString(render::kMethodNames, o.method)}, {"width", o.width}, {"height", o.height}, {"spp", o.spp}, {"seed", o.seed},
       {"camera", o.camera}, {"scene", farm::sceneHash(o.scenePath)},
       {"light_groups", fs::is_regular_file(o.lightGroups) ? "file:" + sha256OfFile(o.lightGroups) : o.lightGroups},
       {"background", o.background}, {"emission_samples", o.obscurance.emissionSamples},
-      {"max_depth", o.obscurance.maxDepth}, {"light_sampling", o.lightSampling}};
-  if (o.method == "obscurance") {
+      {"max_depth", o.obscurance.maxDepth}, {"light_sampling", nameString(render::kLightSamplingNames, o.obscurance.lightSampling)}};
+  if (o.method == render::Method::Obscurance) {
     job["shadow_rays"] = o.obscurance.shadowRays;
     job["obscurance_rays"] = o.obscurance.obscuranceRays;
-    job["rho"] = o.rho;
+    job["rho"] = nameString(render::kRhoKindNames, o.obscurance.rho);
     job["tau"] = o.obscurance.tau;
     job["dmax"] = o.dMax;
-    job["sampling"] = o.sampling;
+    job["sampling"] = nameString(render::kObscuranceSamplingNames, o.obscurance.systematic);
     job["colour_bleeding"] = !o.noBleed;
-    job["vertex_rays"] = o.vertexRays;
-    job["shadow_sampling"] = o.shadowSampling;
-    job["ambient"] = o.ambient;
+    job["vertex_rays"] = nameString(render::kVertexRaysNames, o.obscurance.vertexRaysByThroughput);
+    job["shadow_sampling"] = nameString(render::kShadowSamplingNames, o.obscurance.shadowSampling);
+    job["ambient"] = nameString(render::kAmbientModelNames, o.obscurance.ambient);
     job["secondary_reflectors"] = o.obscurance.secondaryReflectors;
   }
   return job;
@@ -114,7 +112,7 @@ void renderPart(RenderOptions& o) {
   settings.firstSample = part.samples.begin;
   settings.rows = part.rows;
   render::RenderStats stats;
-  if (o.method == "pathtrace") {
+  if (o.method == render::Method::PathTrace) {
     render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
                                  .camera = camera, .maxDepth = settings.maxDepth,
                                  .lightSampling = settings.lightSampling,

@@ -253,7 +253,7 @@ namespace {
 
 // The merged per-light transport, resolved by the pixels' sample counts `counts`.
 render::Transport resolvedTransport(const MergedFrame& merged, const std::vector<std::uint32_t>& counts) {
-  if (merged.method() != "obscurance") throw InputError("merge: only the obscurance method keeps per-light transport");
+  if (merged.method() != render::Method::Obscurance) throw InputError("merge: only the obscurance method keeps per-light transport");
   const nlohmann::json& state = merged.frame.at("state");
   std::vector<std::string> names;
   for (const auto& light : state.at("lights")) names.push_back(light.at("name").get<std::string>());
@@ -276,7 +276,7 @@ nlohmann::json mergedStateJson(const MergedFrame& merged) {
 io::Image mergedImage(const MergedFrame& merged) {
   const std::vector<std::uint32_t> counts = countsOf(merged.sums);
   io::Image image;
-  if (merged.method() == "pathtrace") {
+  if (merged.method() == render::Method::PathTrace) {
     // PathTracer::image(): the sums times the reciprocal of the samples.
     image.width = merged.sums.width;
     image.height = merged.sums.height;
@@ -338,6 +338,13 @@ io::Image mergedImage(const MergedFrame& merged) {
   io::appendChannels(image, render::lightLayers(transport, emissions, weights));
   image.attributes.emplace_back(kMergedAttribute, merged.job.dump());
   return image;
+}
+
+render::Method MergedFrame::method() const {
+  const std::string name = job.at("method").get<std::string>();
+  if (const auto method = valueNamed(render::kMethodNames, name)) return *method;
+  throw InputError(fmt::format("{}: its job's method \"{}\" is not {}", files.empty() ? "merge" : files.front(), name,
+                               namesSentence(render::kMethodNames)));
 }
 
 } // namespace obscura::farm

@@ -16,6 +16,7 @@
 
 #include "farm/part.h"
 #include "io/image_io.h"
+#include "render/method.h"
 #include "render/transport.h"
 
 namespace obscura::farm {
@@ -42,7 +43,8 @@ struct MergedFrame {
   double partGpuMs = 0.0, partWallSeconds = 0.0; // the parts' own figures, summed
 
   std::uint32_t spp() const { return job.at("spp").get<std::uint32_t>(); }
-  std::string method() const { return job.at("method").get<std::string>(); }
+  // The job's method (InputError naming the first part for a name render::kMethodNames lacks).
+  render::Method method() const;
 };
 
 // The part files named: files as given, folders as the .exr files in them (sorted; hidden ones,

@@ -7,6 +7,8 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/names.h"
+
 namespace obscura::io {
 
 struct JsonEntry {
@@ -22,5 +24,12 @@ float jsonNumber(const nlohmann::json& j, const char* key, const JsonEntry& at);
 glm::vec3 jsonVec3(const nlohmann::json& j, const char* key, const JsonEntry& at);
 // A non-empty string at `key`.
 std::string jsonText(const nlohmann::json& j, const char* key, const JsonEntry& at);
+// One of `table`'s names at `key` ("'<key>' is a, b or c" otherwise), as its value.
+template <typename E, std::size_t N>
+E jsonNamed(const nlohmann::json& j, const char* key, const NameTable<E, N>& table, const JsonEntry& at) {
+  const std::string name = jsonText(j, key, at);
+  if (const auto value = valueNamed(table, name)) return *value;
+  at.fail("'" + std::string(key) + "' is " + namesSentence(table));
+}
 
 } // namespace obscura::io

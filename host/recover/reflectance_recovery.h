@@ -25,6 +25,7 @@
 #include <glm/glm.hpp>
 
 #include "bvh/bvh.h"
+#include "core/names.h"
 #include "gpu/context.h"
 #include "recover/confidence_filters.h"
 #include "recover/photo_gather.h"
@@ -35,6 +36,14 @@
 namespace obscura::recover {
 
 enum class IndirectModel { Constant, Obscurance, Gather };
+inline constexpr NameTable<IndirectModel, 3> kIndirectModelNames{
+    {{"gather", IndirectModel::Gather}, {"obscurance", IndirectModel::Obscurance}, {"constant", IndirectModel::Constant}}};
+
+// The I_a models recovery offers (--ambient): not Seen, whose first bounce is fitted to a
+// render's camera view rather than to the photographs.
+inline constexpr NameTable<render::AmbientModel, 2> kRecoveryAmbientNames{
+    {{nameOf(render::kAmbientModelNames, render::AmbientModel::Reached), render::AmbientModel::Reached},
+     {nameOf(render::kAmbientModelNames, render::AmbientModel::Global), render::AmbientModel::Global}}};
 
 struct RecoveryOptions {
   std::uint32_t spp = 16;            // primary samples per pixel (and shadow/obscurance rays with them)
@@ -46,7 +55,7 @@ struct RecoveryOptions {
   std::uint32_t gatherRays = 64;     // Gather: rays per pixel
   int gatherSmoothing = 3;           // Gather: window radius of the surface-aware smoothing of B
   float constantReflectance = 0.5f;  // Constant: k
-  render::AmbientModel ambient = render::AmbientModel::Reached;
+  render::AmbientModel ambient = render::AmbientModel::Reached; // of kRecoveryAmbientNames
   FilterOptions filters;
 };
 

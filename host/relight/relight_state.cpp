@@ -46,16 +46,6 @@ std::size_t RelightState::lightIndex(const std::string& name, const std::string&
   throw InputError(fmt::format("{}: no light named '{}' (lights: {})", where, name, fmt::join(names, ", ")));
 }
 
-std::string lightTypeName(std::uint32_t gpuType) {
-  switch (gpuType) {
-    case gpu::kLightArea: return "area";
-    case gpu::kLightPoint: return "point";
-    case gpu::kLightSpot: return "spot";
-    case gpu::kLightBackground: return "background";
-    default: return "directional";
-  }
-}
-
 void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const std::string& scenePath) {
   saveState(dir, renderer, renderer.transport(), scenePath);
 }
@@ -78,7 +68,7 @@ nlohmann::json stateJson(const render::ObscuranceRenderer& renderer, const std::
       {"average_reflectance", vec3Json(renderer.ambient().averageReflectance)},
       {"lights", nlohmann::json::array()}};
   for (std::size_t i = 0; i < lights.size(); ++i)
-    json["lights"].push_back({{"name", lights.names[i]}, {"type", lightTypeName(lights.lights[i].info.x)},
+    json["lights"].push_back({{"name", lights.names[i]}, {"type", nameString(render::kLightTypeNames, lights.type(i))},
                               {"emission", vec3Json(renderer.emissions()[i])},
                               {"ambient_weight", vec3Json(renderer.ambient().weight[i])}});
   return json;

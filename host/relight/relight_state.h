@@ -37,8 +37,6 @@ struct RelightState {
   std::size_t lightIndex(const std::string& name, const std::string& where) const;
 };
 
-// The light's type as the state file names it.
-std::string lightTypeName(std::uint32_t gpuType);
 
 // Writes DIR (created when missing). The files are written under temporary names and renamed,
 // so an interrupted write leaves no half state.

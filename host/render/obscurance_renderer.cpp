@@ -15,17 +15,6 @@
 
 namespace obscura::render {
 
-RhoKind rhoKindNamed(const std::string& name) {
-  return name == "exp" ? RhoKind::Exp : name == "ao" ? RhoKind::Ao : RhoKind::Sqrt;
-}
-
-const char* rhoKindName(RhoKind kind) {
-  switch (kind) {
-  case RhoKind::Exp: return "exp";
-  case RhoKind::Ao: return "ao";
-  default: return "sqrt";
-  }
-}
 namespace {
 
 using Clock = std::chrono::steady_clock;

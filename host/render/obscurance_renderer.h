@@ -47,14 +47,15 @@
 #include "render/scene/light_set.h"
 #include "render/scene/scene_buffers.h"
 #include "render/transport.h"
+#include "core/names.h"
 #include "scene/scene.h"
 
 namespace obscura::render {
 
 enum class RhoKind : std::uint32_t { Sqrt = 0, Exp = 1, Ao = 2 };
-// The names --rho and the window's panel use: "sqrt", "exp", "ao" (anything else: Sqrt).
-RhoKind rhoKindNamed(const std::string& name);
-const char* rhoKindName(RhoKind kind);
+// --rho, the window's panel and scripts, job descriptions.
+inline constexpr NameTable<RhoKind, 3> kRhoKindNames{
+    {{"sqrt", RhoKind::Sqrt}, {"exp", RhoKind::Exp}, {"ao", RhoKind::Ao}}};
 
 // How the shadow pass spends its rays [SPEC §1.3, IVR §3.1].
 enum class ShadowSampling {
@@ -65,8 +66,18 @@ enum class ShadowSampling {
              // still gets transport, so switching it on later is a clean relight
 };
 
+inline constexpr NameTable<ShadowSampling, 2> kShadowSamplingNames{
+    {{"selection", ShadowSampling::Selection}, {"per-light", ShadowSampling::PerLight}}};
+
 // The dirty test of a geometry edit (ObscuranceSettings::dirtyTest).
 enum class DirtyTest { Auto, Bounds, Probe };
+inline constexpr NameTable<DirtyTest, 3> kDirtyTestNames{
+    {{"auto", DirtyTest::Auto}, {"probe", DirtyTest::Probe}, {"bounds", DirtyTest::Bounds}}};
+
+// The obscurance rays' directions (ObscuranceSettings::systematic) and the rays at a specular
+// path's vertices (ObscuranceSettings::vertexRaysByThroughput): two-valued options with names.
+inline constexpr NameTable<bool, 2> kObscuranceSamplingNames{{{"systematic", true}, {"random", false}}};
+inline constexpr NameTable<bool, 2> kVertexRaysNames{{{"throughput", true}, {"per-hit", false}}};
 
 struct ObscuranceSettings {
   std::uint32_t width = 512, height = 512;

@@ -33,7 +33,7 @@ EditSession::EditSession(const gpu::Context& context, scene::Scene scene, bvh::B
   const render::LightSet& set = renderer_->lights();
   for (std::size_t i = 0; i < set.names.size(); ++i) {
     lights_.insert(i, {.name = set.names[i], .base = renderer_->emissions()[i],
-                       .area = set.lights[i].info.x == gpu::kLightArea});
+                       .area = set.type(i) == render::LightType::Area});
   }
 }
 

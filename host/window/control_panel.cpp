@@ -41,6 +41,15 @@ bool combo(const char* label, const std::string& current, const std::vector<std:
   return changed;
 }
 
+// A combo over an enum's names (core/names.h): the panel offers the words the command line takes.
+template <typename E, std::size_t N>
+bool namedCombo(const char* label, E current, const NameTable<E, N>& table, E& chosen) {
+  std::string picked;
+  if (!combo(label, nameString(table, current), namesOf(table), picked)) return false;
+  chosen = *valueNamed(table, picked);
+  return true;
+}
+
 } // namespace
 
 const char* viewerControlsHelp() {
@@ -65,11 +74,7 @@ std::vector<ViewerAction> drawControlPanel(const PanelState& s) {
   if (!s.status.empty()) ImGui::TextWrapped("%s", s.status.c_str());
 
   std::string chosen;
-  if (combo("method", s.method, {"obscurance", "pathtrace"}, chosen)) {
-    auto a = action(Kind::Method);
-    a.name = chosen;
-    out.push_back(a);
-  }
+  if (auto a = action(Kind::Method); namedCombo("method", s.method, render::kMethodNames, a.method)) out.push_back(a);
   if (combo("AOV", s.aov, s.aovs, chosen)) {
     auto a = action(Kind::Aov);
     a.name = chosen;
@@ -89,11 +94,7 @@ std::vector<ViewerAction> drawControlPanel(const PanelState& s) {
   }
 
   if (ImGui::CollapsingHeader("obscurances")) {
-    if (combo("rho", s.rho, {"sqrt", "exp", "ao"}, chosen)) {
-      auto a = action(Kind::Rho);
-      a.name = chosen;
-      out.push_back(a);
-    }
+    if (auto a = action(Kind::Rho); namedCombo("rho", s.rho, render::kRhoKindNames, a.rho)) out.push_back(a);
     float dMax = s.dMax;
     if (ImGui::SliderFloat("dmax", &dMax, 0.001f * s.sceneSize, s.sceneSize, "%.3f m", ImGuiSliderFlags_Logarithmic)) {
       auto a = action(Kind::DMax);
@@ -114,7 +115,7 @@ std::vector<ViewerAction> drawControlPanel(const PanelState& s) {
   }
 
   if (ImGui::CollapsingHeader("lights", ImGuiTreeNodeFlags_DefaultOpen)) {
-    if (s.method == "pathtrace") ImGui::TextWrapped("path tracing shows the scene's own lights; edits here are the obscurance method's");
+    if (s.method == render::Method::PathTrace) ImGui::TextWrapped("path tracing shows the scene's own lights; edits here are the obscurance method's");
     for (const auto& light : s.lights) {
       ImGui::PushID(light.name.c_str());
       ImGui::TextUnformatted(light.name.c_str());

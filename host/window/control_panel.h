@@ -9,12 +9,16 @@
 #include <glm/glm.hpp>
 
 #include "render/aovs.h"
+#include "render/method.h"
+#include "render/obscurance_renderer.h"
 #include "window/viewer_action.h"
 
 namespace obscura::window {
 
 struct PanelState {
-  std::string method, aov, rho;
+  render::Method method = render::Method::Obscurance;
+  render::RhoKind rho = render::RhoKind::Sqrt;
+  std::string aov;
   std::vector<std::string> aovs;       // what the AOV list offers
   float exposure = 0.0f, dMax = 0.0f;
   std::uint32_t shadowRays = 0, obscuranceRays = 0;

@@ -76,12 +76,10 @@ ViewerAction panelAction(const json& p, const io::JsonEntry& at) {
     a.name = io::jsonText(p, "aov", at);
   } else if (p.contains("method")) {
     a.kind = Kind::Method;
-    a.name = io::jsonText(p, "method", at);
-    if (a.name != "obscurance" && a.name != "pathtrace") at.fail("'method' is obscurance or pathtrace");
+    a.method = io::jsonNamed(p, "method", render::kMethodNames, at);
   } else if (p.contains("rho")) {
     a.kind = Kind::Rho;
-    a.name = io::jsonText(p, "rho", at);
-    if (a.name != "sqrt" && a.name != "exp" && a.name != "ao") at.fail("'rho' is sqrt, exp or ao");
+    a.rho = io::jsonNamed(p, "rho", render::kRhoKindNames, at);
   } else if (p.contains("dmax")) {
     a.kind = Kind::DMax;
     a.value = io::jsonNumber(p, "dmax", at);

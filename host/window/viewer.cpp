@@ -176,12 +176,12 @@ void Viewer::apply(const ViewerAction& a, FrameRecord& record) {
     break;
   }
   case Kind::Method:
-    config_.method = a.name;
+    config_.method = a.method;
     needsCompose_ = true;
     record.actions.push_back("method");
     break;
   case Kind::Rho:
-    config_.obscurance.rho = render::rhoKindNamed(a.name);
+    config_.obscurance.rho = a.rho;
     restartFor("rho", false);
     break;
   case Kind::DMax:
@@ -247,7 +247,7 @@ int Viewer::pick(double x, double y) {
 
 void Viewer::renderStep(FrameRecord& record) {
   const std::uint32_t maxSamples = std::max(config_.obscurance.spp, 1u);
-  if (config_.method == "pathtrace") {
+  if (config_.method == render::Method::PathTrace) {
     if (!pathTracer_) {
       render::PathTraceSettings s;
       s.width = config_.obscurance.width;
@@ -312,7 +312,7 @@ const std::vector<std::uint32_t>& Viewer::shownBytes() {
 }
 
 render::RenderStats Viewer::currentStats() const {
-  if (config_.method == "pathtrace") return pathTracer_ ? pathTracer_->stats() : render::RenderStats{};
+  if (config_.method == render::Method::PathTrace) return pathTracer_ ? pathTracer_->stats() : render::RenderStats{};
   return session_->renderer().stats();
 }
 
@@ -323,19 +323,19 @@ PanelState Viewer::panelState() const {
   s.aovs = {"combined"};
   for (const auto& name : render::obscuranceAovNames())
     if (name != "combined") s.aovs.push_back(name);
-  s.rho = render::rhoKindName(config_.obscurance.rho);
+  s.rho = config_.obscurance.rho;
   s.exposure = config_.exposure;
   s.dMax = session_->renderer().dMax();
   s.shadowRays = config_.obscurance.shadowRays;
   s.obscuranceRays = config_.obscurance.obscuranceRays;
   s.denoise = config_.denoise;
-  s.samples = config_.method == "pathtrace" && pathTracer_ ? pathTracer_->samples() : session_->renderer().samples();
+  s.samples = config_.method == render::Method::PathTrace && pathTracer_ ? pathTracer_->samples() : session_->renderer().samples();
   s.maxSamples = std::max(config_.obscurance.spp, 1u);
   s.preview = previewShown_;
   s.frameMs = lastFrameMs_;
   const auto stats = currentStats();
   s.passes = stats.passes;
-  if (config_.denoise && config_.method == "obscurance") s.passes["denoise (last frame)"] = {denoiser_->lastGpuMs(), 0};
+  if (config_.denoise && config_.method == render::Method::Obscurance) s.passes["denoise (last frame)"] = {denoiser_->lastGpuMs(), 0};
   const double ms = totalGpuMs(stats);
   s.raysPerSecond = ms > 0 ? double(totalRays(stats)) / (ms * 1e-3) : 0.0;
   for (const auto& l : session_->lights())
@@ -354,8 +354,8 @@ PanelState Viewer::panelState() const {
 void Viewer::writeLog(const FrameRecord& r) {
   if (!log_) return;
   nlohmann::json line = {{"frame", r.frame},
-                         {"method", config_.method},
-                         {"samples", config_.method == "pathtrace" && pathTracer_ ? pathTracer_->samples()
+                         {"method", nameString(render::kMethodNames, config_.method)},
+                         {"samples", config_.method == render::Method::PathTrace && pathTracer_ ? pathTracer_->samples()
                                                                                    : session_->renderer().samples()},
                          {"restarted", r.restarted},
                          {"preview", r.preview},
@@ -376,7 +376,7 @@ void Viewer::writeLog(const FrameRecord& r) {
 }
 
 io::Image Viewer::shownImage() {
-  if (config_.method == "pathtrace") return pathTracer_->image();
+  if (config_.method == render::Method::PathTrace) return pathTracer_->image();
   if (config_.aov == "combined" && config_.denoise) return denoiser_->image();
   shownBytes(); // as in pick(): compose() overwrites the display bytes not yet read back
   session_->renderer().compose(config_.exposure);

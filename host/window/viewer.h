@@ -41,7 +41,7 @@ struct ViewerConfig {
   std::string title = "obscura";
   render::ObscuranceSettings obscurance; // size, camera, rays; spp = the samples accumulated
   std::uint32_t pathDepth = 6;
-  std::string method = "obscurance";     // or "pathtrace"
+  render::Method method = render::Method::Obscurance;
   std::string aov = "combined";
   float exposure = 0.0f;
   bool denoise = true;                   // the denoiser (render/denoise/) on the combined image

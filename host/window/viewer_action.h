@@ -8,6 +8,8 @@
 
 #include <glm/glm.hpp>
 
+#include "render/method.h"
+#include "render/obscurance_renderer.h"
 #include "session/edit.h"
 
 namespace obscura::window {
@@ -18,8 +20,8 @@ struct ViewerAction {
     SelectObject,  // object `name` ("" = none)
     Exposure,      // `value` stops (display only)
     Aov,           // show AOV `name`
-    Method,        // "obscurance" or "pathtrace"
-    Rho,           // "sqrt", "exp" or "ao" (restarts)
+    Method,        // `method`
+    Rho,           // `rho` (restarts)
     DMax,          // `value` metres (restarts)
     ShadowRays,    // `count` (restarts)
     ObscuranceRays,// `count` (restarts)
@@ -32,6 +34,8 @@ struct ViewerAction {
   std::string name;
   float value = 0.0f;
   std::size_t count = 0;
+  render::Method method = render::Method::Obscurance;
+  render::RhoKind rho = render::RhoKind::Sqrt;
   session::Edit edit;
 };
 

@@ -14,6 +14,7 @@
 
 #include "render/scene/light_set.h"
 #include "render/scene/reached_surfaces.h"
+#include "core/names.h"
 #include "scene/scene.h"
 
 namespace obscura::render {
@@ -23,6 +24,8 @@ namespace obscura::render {
 // light's landing points send to the surfaces the camera sees, reached_surfaces.h) or Global (the
 // paper's: the whole scene).
 enum class AmbientModel { Reached, Global, Seen };
+inline constexpr NameTable<AmbientModel, 3> kAmbientModelNames{
+    {{"reached", AmbientModel::Reached}, {"seen", AmbientModel::Seen}, {"global", AmbientModel::Global}}};
 
 struct AmbientTerm {
   AmbientModel model = AmbientModel::Global;

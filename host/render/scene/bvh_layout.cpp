@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include "bvh/binary_layout.h"
 #include "core/error.h"
@@ -27,20 +28,12 @@ bvh::BuildOptions treeOptionsFor(Traversal traversal) {
 
 std::optional<Traversal> parseTraversal(std::string_view name) {
   if (name.empty() || name == "auto") return std::nullopt;
-  if (name == "wide") return Traversal::Wide;
-  if (name == "binary") return Traversal::Binary;
-  if (name == "binary-while-while") return Traversal::BinaryWhileWhile;
-  throw std::invalid_argument(fmt::format("unknown traversal '{}' (expected one of: {})", name, kTraversalNames));
+  if (const auto traversal = valueNamed(kTraversalNames, name)) return traversal;
+  throw std::invalid_argument(
+      fmt::format("unknown traversal '{}' (expected one of: auto, {})", name, fmt::join(namesOf(kTraversalNames), ", ")));
 }
 
-std::string traversalName(Traversal traversal) {
-  switch (traversal) {
-  case Traversal::Wide: return "wide";
-  case Traversal::Binary: return "binary";
-  case Traversal::BinaryWhileWhile: return "binary-while-while";
-  }
-  return "?";
-}
+std::string traversalName(Traversal traversal) { return std::string(nameOf(kTraversalNames, traversal)); }
 
 std::uint32_t bvhLayoutOf(Traversal traversal) {
   return traversal == Traversal::Wide ? gpu::kBvhLayoutWide : gpu::kBvhLayoutBinary;

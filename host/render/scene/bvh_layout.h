@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bvh/bvh.h"
+#include "core/names.h"
 #include "gpu/context.h"
 
 namespace obscura::render {
@@ -35,12 +36,13 @@ Traversal traversalFor(const gpu::Context& context);
 // "Traversal per device"; on lavapipe the splits made shadow rays slower).
 bvh::BuildOptions treeOptionsFor(Traversal traversal);
 
-// "wide", "binary", "binary-while-while"; "auto" (or empty) is nullopt: the device's. Throws
+inline constexpr NameTable<Traversal, 3> kTraversalNames{{{"wide", Traversal::Wide},
+                                                          {"binary", Traversal::Binary},
+                                                          {"binary-while-while", Traversal::BinaryWhileWhile}}};
+// A name of kTraversalNames; "auto" (or empty) is nullopt: the device's. Throws
 // std::invalid_argument naming the accepted values otherwise.
 std::optional<Traversal> parseTraversal(std::string_view name);
 std::string traversalName(Traversal traversal);
-// The accepted names, for --help.
-inline constexpr const char* kTraversalNames = "auto, wide, binary, binary-while-while";
 
 std::uint32_t bvhLayoutOf(Traversal traversal); // gpu::kBvhLayoutWide or kBvhLayoutBinary
 bool binaryWhileWhile(Traversal traversal);

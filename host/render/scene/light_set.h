@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/names.h"
 #include "scene/scene.h"
 #include "shared/host_device.h"
 
@@ -19,6 +20,23 @@ namespace obscura::render {
 // (the default: importance at the point, solid angle, MIS on glossy lobes) or Area (the paper's:
 // by power, uniform by area), kept for reproducing the paper.
 enum class LightSampling : std::uint32_t { Spatial = gpu::kLightSamplingSpatial, Area = gpu::kLightSamplingArea };
+inline constexpr NameTable<LightSampling, 2> kLightSamplingNames{
+    {{"spatial", LightSampling::Spatial}, {"area", LightSampling::Area}}};
+
+// What kind of light a light set's light is (GpuLight::info.x, read only by LightSet::type).
+enum class LightType : std::uint32_t {
+  Area = gpu::kLightArea,
+  Point = gpu::kLightPoint,
+  Spot = gpu::kLightSpot,
+  Directional = gpu::kLightDirectional,
+  Background = gpu::kLightBackground,
+};
+// `obscura info`, relighting states ("type").
+inline constexpr NameTable<LightType, 5> kLightTypeNames{{{"area", LightType::Area},
+                                                          {"point", LightType::Point},
+                                                          {"spot", LightType::Spot},
+                                                          {"directional", LightType::Directional},
+                                                          {"background", LightType::Background}}};
 
 struct LightSet {
   std::vector<gpu::GpuLight> lights;     // selection CDF filled in; probability 0 = never sampled
@@ -27,6 +45,7 @@ struct LightSet {
   std::vector<glm::vec3> emission;       // E_s: the scene's own emission scale of each light
   std::vector<glm::vec3> unitFlux;       // emitted flux of light s at E_s = 1 (W, per channel)
   std::vector<double> power;             // selection weight ("power", SPEC §5)
+  LightType type(std::size_t light) const { return static_cast<LightType>(lights[light].info.x); }
 
   std::size_t size() const { return lights.size(); }
   bool anySampled() const;               // some light has positive power
