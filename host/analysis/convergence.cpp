@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-namespace obscura::render {
+namespace obscura::analysis {
 
 double errorOf(const ImageError& e, Metric metric) {
   switch (metric) {
@@ -40,4 +40,4 @@ TimeAt timeToReach(const Curve& curve, double target, ErrorKind kind, Metric met
   return {.ms = last.gpuMs * (e / target) * (e / target), .extrapolated = true, .valid = true};
 }
 
-} // namespace obscura::render
+} // namespace obscura::analysis

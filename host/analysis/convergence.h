@@ -6,7 +6,7 @@
 
 #include "analysis/image_error.h"
 
-namespace obscura::render {
+namespace obscura::analysis {
 
 struct CurvePoint {
   unsigned spp = 0;            // primary samples per pixel
@@ -39,4 +39,4 @@ double errorOf(const ImageError& e, Metric metric);
 // the Monte Carlo rate of an unbiased estimator (only meaningful for noise).
 TimeAt timeToReach(const Curve& curve, double target, ErrorKind kind, Metric metric = Metric::Rmse);
 
-} // namespace obscura::render
+} // namespace obscura::analysis

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-namespace obscura::render {
+namespace obscura::analysis {
 namespace {
 
 Curve monteCarloCurve() {
@@ -36,4 +36,4 @@ TEST(Convergence, ExtrapolatesAtTheMonteCarloRate) {
 }
 
 } // namespace
-} // namespace obscura::render
+} // namespace obscura::analysis

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace obscura::render {
+namespace obscura::analysis {
 
 ImageError imageError(const io::Image& image, const io::Image& reference, const std::string& channel) {
   int a = image.channelIndex(channel), b = reference.channelIndex(channel);
@@ -48,4 +48,4 @@ ImageError imageError(const io::Image& image, const io::Image& reference, const 
           .meanRatio = sumY != 0.0 ? sumX / sumY : (sumX == 0.0 ? 1.0 : HUGE_VAL)};
 }
 
-} // namespace obscura::render
+} // namespace obscura::analysis

@@ -8,7 +8,7 @@
 
 #include "io/image_io.h"
 
-namespace obscura::render {
+namespace obscura::analysis {
 
 struct ImageError {
   double rmse = 0.0;
@@ -25,4 +25,4 @@ inline constexpr double kTrimmedFraction = 0.001;
 // std::invalid_argument when sizes differ or a channel is missing.
 ImageError imageError(const io::Image& image, const io::Image& reference, const std::string& channel = "combined.R");
 
-} // namespace obscura::render
+} // namespace obscura::analysis

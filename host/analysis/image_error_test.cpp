@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-namespace obscura::render {
+namespace obscura::analysis {
 namespace {
 
 io::Image constant(float v) {
@@ -45,4 +45,4 @@ TEST(ImageError, RobustMeasuresShowOneFireflyAsSuch) {
 }
 
 } // namespace
-} // namespace obscura::render
+} // namespace obscura::analysis

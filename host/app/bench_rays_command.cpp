@@ -56,7 +56,7 @@ struct BenchOptions {
   std::string bvhItems = "texel";              // how trace.comp reads the BVH: "texel" view or "storage" buffer
   bool cullOnPop = false;                      // the binary traversal with its cull on pop
   std::optional<float> spatialSplits; // the tree's spatial splits (bvh::BuildOptions::spatialSplitBudget); unset: the device's tree
-  render::ObscuranceFrameWork frameWork; // its spp, rays per hit, dmax, seed
+  bench::ObscuranceFrameWork frameWork; // its spp, rays per hit, dmax, seed
   DeviceOptions device;
 };
 
@@ -71,7 +71,7 @@ glm::uvec2 parseSize(const std::string& text, const char* option) {
 
 // --trace-shape WxR: trace.comp's workgroup size W (a multiple of 8, lavapipe's SIMD width) and
 // rays per invocation R (1 to kTraceRaysPerLane), for trying other shapes on a new device.
-render::TraceShape parseTraceShape(const std::string& text, const gpu::Context& context) {
+bench::TraceShape parseTraceShape(const std::string& text, const gpu::Context& context) {
   unsigned w = 0, r = 0;
   char tail = 0;
   if (std::sscanf(text.c_str(), "%ux%u%c", &w, &r, &tail) != 2 || w == 0 || w % 8 != 0 || w > 1024 || r == 0 ||
@@ -121,8 +121,8 @@ struct SetResult {
   std::vector<std::string> mismatchExamples; // the first few traversal errors, for the report
 };
 
-SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std::vector<gpu::GpuRay>& rays,
-                 render::TraceMode mode, const BenchOptions& o, bool backToBack) {
+SetResult runSet(bench::RayTracer& tracer, const LoadedScene& loaded, const std::vector<gpu::GpuRay>& rays,
+                 bench::TraceMode mode, const BenchOptions& o, bool backToBack) {
   SetResult r;
   // Warm-up (pipeline JIT, caches) and hit statistics, then timed repeats.
   auto first = tracer.trace(rays, mode, true);
@@ -153,14 +153,14 @@ SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std
     // warming up for 0.4 s of repeated traces made more sets do so (docs/BENCHMARKS.md,
     // "Traversal per device"), so a set's figure is checked against the other runs of its kernel.
     tracer.traceRepeated(rays, mode, static_cast<std::uint32_t>(o.repeats));
-    double c0 = render::processCpuMs();
+    double c0 = bench::processCpuMs();
     times = tracer.traceRepeated(rays, mode, static_cast<std::uint32_t>(o.repeats)).repeatGpuMs;
-    cpuMs.push_back((render::processCpuMs() - c0) / o.repeats);
+    cpuMs.push_back((bench::processCpuMs() - c0) / o.repeats);
   } else { // lavapipe: each repeat on its own, its process CPU time measured (the Embree ratio's)
     for (int k = 0; k < o.repeats; ++k) {
-      double c0 = render::processCpuMs();
+      double c0 = bench::processCpuMs();
       times.push_back(tracer.trace(rays, mode).gpuMs);
-      cpuMs.push_back(render::processCpuMs() - c0);
+      cpuMs.push_back(bench::processCpuMs() - c0);
     }
   }
   r.bestCpuMs = *std::min_element(cpuMs.begin(), cpuMs.end());
@@ -168,17 +168,17 @@ SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std
   r.bestMs = times.front();
   r.medianMs = times[times.size() / 2];
   // Optional check of the first `verify` rays against the CPU reference traversal.
-  const bool shadowRays = mode == render::TraceMode::Any;
+  const bool shadowRays = mode == bench::TraceMode::Any;
   const bvh::TriangleSoup soup = o.verify > 0 ? render::triangleSoup(loaded.scene) : bvh::TriangleSoup{};
   for (std::size_t i = 0; i < std::min(o.verify, rays.size()); ++i) {
     bvh::Ray ray{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
     const bvh::Hit cpu = bvh::closestHit(loaded.bvh, ray);
     const bool cpuOccluded = shadowRays && bvh::anyHit(loaded.bvh, ray);
     const gpu::GpuHit& g = first.hits[i];
-    const render::HitAgreement agreement =
-        shadowRays ? render::anyHitAgreement(ray, cpuOccluded, cpu, g)
-                   : render::closestHitAgreement(ray, cpu, g, &soup);
-    if (agreement == render::HitAgreement::Different && ++r.mismatches <= 5) {
+    const bench::HitAgreement agreement =
+        shadowRays ? bench::anyHitAgreement(ray, cpuOccluded, cpu, g)
+                   : bench::closestHitAgreement(ray, cpu, g, &soup);
+    if (agreement == bench::HitAgreement::Different && ++r.mismatches <= 5) {
       r.mismatchExamples.push_back(fmt::format(
           "{} ray {}: origin ({}, {}, {}) direction ({}, {}, {}) t in ({}, {}); CPU closest t {} u {} v {} "
           "triangle {}{}; GPU t {} u {} v {} triangle {}",
@@ -186,7 +186,7 @@ SetResult runSet(render::RayTracer& tracer, const LoadedScene& loaded, const std
           ray.direction.y, ray.direction.z, ray.tmin, ray.tmax, cpu.t, cpu.u, cpu.v, cpu.primitive,
           shadowRays ? fmt::format(" (occluded: {})", cpuOccluded) : "", g.t, g.u, g.v, g.primitive));
     }
-    if (agreement == render::HitAgreement::WithinPrecision) ++r.precisionDifferences;
+    if (agreement == bench::HitAgreement::WithinPrecision) ++r.precisionDifferences;
   }
   return r;
 }
@@ -205,7 +205,7 @@ std::optional<Baseline> runBaseline(const BenchOptions& o, const LoadedScene& lo
                                     const std::vector<gpu::GpuRay>& shadowRays) {
   if (o.baseline.empty()) return std::nullopt;
 #ifdef OBSCURA_HAVE_EMBREE
-  auto e = render::runEmbreeBaseline(loaded.scene, closestRays, shadowRays, o.repeats);
+  auto e = bench::runEmbreeBaseline(loaded.scene, closestRays, shadowRays, o.repeats);
   const double n = static_cast<double>(o.rays);
   return Baseline{.buildSeconds = e.buildSeconds,
                   .closestMrays = n / (e.closest.bestMs * 1e3),
@@ -238,8 +238,8 @@ const char* benchKindOf(const std::string& pass) { return pass == "shadow" ? "sh
 // Embree refuses --frame before it gets here).
 struct FrameRun {
   glm::uvec2 size{0};
-  render::ObscuraFrameResult ours;
-  render::EmbreeFrameResult embree;
+  bench::ObscuraFrameResult ours;
+  bench::EmbreeFrameResult embree;
 };
 
 double meanOf(const std::vector<float>& values) {
@@ -252,13 +252,13 @@ FrameRun runFrame(const BenchOptions& o, const gpu::Context& context, const Load
                   const scene::Camera& camera, glm::uvec2 size) {
   FrameRun run;
   run.size = size;
-  render::ObscuranceFrameWork work = o.frameWork;
+  bench::ObscuranceFrameWork work = o.frameWork;
   work.width = size.x;
   work.height = size.y;
   work.camera = render::gpuCamera(camera, size.x, size.y);
   work.sceneScale = render::sceneScale(loaded.scene.bounds);
-  run.ours = render::runObscuraFrame(context, loaded.scene, loaded.bvh, camera, work, o.repeats);
-  run.embree = render::runEmbreeFrame(loaded.scene, work, o.repeats);
+  run.ours = bench::runObscuraFrame(context, loaded.scene, loaded.bvh, camera, work, o.repeats);
+  run.embree = bench::runEmbreeFrame(loaded.scene, work, o.repeats);
   // The same work on both sides: every camera ray, and N_obs rays per hit (the hits may differ at
   // a few silhouette pixels: Embree's triangle test is not watertight, ours is).
   if (run.ours.primaryRays != run.embree.primaryRays)
@@ -286,7 +286,7 @@ nlohmann::json passesJson(const PassesRun& p, double closestMrays, double shadow
     passes[name] = j;
   }
   return {{"width", p.size.x}, {"height", p.size.y}, {"wall_s", p.stats.wallSeconds},
-          {"gpu_ms", render::totalGpuMs(p.stats)}, {"per_pass", passes}};
+          {"gpu_ms", p.stats.totalGpuMs()}, {"per_pass", passes}};
 }
 
 #ifdef OBSCURA_HAVE_EMBREE
@@ -314,7 +314,7 @@ void printPasses(const PassesRun& p, double closestMrays, double shadowMrays) {
              "as render -o out.png makes it), best repeat by GPU time: wall {:.2f} s, GPU {:.0f} ms\n",
              p.size.x, p.size.y, budget.spp, budget.shadowRays, budget.obscuranceRays,
              budget.vertexRaysByThroughput ? ", at specular path vertices scaled by throughput" : "",
-             p.stats.wallSeconds, render::totalGpuMs(p.stats));
+             p.stats.wallSeconds, p.stats.totalGpuMs());
   fmt::print("  {:<12} {:>10} {:>12} {:>9}   {}\n", "pass", "GPU ms", "rays", "Mrays/s",
              "/ bench-rays rate of its kind (goal >= 0.77, i.e. within 1.3x)");
   for (const auto& [name, pass] : p.stats.passes) {
@@ -373,44 +373,44 @@ void runBench(const BenchOptions& o) {
   render::SceneBuffers buffers(context, loaded.scene, loaded.bvh);
   for (const std::string& note : buffers.notes()) fmt::print(stderr, "note: {}\n", note);
   if (!o.json) fmt::print("traversal: {}\n", render::traversalName(buffers.traversal()));
-  std::optional<render::TraceShape> shape;
+  std::optional<bench::TraceShape> shape;
   if (!o.traceShape.empty()) shape = parseTraceShape(o.traceShape, context);
   if (o.bvhItems == "storage" || o.cullOnPop) {
-    if (!shape) shape = render::TraceShape::forDevice(context, buffers.traversal());
+    if (!shape) shape = bench::TraceShape::forDevice(context, buffers.traversal());
     shape->bvhItemsFromStorage = o.bvhItems == "storage";
     shape->binaryCullOnPop = o.cullOnPop;
   }
   if (o.stackRegisters && !bvh::compactStackHolds(*o.stackRegisters, buffers.compactStackVectors()))
     throw InputError(fmt::format("--stack-registers {}: this BVH (depth {}) needs {} (or 0, the general kernel)",
                                  *o.stackRegisters, loaded.bvh.stats.maxDepth, buffers.compactStackVectors()));
-  render::RayTracer tracer(context, buffers, shape, o.stackRegisters);
-  auto closestRays = render::closestBenchRays(loaded.scene.bounds, o.rays, o.seed);
-  auto shadowRays = render::shadowBenchRays(loaded.scene.bounds, o.rays, o.seed + 1);
+  bench::RayTracer tracer(context, buffers, shape, o.stackRegisters);
+  auto closestRays = bench::closestBenchRays(loaded.scene.bounds, o.rays, o.seed);
+  auto shadowRays = bench::shadowBenchRays(loaded.scene.bounds, o.rays, o.seed + 1);
   if (!o.saveRays.empty()) {
-    render::saveRays(o.saveRays + ".closest.bin", closestRays);
-    render::saveRays(o.saveRays + ".shadow.bin", shadowRays);
+    bench::saveRays(o.saveRays + ".closest.bin", closestRays);
+    bench::saveRays(o.saveRays + ".shadow.bin", shadowRays);
   }
   const bool backToBack = context.info().type != "cpu";
-  SetResult closest = runSet(tracer, loaded, closestRays, render::TraceMode::Closest, o, backToBack);
-  SetResult shadow = runSet(tracer, loaded, shadowRays, render::TraceMode::Any, o, backToBack);
+  SetResult closest = runSet(tracer, loaded, closestRays, bench::TraceMode::Closest, o, backToBack);
+  SetResult shadow = runSet(tracer, loaded, shadowRays, bench::TraceMode::Any, o, backToBack);
   std::optional<Baseline> base = runBaseline(o, loaded, closestRays, shadowRays);
   const scene::Camera camera = chooseCamera(loaded.scene, -1);
   std::optional<PassesRun> passes;
   if (passesSize)
-    passes = PassesRun{*passesSize, render::renderPaperBudget(context, loaded.scene, loaded.bvh, camera, passesSize->x,
+    passes = PassesRun{*passesSize, bench::renderPaperBudget(context, loaded.scene, loaded.bvh, camera, passesSize->x,
                                                               passesSize->y, o.repeats)};
 #ifdef OBSCURA_HAVE_EMBREE
   std::vector<FrameRun> frames;
   for (glm::uvec2 size : frameSizes) frames.push_back(runFrame(o, context, loaded, camera, size));
 #endif
-  std::vector<render::LaneOrderFigures> lanes;
+  std::vector<bench::LaneOrderFigures> lanes;
   if (lanesSize) {
-    render::ObscuranceFrameWork work = o.frameWork;
+    bench::ObscuranceFrameWork work = o.frameWork;
     work.width = lanesSize->x;
     work.height = lanesSize->y;
     work.camera = render::gpuCamera(camera, work.width, work.height);
     work.sceneScale = render::sceneScale(loaded.scene.bounds);
-    lanes = render::measureLaneOrders(tracer, loaded.scene, work, o.repeats);
+    lanes = bench::measureLaneOrders(tracer, loaded.scene, work, o.repeats);
   }
   std::uint32_t truncated = buffers.truncatedTraversals();
   if (truncated > 0) throw DeviceError(fmt::format("{} traversals ran out of steps", truncated));

@@ -24,7 +24,7 @@ void addCompareCommand(CLI::App& app) {
   cmd->callback([o] {
     const io::Image a = io::readImage(o->image), b = io::readImage(o->reference);
     try {
-      const render::ImageError e = render::imageError(a, b, o->channel);
+      const analysis::ImageError e = analysis::imageError(a, b, o->channel);
       fmt::print("rmse {:.6g} relmse {:.6g}\n", e.rmse, e.relMse);
     } catch (const std::invalid_argument& e) {
       throw InputError(fmt::format("{} against {}: {}", o->image, o->reference, e.what()));

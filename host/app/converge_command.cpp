@@ -352,20 +352,20 @@ void runConverge(const ConvergeOptions& o) {
     return m.secondaryReflectors > 0.0f ? reflectorReferences.at(m.name) : obscuranceReference;
   };
 
-  std::vector<render::Curve> curves;
+  std::vector<analysis::Curve> curves;
   std::map<std::string, io::Image> atBudget; // each method's image at its budget
   const fs::path csvPath = fs::path(o.outputDir) / (study.stem() + ".convergence.csv");
   std::ofstream csv(csvPath);
   csv << "method,spp,rays_per_pixel,gpu_ms,rmse_noise,relmse_noise,mae_noise,rmse_trimmed_noise,"
          "rmse_vs_pathtrace,relmse_vs_pathtrace,mae_vs_pathtrace,rmse_trimmed_vs_pathtrace\n";
   for (const auto& m : methods) {
-    render::Curve curve{.method = m.name, .points = {}};
+    analysis::Curve curve{.method = m.name, .points = {}};
     std::uint32_t maxSpp = m.pathTrace ? o.pathMaxSpp : o.obscuranceMaxSpp;
     for (std::uint32_t spp = 1; spp <= maxSpp; spp *= 2) {
       Rendered r = study.render(m, spp, o.seed + spp);
-      render::CurvePoint p{.spp = spp, .raysPerPixel = r.rays, .gpuMs = r.gpuMs,
-                           .noise = render::imageError(r.image, noiseReference(m)),
-                           .total = render::imageError(r.image, ptReference)};
+      analysis::CurvePoint p{.spp = spp, .raysPerPixel = r.rays, .gpuMs = r.gpuMs,
+                           .noise = analysis::imageError(r.image, noiseReference(m)),
+                           .total = analysis::imageError(r.image, ptReference)};
       if (spp == m.budgetSpp) atBudget[m.name] = r.image;
       curve.points.push_back(p);
       csv << fmt::format("{},{},{:.2f},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", m.name, spp,
@@ -380,15 +380,15 @@ void runConverge(const ConvergeOptions& o) {
   }
   csv.close();
 
-  const render::Curve& pt = curves.back();
+  const analysis::Curve& pt = curves.back();
   nlohmann::json summary = {{"scene", o.scenePath}, {"width", study.width()}, {"height", study.height()},
                             {"device", context.info().name}, {"command", o.commandLine}};
-  auto errorJson = [](const render::ImageError& e) {
+  auto errorJson = [](const analysis::ImageError& e) {
     return nlohmann::json{{"rmse", e.rmse}, {"relmse", e.relMse}, {"mae", e.mae}, {"rmse_trimmed", e.rmseTrimmed},
                           {"mean_ratio", e.meanRatio}};
   };
-  const render::ImageError bias = render::imageError(obscuranceReference, ptReference);
-  const render::TimeAt ptBelowFloor = render::timeToReach(pt, bias.rmse, render::ErrorKind::AgainstReference);
+  const analysis::ImageError bias = analysis::imageError(obscuranceReference, ptReference);
+  const analysis::TimeAt ptBelowFloor = analysis::timeToReach(pt, bias.rmse, analysis::ErrorKind::AgainstReference);
   fmt::print("\nbias floor (converged obscurance, seen I_a, vs converged path tracing): RMSE {:.5f}, relMSE {:.5f}, "
              "MAE {:.5f}, trimmed RMSE {:.5f}, mean ratio {:.4f}\n",
              bias.rmse, bias.relMse, bias.mae, bias.rmseTrimmed, bias.meanRatio);
@@ -396,15 +396,15 @@ void runConverge(const ConvergeOptions& o) {
              ptBelowFloor.extrapolated ? " (extrapolated)" : "");
   summary["bias_floor"] = errorJson(bias);
   for (const auto& [model, what] : {std::pair{"reached", "the reached I_a"}, std::pair{"global", "the paper's whole-scene I_a"}}) {
-    const render::ImageError e = render::imageError(study.otherReference(model, best.name), ptReference);
+    const analysis::ImageError e = analysis::imageError(study.otherReference(model, best.name), ptReference);
     fmt::print("bias floor with {}: RMSE {:.5f}, relMSE {:.5f}, MAE {:.5f}, trimmed RMSE {:.5f}, mean ratio {:.4f}\n", what,
                e.rmse, e.relMse, e.mae, e.rmseTrimmed, e.meanRatio);
     summary[fmt::format("bias_floor_{}_ia", model)] = errorJson(e);
   }
   for (const auto& [name, reference] : reflectorReferences) {
-    const render::ImageError seen = render::imageError(reference, ptReference);
-    const render::ImageError reached = render::imageError(study.otherReference("reached", name), ptReference);
-    const render::ImageError global = render::imageError(study.otherReference("global", name), ptReference);
+    const analysis::ImageError seen = analysis::imageError(reference, ptReference);
+    const analysis::ImageError reached = analysis::imageError(study.otherReference("reached", name), ptReference);
+    const analysis::ImageError global = analysis::imageError(study.otherReference("global", name), ptReference);
     for (const auto& [which, e] :
          {std::pair{"seen I_a", seen}, std::pair{"reached I_a", reached}, std::pair{"the paper's I_a", global}})
       fmt::print("bias floor with secondary reflectors ({}), {}: RMSE {:.5f}, relMSE {:.5f}, MAE {:.5f}, trimmed RMSE "
@@ -419,11 +419,11 @@ void runConverge(const ConvergeOptions& o) {
 
   // Per obscurance method at its budget: equal-noise speed-up in each measure, and the time path
   // tracing needs to reach the same total error (bias included).
-  const std::pair<const char*, render::Metric> metrics[] = {
-      {"rmse", render::Metric::Rmse}, {"rmse_trimmed", render::Metric::RmseTrimmed}, {"mae", render::Metric::Mae}};
+  const std::pair<const char*, analysis::Metric> metrics[] = {
+      {"rmse", analysis::Metric::Rmse}, {"rmse_trimmed", analysis::Metric::RmseTrimmed}, {"mae", analysis::Metric::Mae}};
   for (std::size_t i = 0; i + 1 < methods.size(); ++i) {
     const Method& m = methods[i];
-    const render::CurvePoint* point = nullptr;
+    const analysis::CurvePoint* point = nullptr;
     for (const auto& p : curves[i].points)
       if (p.spp == m.budgetSpp) point = &p;
     if (!point) continue;
@@ -431,10 +431,10 @@ void runConverge(const ConvergeOptions& o) {
                             {"rays_per_pixel", point->raysPerPixel}};
     fmt::print("\n{} ({}): {:.1f} ms, {:.1f} rays per pixel\n", m.name, m.what, point->gpuMs, point->raysPerPixel);
     for (const auto& [key, metric] : metrics) {
-      const double noise = render::errorOf(*point, render::ErrorKind::Noise, metric);
-      const double total = render::errorOf(*point, render::ErrorKind::AgainstReference, metric);
-      const render::TimeAt equalNoise = render::timeToReach(pt, noise, render::ErrorKind::Noise, metric);
-      const render::TimeAt equalTotal = render::timeToReach(pt, total, render::ErrorKind::AgainstReference, metric);
+      const double noise = analysis::errorOf(*point, analysis::ErrorKind::Noise, metric);
+      const double total = analysis::errorOf(*point, analysis::ErrorKind::AgainstReference, metric);
+      const analysis::TimeAt equalNoise = analysis::timeToReach(pt, noise, analysis::ErrorKind::Noise, metric);
+      const analysis::TimeAt equalTotal = analysis::timeToReach(pt, total, analysis::ErrorKind::AgainstReference, metric);
       const double speedUp = equalNoise.valid ? equalNoise.ms / point->gpuMs : 0.0;
       fmt::print("  {:13s} noise {:.5f}: path tracing reaches it in {:9.1f} ms{} -> equal-noise speed-up {:.2f}x; "
                  "total error {:.5f}: path tracing reaches it in {:.1f} ms{}\n",
@@ -450,7 +450,7 @@ void runConverge(const ConvergeOptions& o) {
 
   // What a user sees: the obscurance image at the paper's budget and path tracing at equal GPU time.
   if (atBudget.contains(best.name)) {
-    const render::CurvePoint* point = nullptr;
+    const analysis::CurvePoint* point = nullptr;
     for (const auto& p : curves.front().points)
       if (p.spp == best.budgetSpp) point = &p;
     const double msPerPath = pt.points.back().gpuMs / pt.points.back().spp;

@@ -18,12 +18,6 @@ namespace obscura::app {
 namespace {
 namespace fs = std::filesystem;
 
-double gpuMsOf(const render::RenderStats& stats) {
-  double ms = 0.0;
-  for (const auto& [name, pass] : stats.passes) ms += pass.gpuMs;
-  return ms;
-}
-
 void checkPartOptions(const RenderOptions& o) {
   if (io::extensionOf(o.output) != "exr")
     throw InputError(fmt::format("{}: a part (--samples, --tile) is written as .exr, the sums that 'obscura merge' "
@@ -153,7 +147,7 @@ void renderPart(RenderOptions& o) {
   if (stats.truncatedTraversals > 0)
     throw DeviceError(fmt::format("{} traversals ran out of steps (kMaxTraversalSteps); the part would be wrong",
                                   stats.truncatedTraversals));
-  const double gpuMs = gpuMsOf(stats);
+  const double gpuMs = stats.totalGpuMs();
   part.info = {{"scene_path", o.scenePath}, {"device", context.info().name}, {"gpu_ms", gpuMs},
                {"wall_s", stats.wallSeconds}};
   farm::writePart(o.output, part);

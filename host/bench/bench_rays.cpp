@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 namespace {
 
 struct UniformFloats {
@@ -71,4 +71,4 @@ void saveRays(const std::string& path, const std::vector<gpu::GpuRay>& rays) {
   }
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench

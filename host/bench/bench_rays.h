@@ -15,7 +15,7 @@
 #include "shared/host_device.h"
 #include "scene/scene.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 std::vector<gpu::GpuRay> closestBenchRays(const scene::Bounds& bounds, std::size_t count, std::uint64_t seed);
 std::vector<gpu::GpuRay> shadowBenchRays(const scene::Bounds& bounds, std::size_t count, std::uint64_t seed);
@@ -23,4 +23,4 @@ std::vector<gpu::GpuRay> shadowBenchRays(const scene::Bounds& bounds, std::size_
 // Binary file: count x 8 little-endian float32 (ox oy oz tmin dx dy dz tmax), i.e. GpuRay[].
 void saveRays(const std::string& path, const std::vector<gpu::GpuRay>& rays);
 
-} // namespace obscura::render
+} // namespace obscura::bench

@@ -4,7 +4,7 @@
 #pragma once
 #include <sys/resource.h>
 
-namespace obscura::render {
+namespace obscura::bench {
 
 inline double processCpuMs() {
   rusage u{};
@@ -13,4 +13,4 @@ inline double processCpuMs() {
   return ms(u.ru_utime) + ms(u.ru_stime);
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench

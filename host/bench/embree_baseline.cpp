@@ -8,7 +8,7 @@
 #include "bench/cpu_time.h"
 #include "bench/embree_scene.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 namespace {
 
 RTCRay toRtcRay(const gpu::GpuRay& r) {
@@ -101,5 +101,5 @@ EmbreeBaselineResult runEmbreeBaseline(const scene::Scene& scene, const std::vec
   return result;
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench
 #endif // OBSCURA_HAVE_EMBREE

@@ -8,7 +8,7 @@
 #include "shared/host_device.h"
 #include "scene/scene.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 struct EmbreeSetResult {
   double bestMs = 0.0, medianMs = 0.0;
@@ -29,4 +29,4 @@ EmbreeBaselineResult runEmbreeBaseline(const scene::Scene& scene, const std::vec
                                        const std::vector<gpu::GpuRay>& shadowRays, int repeats,
                                        unsigned threads = 0);
 
-} // namespace obscura::render
+} // namespace obscura::bench

@@ -8,7 +8,7 @@
 #include "bench/cpu_time.h"
 #include "bench/embree_scene.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 namespace {
 
 // Closest hit of one ray; t = +inf on a miss.
@@ -115,5 +115,5 @@ EmbreeFrameResult runEmbreeFrame(const scene::Scene& scene, const ObscuranceFram
   return result;
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench
 #endif // OBSCURA_HAVE_EMBREE

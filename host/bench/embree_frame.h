@@ -10,7 +10,7 @@
 #include "bench/frame_rays.h"
 #include "scene/scene.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 struct EmbreeFrameResult {
   double bestMs = 0.0, medianMs = 0.0; // wall time of the frame, best and median of the repeats
@@ -28,4 +28,4 @@ struct EmbreeFrameResult {
 EmbreeFrameResult runEmbreeFrame(const scene::Scene& scene, const ObscuranceFrameWork& work, int repeats,
                                  unsigned threads = 0);
 
-} // namespace obscura::render
+} // namespace obscura::bench

@@ -5,7 +5,7 @@
 
 #include "core/error.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 EmbreeScene::EmbreeScene(const scene::Scene& scene, unsigned threads)
     : threads_(threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : threads) {
@@ -45,5 +45,5 @@ void EmbreeScene::check(const char* what) const {
   if (e != RTC_ERROR_NONE) throw DeviceError(fmt::format("Embree: {} failed (error {})", what, static_cast<int>(e)));
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench
 #endif // OBSCURA_HAVE_EMBREE

@@ -16,7 +16,7 @@
 
 #include "scene/scene.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 // Owns the device and the committed scene (RTC_BUILD_QUALITY_MEDIUM, Embree's default).
 class EmbreeScene {
@@ -63,5 +63,5 @@ double parallelChunks(std::size_t n, unsigned threads, std::size_t chunk, Body b
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench
 #endif // OBSCURA_HAVE_EMBREE

@@ -3,7 +3,7 @@
 #include <bit>
 #include <cmath>
 
-namespace obscura::render {
+namespace obscura::bench {
 namespace {
 
 constexpr float kPi = 3.14159265358979323846f;
@@ -89,4 +89,4 @@ glm::vec3 ObscuranceRaySet::direction(std::uint32_t i) const {
   return local.x * t_ + local.y * b_ + local.z * n_;
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench

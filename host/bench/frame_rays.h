@@ -15,7 +15,7 @@
 
 #include "shared/host_device.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 // What the obscurance-only frame asks for (the issue's: 8 spp x 5 rays, dMax 2).
 struct ObscuranceFrameWork {
@@ -53,4 +53,4 @@ private:
   glm::vec3 origin_, t_, b_, n_;
 };
 
-} // namespace obscura::render
+} // namespace obscura::bench

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace obscura::render {
+namespace obscura::bench {
 namespace {
 
 bool atEdge(float u, float v) { return std::min({u, v, 1.0f - u - v}) <= kEdgeBarycentric; }
@@ -66,4 +66,4 @@ ExactHit exactHit(const bvh::Ray& ray, const bvh::TriangleSoup& soup, std::uint3
   return {glm::dot(e2, q) / det, std::min({u, v, 1.0 - u - v}) >= -double(kEdgeBarycentric)};
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench

@@ -15,7 +15,7 @@
 #include "bvh/bvh.h"
 #include "shared/host_device.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 enum class HitAgreement {
   Same,            // the same triangle (or both missed / both occluded)
@@ -48,4 +48,4 @@ HitAgreement closestHitAgreement(const bvh::Ray& ray, const bvh::Hit& cpu, const
 HitAgreement anyHitAgreement(const bvh::Ray& ray, bool cpuOccluded, const bvh::Hit& cpuClosest,
                              const gpu::GpuHit& gpu);
 
-} // namespace obscura::render
+} // namespace obscura::bench

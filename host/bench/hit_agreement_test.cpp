@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-namespace obscura::render {
+namespace obscura::bench {
 namespace {
 
 const bvh::Ray kRay{glm::vec3(0.0f), glm::vec3(0.0f, 0.0f, 1.0f), 0.0f, 10.0f};
@@ -74,4 +74,4 @@ TEST(HitAgreement, ShadowRaysDisagreeWithinPrecisionOnlyAtAnEdgeOrAnEnd) {
 }
 
 } // namespace
-} // namespace obscura::render
+} // namespace obscura::bench

@@ -5,7 +5,7 @@
 #include <limits>
 #include <numeric>
 
-namespace obscura::render {
+namespace obscura::bench {
 namespace {
 
 constexpr std::size_t kLanes = 8;
@@ -162,4 +162,4 @@ std::vector<LaneOrderFigures> measureLaneOrders(RayTracer& tracer, const scene::
   return out;
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench

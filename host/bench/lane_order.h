@@ -16,7 +16,7 @@
 #include "bench/ray_tracer.h"
 #include "scene/scene.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 struct LaneOrderFigures {
   std::string name;       // which rays, in which order
@@ -34,4 +34,4 @@ struct LaneOrderFigures {
 std::vector<LaneOrderFigures> measureLaneOrders(RayTracer& tracer, const scene::Scene& scene,
                                                 const ObscuranceFrameWork& work, int repeats);
 
-} // namespace obscura::render
+} // namespace obscura::bench

@@ -10,17 +10,11 @@
 #include "core/error.h"
 #include "render/obscurance_renderer.h"
 
-namespace obscura::render {
-
-double totalGpuMs(const RenderStats& stats) {
-  double ms = 0.0;
-  for (const auto& [name, pass] : stats.passes) ms += pass.gpuMs;
-  return ms;
-}
+namespace obscura::bench {
 
 ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
                                    const scene::Camera& camera, const ObscuranceFrameWork& work, int repeats) {
-  ObscuranceSettings settings;
+  render::ObscuranceSettings settings;
   settings.width = work.width;
   settings.height = work.height;
   settings.spp = work.spp;
@@ -29,14 +23,14 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
   settings.shadowRays = 0;
   settings.obscuranceRays = work.obscuranceRays;
   settings.dMax = work.dMax;
-  settings.rho = RhoKind::Sqrt;
+  settings.rho = render::RhoKind::Sqrt;
   settings.systematic = true;
   settings.colourBleeding = false;
   settings.maxDepth = 1; // the primary hit only: no specular pass
   settings.primaryAovs = false;
   settings.editableGeometry = false;
-  settings.ambient = AmbientModel::Global; // no light rays for the reach (not timed, not needed)
-  ObscuranceRenderer renderer(context, scene, bvh, settings);
+  settings.ambient = render::AmbientModel::Global; // no light rays for the reach (not timed, not needed)
+  render::ObscuranceRenderer renderer(context, scene, bvh, settings);
   renderer.iterate(1); // warm-up: the first dispatches fault the buffers in
 
   ObscuraFrameResult result;
@@ -47,7 +41,7 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
     const double c0 = processCpuMs();
     renderer.iterate(work.spp);
     result.bestCpuMs = std::min(result.bestCpuMs, processCpuMs() - c0);
-    const RenderStats stats = renderer.stats();
+    const render::RenderStats stats = renderer.stats();
     if (stats.truncatedTraversals > 0)
       throw DeviceError(fmt::format("{} traversals ran out of steps", stats.truncatedTraversals));
     const auto ms = [&](const char* pass) { return stats.passes.contains(pass) ? stats.passes.at(pass).gpuMs : 0.0; };
@@ -66,7 +60,7 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
   result.medianMs = times[times.size() / 2];
   renderer.compose();
   const io::Image image = renderer.image();
-  const int w = image.channelIndex(aovChannels("obscurance").front());
+  const int w = image.channelIndex(render::aovChannels("obscurance").front());
   if (w < 0) throw std::logic_error("runObscuraFrame: the frame has no obscurance AOV");
   result.obscurance.resize(std::size_t(work.width) * work.height);
   for (std::uint32_t y = 0; y < work.height; ++y)
@@ -75,9 +69,9 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
   return result;
 }
 
-RenderStats renderPaperBudget(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
-                              const scene::Camera& camera, std::uint32_t width, std::uint32_t height, int repeats) {
-  ObscuranceSettings settings; // the paper's budget is the defaults
+render::RenderStats renderPaperBudget(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+                                      const scene::Camera& camera, std::uint32_t width, std::uint32_t height, int repeats) {
+  render::ObscuranceSettings settings; // the paper's budget is the defaults
   settings.width = width;
   settings.height = height;
   settings.camera = camera;
@@ -85,23 +79,23 @@ RenderStats renderPaperBudget(const gpu::Context& context, const scene::Scene& s
   settings.editableGeometry = false;
   settings.primaryAovs = false;
   settings.composedAovs = false;
-  ObscuranceRenderer renderer(context, scene, bvh, settings);
+  render::ObscuranceRenderer renderer(context, scene, bvh, settings);
   // Warm-up: pipelines, caches, and a GPU's clocks, which are down after a pause (bench-rays checks
   // its rays on the CPU before) and take a few hundred ms of work to come up.
   const auto start = std::chrono::steady_clock::now();
   do renderer.iterate(1);
   while (context.info().type != "cpu" && std::chrono::steady_clock::now() - start < std::chrono::milliseconds(400));
-  RenderStats best;
+  render::RenderStats best;
   for (int k = 0; k < std::max(1, repeats); ++k) {
     renderer.reset();
     renderer.iterate(settings.spp);
     renderer.compose(); // and the frame from its sums, tonemapped, as the render's last step
-    RenderStats stats = renderer.stats();
+    render::RenderStats stats = renderer.stats();
     if (stats.truncatedTraversals > 0)
       throw DeviceError(fmt::format("{} traversals ran out of steps", stats.truncatedTraversals));
-    if (k == 0 || totalGpuMs(stats) < totalGpuMs(best)) best = std::move(stats);
+    if (k == 0 || stats.totalGpuMs() < best.totalGpuMs()) best = std::move(stats);
   }
   return best;
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench

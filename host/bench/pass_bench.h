@@ -12,7 +12,7 @@
 #include "render/aovs.h"
 #include "scene/scene.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 // The obscurance-only frame (`work`) traced by the primary and obscurance passes: no shadow ray,
 // no specular path, grey W (no colour bleeding: R(Q) is shading, not rays), primary AOVs off.
@@ -30,10 +30,8 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
 // hit, specular paths on glossy surfaces, default dMax) at width x height, rendered as `render -o
 // out.png --spp 8` renders it (the combined image only, composed and tonemapped); the stats of the
 // repeat with the least GPU time, after one warm-up sample.
-RenderStats renderPaperBudget(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
-                              const scene::Camera& camera, std::uint32_t width, std::uint32_t height, int repeats);
+render::RenderStats renderPaperBudget(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
+                                      const scene::Camera& camera, std::uint32_t width, std::uint32_t height,
+                                      int repeats);
 
-// Sum of the passes' GPU ms.
-double totalGpuMs(const RenderStats& stats);
-
-} // namespace obscura::render
+} // namespace obscura::bench

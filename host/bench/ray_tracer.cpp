@@ -6,12 +6,12 @@
 
 #include "trace.spv.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 namespace {
 gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::uint32_t compactStackVectors,
-                                Traversal traversal) {
-  auto bindings = sceneBindingKinds();
+                                render::Traversal traversal) {
+  auto bindings = render::sceneBindingKinds();
   // rays (two RGBA32F texels each), hits (one RGBA32F texel each), steps (R32UI): texel views,
   // which lavapipe reads and writes a texel per lane at a time (an SSBO: a word per lane at a time).
   bindings.push_back(gpu::BindingKind::UniformTexelBuffer);
@@ -26,18 +26,18 @@ gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::
                             {gpu::kSpecConstantTraceWorkgroupSize, shape.workgroupSize},
                             {gpu::kSpecConstantCompactStack, compactStackVectors},
                             {gpu::kSpecConstantBvhItemsFromStorage, shape.bvhItemsFromStorage ? 1u : 0u},
-                            {gpu::kSpecConstantBvhLayout, bvhLayoutOf(traversal)},
-                            {gpu::kSpecConstantBinaryLoop, binaryWhileWhile(traversal) ? 1u : 0u},
+                            {gpu::kSpecConstantBvhLayout, render::bvhLayoutOf(traversal)},
+                            {gpu::kSpecConstantBinaryLoop, render::binaryWhileWhile(traversal) ? 1u : 0u},
                             {gpu::kSpecConstantBinaryCullOnPop, shape.binaryCullOnPop ? 1u : 0u}}};
 }
 } // namespace
 
-TraceShape TraceShape::forDevice(const gpu::Context& context, Traversal traversal) {
-  if (traversal != Traversal::Wide) return forBinary();
+TraceShape TraceShape::forDevice(const gpu::Context& context, render::Traversal traversal) {
+  if (traversal != render::Traversal::Wide) return forBinary();
   return context.info().type == "cpu" ? forCpu() : forGpu();
 }
 
-RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape,
+RayTracer::RayTracer(const gpu::Context& context, const render::SceneBuffers& scene, std::optional<TraceShape> shape,
                      std::optional<std::uint32_t> compactStackVectors)
     : context_(&context), shape_(shape.value_or(TraceShape::forDevice(context, scene.traversal()))),
       kernel_(context, traceKernelDesc(shape_, false, compactStackVectors.value_or(scene.compactStackVectors()),
@@ -127,4 +127,4 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
   return result;
 }
 
-} // namespace obscura::render
+} // namespace obscura::bench

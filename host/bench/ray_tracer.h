@@ -9,7 +9,7 @@
 #include "gpu/timestamps.h"
 #include "render/scene/scene_buffers.h"
 
-namespace obscura::render {
+namespace obscura::bench {
 
 enum class TraceMode : std::uint32_t { Closest = 0, Any = 1 };
 
@@ -37,7 +37,7 @@ struct TraceShape {
   // ray gets); other shapes refill (lib/bvh_stream.glsl, traverseBinaryStream).
   static TraceShape forBinary() { return {gpu::kTraceBinaryWorkgroupSize, 1}; }
   // For the wide layout forCpu() on a CPU device, forGpu() otherwise; forBinary() for a binary one.
-  static TraceShape forDevice(const gpu::Context& context, Traversal traversal);
+  static TraceShape forDevice(const gpu::Context& context, render::Traversal traversal);
 };
 
 class RayTracer {
@@ -46,7 +46,7 @@ public:
   // `compactStackVectors` (kSpecConstantCompactStack) defaults to what the scene's BVH needs; a
   // test may force the general kernel (0) or any compact stack (which throws where the BVH
   // could overflow it).
-  RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape = {},
+  RayTracer(const gpu::Context& context, const render::SceneBuffers& scene, std::optional<TraceShape> shape = {},
             std::optional<std::uint32_t> compactStackVectors = {});
   const TraceShape& shape() const { return shape_; }
 
@@ -68,4 +68,4 @@ private:
   gpu::Timestamps timestamps_;
 };
 
-} // namespace obscura::render
+} // namespace obscura::bench

@@ -24,6 +24,17 @@ struct RenderStats {
   std::uint32_t truncatedTraversals = 0; // must be 0; reported so it can never go unnoticed
   std::uint64_t deviceBytes = 0;
   std::vector<std::string> notes;        // what the upload changed (e.g. textures reduced)
+
+  double totalGpuMs() const {
+    double ms = 0.0;
+    for (const auto& [name, pass] : passes) ms += pass.gpuMs;
+    return ms;
+  }
+  std::uint64_t totalRays() const {
+    std::uint64_t rays = 0;
+    for (const auto& [name, pass] : passes) rays += pass.rays;
+    return rays;
+  }
 };
 
 // Names of the primary pass's AOVs, in the order of the EXR layers.

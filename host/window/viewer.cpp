@@ -28,18 +28,6 @@ using Kind = ViewerAction::Kind;
 // Light slots reserved for lights added in the window (each holds a basis buffer per pixel).
 constexpr std::uint32_t kSpareLightSlots = 8;
 
-std::uint64_t totalRays(const render::RenderStats& stats) {
-  std::uint64_t rays = 0;
-  for (const auto& [name, pass] : stats.passes) rays += pass.rays;
-  return rays;
-}
-
-double totalGpuMs(const render::RenderStats& stats) {
-  double ms = 0.0;
-  for (const auto& [name, pass] : stats.passes) ms += pass.gpuMs;
-  return ms;
-}
-
 } // namespace
 
 struct Viewer::FrameRecord {
@@ -336,8 +324,8 @@ PanelState Viewer::panelState() const {
   const auto stats = currentStats();
   s.passes = stats.passes;
   if (config_.denoise && config_.method == render::Method::Obscurance) s.passes["denoise (last frame)"] = {denoiser_->lastGpuMs(), 0};
-  const double ms = totalGpuMs(stats);
-  s.raysPerSecond = ms > 0 ? double(totalRays(stats)) / (ms * 1e-3) : 0.0;
+  const double ms = stats.totalGpuMs();
+  s.raysPerSecond = ms > 0 ? double(stats.totalRays()) / (ms * 1e-3) : 0.0;
   for (const auto& l : session_->lights())
     s.lights.push_back({l.name, l.scale, l.color, l.added && !l.area, l.light.position});
   for (const auto& c : session_->scene().cameras) s.cameras.push_back(c.name);
@@ -480,8 +468,8 @@ void Viewer::run() {
     renderStep(record);
     const render::RenderStats after = currentStats();
     // A restart zeroes the renderer's counters: then all it counts is this frame's.
-    record.rays = totalRays(after) - (record.restarted ? 0 : totalRays(before));
-    record.gpuMs = totalGpuMs(after) - (record.restarted ? 0.0 : totalGpuMs(before));
+    record.rays = after.totalRays() - (record.restarted ? 0 : before.totalRays());
+    record.gpuMs = after.totalGpuMs() - (record.restarted ? 0.0 : before.totalGpuMs());
     for (const auto& [name, pass] : after.passes) {
       const auto was = before.passes.find(name);
       const double ms = pass.gpuMs - (record.restarted || was == before.passes.end() ? 0.0 : was->second.gpuMs);

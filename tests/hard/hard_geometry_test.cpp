@@ -104,8 +104,8 @@ protected:
     Traced out;
     out.tree = bvh::build(render::triangleSoup(s), options);
     render::SceneBuffers buffers(context(), s, out.tree);
-    render::RayTracer tracer(context(), buffers);
-    out.hits = tracer.trace(rays, render::TraceMode::Closest).hits;
+    bench::RayTracer tracer(context(), buffers);
+    out.hits = tracer.trace(rays, bench::TraceMode::Closest).hits;
     out.truncatedStatus = buffers.truncatedTraversals();
     return out;
   }

@@ -77,7 +77,7 @@ protected:
   // emitter: the denoiser adds the seen emission back as it is, and at 1 spp the outline of a
   // lamp (its coverage) is the noisiest thing in the Cornell box: 60 pixels of it make 90 % of
   // the RMSE there, the same before and after.
-  std::pair<render::ImageError, render::ImageError> errors(const Loaded& l, const render::ObscuranceSettings& s,
+  std::pair<analysis::ImageError, analysis::ImageError> errors(const Loaded& l, const render::ObscuranceSettings& s,
                                                            const Converged& reference) {
     render::ObscuranceRenderer renderer(context(), l.scene, l.bvh, s);
     renderer.render();
@@ -85,7 +85,7 @@ protected:
     denoiser.denoise(renderer);
     const io::Image noisy = withPixelsOf(channelsOf(renderer.image()), reference.combined, reference.emissive);
     const io::Image denoised = withPixelsOf(denoiser.image(), reference.combined, reference.emissive);
-    return {render::imageError(noisy, reference.combined), render::imageError(denoised, reference.combined)};
+    return {analysis::imageError(noisy, reference.combined), analysis::imageError(denoised, reference.combined)};
   }
 
   Converged converged(const Loaded& l, render::ObscuranceSettings s, std::uint32_t spp) {
