@@ -18,7 +18,7 @@
 
 #include "app/commands.h"
 #include "scene/scene_edit.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
 #include "bench/bench_rays.h"

@@ -10,7 +10,7 @@ namespace obscura::app {
 struct DeviceOptions {
   std::string device;
   bool validate = false;
-  std::string traversal; // render/scene/bvh_layout.h: "" or "auto" = the device's
+  std::string traversal; // render/scene_data/bvh_layout.h: "" or "auto" = the device's
   gpu::ContextOptions contextOptions() const { return {.validate = validate, .device = device, .traversal = traversal}; }
 };
 void addDeviceOptions(CLI::App& command, DeviceOptions& options);

@@ -4,7 +4,7 @@
 #include <fmt/ranges.h>
 
 #include "app/commands.h"
-#include "render/scene/bvh_layout.h"
+#include "render/scene_data/bvh_layout.h"
 
 namespace obscura::app {
 

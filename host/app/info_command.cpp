@@ -6,7 +6,7 @@
 #include "app/commands.h"
 #include "app/scene_setup.h"
 #include "render/obscurance_renderer.h"
-#include "render/scene/light_set.h"
+#include "render/scene_data/light_set.h"
 #include "relight/relight_state.h"
 #include "scene/scene_edit.h"
 

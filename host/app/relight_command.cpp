@@ -21,8 +21,8 @@
 #include "io/image_io.h"
 #include "relight/light_edits.h"
 #include "relight/relight_state.h"
-#include "render/scene/bvh_layout.h"
-#include "render/scene/light_set.h"
+#include "render/scene_data/bvh_layout.h"
+#include "render/scene_data/light_set.h"
 #include "render/transport.h"
 #include "session/edit_session.h"
 

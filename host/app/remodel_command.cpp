@@ -31,7 +31,7 @@
 #include "relight/light_edits.h"
 #include "session/light_controls.h"
 #include "session/scene_history.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene_edit.h"
 

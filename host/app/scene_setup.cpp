@@ -4,8 +4,8 @@
 
 #include <fmt/core.h>
 
-#include "render/scene/bvh_layout.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/bvh_layout.h"
+#include "render/scene_data/scene_buffers.h"
 #include "scene/gltf_loader.h"
 #include "scene/light_groups.h"
 #include "scene/scene_edit.h"

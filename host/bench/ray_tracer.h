@@ -7,7 +7,7 @@
 
 #include "gpu/kernel.h"
 #include "gpu/timestamps.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 
 namespace obscura::bench {
 

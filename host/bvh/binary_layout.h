@@ -1,5 +1,5 @@
 // binary_layout.h — the binary GPU layout of a built BVH (gpu::BvhBinaryNode, kBvhLayoutBinary),
-// the one a GPU traverses (render/scene/bvh_layout.h chooses), and its CPU twin traversal.
+// the one a GPU traverses (render/scene_data/bvh_layout.h chooses), and its CPU twin traversal.
 //
 // The layout is derived from the wide tree, not built anew: every wide node becomes a small
 // binary tree over its (up to 8) children, found by agglomerative clustering (the pair whose

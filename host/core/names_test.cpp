@@ -12,7 +12,7 @@
 #include "recover/reflectance_recovery.h"
 #include "render/method.h"
 #include "render/obscurance_renderer.h"
-#include "render/scene/bvh_layout.h"
+#include "render/scene_data/bvh_layout.h"
 
 namespace obscura {
 namespace {

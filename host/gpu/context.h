@@ -44,7 +44,7 @@ struct ContextOptions {
   std::function<bool(const vk::raii::PhysicalDevice&, std::uint32_t family)> canPresent;
   std::vector<const char*> instanceExtensions; // e.g. the window system's surface extensions
   // The BVH layout and traversal loop the kernels use on this device: "" or "auto" for the
-  // device's own (render/scene/bvh_layout.h, which also reads and checks the name), else one it
+  // device's own (render/scene_data/bvh_layout.h, which also reads and checks the name), else one it
   // names. Kept by the context because it is a property of how this device is driven.
   std::string traversal;
 };

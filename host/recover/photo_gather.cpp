@@ -7,7 +7,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "recover/recovery_scene.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 
 namespace obscura::recover {
 namespace {

@@ -30,7 +30,7 @@
 #include "recover/confidence_filters.h"
 #include "recover/photo_gather.h"
 #include "recover/photo_set.h"
-#include "render/scene/ambient.h"
+#include "render/scene_data/ambient.h"
 #include "scene/scene.h"
 
 namespace obscura::recover {

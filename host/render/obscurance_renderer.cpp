@@ -9,8 +9,8 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "render/scene/light_tree.h"
-#include "render/scene/secondary_reflectors.h"
+#include "render/scene_data/light_tree.h"
+#include "render/scene_data/secondary_reflectors.h"
 #include "shading/bsdf.h"
 
 namespace obscura::render {

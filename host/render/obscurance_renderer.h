@@ -42,10 +42,10 @@
 #include "render/passes/shadow_pass.h"
 #include "render/passes/specular_pass.h"
 #include "render/passes/tonemap_pass.h"
-#include "render/scene/ambient.h"
-#include "render/scene/free_path.h"
-#include "render/scene/light_set.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/ambient.h"
+#include "render/scene_data/free_path.h"
+#include "render/scene_data/light_set.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/transport.h"
 #include "core/names.h"
 #include "scene/scene.h"
@@ -100,7 +100,7 @@ struct ObscuranceSettings {
   RhoKind rho = RhoKind::Sqrt;
   float tau = 3.0f;                  // for RhoKind::Exp
   float dMax = 0.0f;                 // 0 = half the median free path seen from the camera the
-                                     // renderer was made with (render/scene/free_path.h)
+                                     // renderer was made with (render/scene_data/free_path.h)
   bool systematic = true;            // [RTO §4.2]
   bool colourBleeding = true;        // W_c [RTO eq. 6]; false: grey W [RTO eq. 2]
   std::uint32_t maxDepth = 6;        // specular paths: scattering vertices, the primary hit is 1
@@ -128,7 +128,7 @@ struct ObscuranceSettings {
   ShadowSampling shadowSampling = ShadowSampling::Selection;
   LightSampling lightSampling = LightSampling::Spatial;
   AmbientModel ambient = AmbientModel::Reached; // which surfaces share a light's flux in I_a
-  // Important secondary reflectors [RTO §2.2, §6] (render/scene/secondary_reflectors.h): 0 = off;
+  // Important secondary reflectors [RTO §2.2, §6] (render/scene_data/secondary_reflectors.h): 0 = off;
   // > 0 = the marking threshold (a triangle lit at least this many times its light's mean direct
   // irradiance is marked). Needs ShadowSampling::Selection. With them on, adding or removing a
   // light and a geometry edit mark anew and retrace every pixel.

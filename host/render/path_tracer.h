@@ -13,9 +13,9 @@
 #include "gpu/timestamps.h"
 #include "render/aovs.h"
 #include "render/frame/frame_layout.h"
-#include "render/scene/light_set.h"
-#include "render/scene/light_tree.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/light_set.h"
+#include "render/scene_data/light_tree.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/status_counters.h"
 #include "scene/scene.h"
 

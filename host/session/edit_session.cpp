@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "render/scene/light_set.h"
+#include "render/scene_data/light_set.h"
 
 namespace obscura::session {
 namespace {

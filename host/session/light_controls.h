@@ -1,6 +1,6 @@
 // light_controls.h — the lights of a scene being edited, addressed by name: each light's own
 // emission and the intensity and colour multipliers edits set on it. The order is the renderer's
-// (area lights first, then punctual ones, as render/scene/light_set.h builds them), which an
+// (area lights first, then punctual ones, as render/scene_data/light_set.h builds them), which an
 // EditSession keeps in step with the renderer's; nothing outside the session sees an index.
 #pragma once
 #include <cstddef>

@@ -3,7 +3,7 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "scene/scene_edit.h"
 
 namespace obscura::session {

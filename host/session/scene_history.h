@@ -1,7 +1,7 @@
 // scene_history.h — the scene being edited and its BVH, one version per geometry edit, and the
 // choice of how the BVH follows an edit: a move or a removal keeps every triangle, so the tree is
 // refitted (bvh/refit.cpp); an insert or an emissive quad adds triangles, so it is rebuilt with
-// the options the device's traversal wants (render/scene/bvh_layout.h). A renderer holds
+// the options the device's traversal wants (render/scene_data/bvh_layout.h). A renderer holds
 // pointers to the newest version; the one before stays until dropPrevious(), once the renderer
 // has moved on to the new one.
 #pragma once

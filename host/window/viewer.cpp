@@ -10,7 +10,7 @@
 #include <GLFW/glfw3.h> // the key codes alone: input arrives through the FrameTarget
 
 #include "bvh/bvh.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "core/error.h"
 #include "io/image_io.h"
 #include "render/aovs.h"

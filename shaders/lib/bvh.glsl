@@ -275,7 +275,7 @@ uvec2 popRegisterStack(inout uvec4 s0, inout uvec4 s1, inout uvec4 s2, inout uve
 // children's exact boxes, so one fetch of 64 bytes decides both (Aila & Laine, "Understanding the
 // Efficiency of Ray Traversal on GPUs", HPG 2009), the nearer child is visited first and the
 // other pushed on a per-invocation array of kBinaryStackSize (which the host keeps deeper trees
-// from: render/scene/bvh_layout.cpp). The CPU twin is host/bvh/binary_layout.cpp.
+// from: render/scene_data/bvh_layout.cpp). The CPU twin is host/bvh/binary_layout.cpp.
 layout(constant_id = kSpecConstantBvhLayout) const uint kBvhLayout = kBvhLayoutWide;
 const bool kBinaryLayout = kBvhLayout == kBvhLayoutBinary;
 // The binary loop's shape (kSpecConstantBinaryLoop): false, ONE loop whose pass visits a node or

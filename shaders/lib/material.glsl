@@ -57,7 +57,7 @@ vec3 materialEmission(GpuMaterial m, vec2 uv, bool frontFacing) {
 }
 
 // Emission in unit-emission terms for a light whose render-time scale is `scale` (E_s): divided
-// by it per channel, 1 where E_s is 0 (the rule of render/scene/light_set.cpp unitRadiance), so
+// by it per channel, 1 where E_s is 0 (the rule of render/scene_data/light_set.cpp unitRadiance), so
 // that compose's sum_s E_s M_s gives back the emission with the scene's own E_s.
 vec3 unitEmission(vec3 emission, vec3 scale) {
   return emission / mix(scale, vec3(1.0), equal(scale, vec3(0.0)));

@@ -104,7 +104,7 @@ OBS_CONST uint kBinaryLeafBit = 0x80000000u;
 OBS_CONST uint kBinaryLeafCountShift = 28u;   // 3 bits: 1..kLeafMaxTriangles triangles
 OBS_CONST uint kBinaryLeafTexelMask = 0x0FFFFFFFu;
 // The binary traversal's stack (an array per invocation): a traversal pushes at most depth - 1
-// entries, and a scene whose binary tree is deeper keeps the wide layout (render/scene/bvh_layout.h).
+// entries, and a scene whose binary tree is deeper keeps the wide layout (render/scene_data/bvh_layout.h).
 OBS_CONST uint kBinaryStackSize = 64;
 // Which layout and traversal loop a kernel is specialised for (kSpecConstantBvhLayout).
 OBS_CONST uint kBvhLayoutWide = 0u;
@@ -160,7 +160,7 @@ OBS_CONST uint kLightSamplingArea = 1u;
 // 2 x depth nodes per sample (lavapipe's loop limiter counts each light or node visited).
 OBS_CONST uint kMaxSpatialLights = 64u;
 // The importance bound of a spot reaches this cosine past its outer cone (rounding slack; no
-// cosine factor inside the cone): lights.glsl and its C++ twin, render/scene/light_selection.h.
+// cosine factor inside the cone): lights.glsl and its C++ twin, render/scene_data/light_selection.h.
 OBS_CONST float kSpotConeSlack = 0.99999f;
 // Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013: scaling a box's far distance by 1 + 2 gamma(n)
 // makes the float slab test conservative, so rounding never culls a box the ray touches. Ize's
@@ -197,7 +197,7 @@ OBS_CONST uint kTexelsPerEmitter = 4;
 // ---- Light tree: a binary BVH over the bounded lights (area, point, spot) for spatial selection
 // with more than kMaxSpatialLights lights (Conty Estevez & Kulla, "Importance Sampling of Many
 // Lights with Adaptive Tree Splitting", HPG 2018; pbrt-v4's BVHLightSampler). Built on the host
-// (host/render/scene/light_tree.cpp), read by lights.glsl. One array of nodes (binding
+// (host/render/scene_data/light_tree.cpp), read by lights.glsl. One array of nodes (binding
 // kBindingLightTree / kBindingPathLightTree):
 // - row 0: the header: refs = (root row or kInvalidIndex when no bounded light has power, the
 //   number U of unbounded lights with power, the light count it was built for, the tree's depth);
@@ -460,7 +460,7 @@ OBS_CONST uint kSpecConstantTexturesAbsent = 14u;
 OBS_CONST uint kTexturesAbsentBaseColor = 1u;
 OBS_CONST uint kTexturesAbsentEmissive = 2u;
 // The BVH layout and traversal loop (kBvhLayoutWide, the default, or kBvhLayoutBinary) the
-// scene's items buffer holds: render/scene/bvh_layout.h chooses per device.
+// scene's items buffer holds: render/scene_data/bvh_layout.h chooses per device.
 OBS_CONST uint kSpecConstantBvhLayout = 15u;
 // The binary traversal's loop (a bool): false, one loop (what lavapipe's loop limiter needs),
 // true, Aila & Laine's while-while (lib/bvh.glsl, traverseBinary).

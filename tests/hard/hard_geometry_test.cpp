@@ -20,7 +20,7 @@
 #include "gpu_test.h"
 #include "render/test_scenes.h"
 #include "bench/ray_tracer.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
 namespace obscura::test {

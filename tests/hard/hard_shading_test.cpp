@@ -13,8 +13,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
-#include "render/scene/ambient.h"
-#include "render/scene/reached_surfaces.h"
+#include "render/scene_data/ambient.h"
+#include "render/scene_data/reached_surfaces.h"
 #include "shading/bsdf.h"
 
 #include "render/one_shot.h"
@@ -22,7 +22,7 @@
 #include "gpu_test.h"
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 #include "scene/gltf_loader.h"
 

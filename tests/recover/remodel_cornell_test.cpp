@@ -12,7 +12,7 @@
 
 #include "bvh/bvh.h"
 #include "recover/remodel.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "scene/scene_edit.h"
 #include "recover_cornell_fixture.h"
 

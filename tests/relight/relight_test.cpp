@@ -10,7 +10,7 @@
 #include "gpu_test.h"
 #include "render/obscurance_renderer.h"
 #include "render/one_shot.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 #include "render/transport.h"
 #include "scene/scene_edit.h"

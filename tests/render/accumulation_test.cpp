@@ -12,7 +12,7 @@
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "render/aovs.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 
 namespace obscura::test {

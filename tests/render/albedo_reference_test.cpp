@@ -10,7 +10,7 @@
 #include "gpu_test.h"
 #include "io/image_io.h"
 #include "render/aovs.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
 namespace obscura::test {

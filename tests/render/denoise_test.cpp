@@ -15,7 +15,7 @@
 #include "gpu_test.h"
 #include "render/denoise/denoiser.h"
 #include "render/obscurance_renderer.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 #include "scene/gltf_loader.h"
 

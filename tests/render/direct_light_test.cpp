@@ -17,7 +17,7 @@
 #include "render/obscurance_renderer.h"
 #include "render/one_shot.h"
 #include "render/passes/shading_inputs.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 
 namespace obscura::test {

@@ -1,5 +1,5 @@
-// The light tree (render/scene/light_tree.h) and its selection (shaders/lib/lights.glsl beyond
-// kMaxSpatialLights lights, twinned in render/scene/light_selection.h):
+// The light tree (render/scene_data/light_tree.h) and its selection (shaders/lib/lights.glsl beyond
+// kMaxSpatialLights lights, twinned in render/scene_data/light_selection.h):
 // - the tree holds every light with power in one leaf whose trail leads to it, each node bounds
 //   its children (sphere, cone, power) and no leaf is deeper than the 32 trail bits;
 // - at any point the selection pdfs of all lights and the share of descents that end at no light
@@ -26,10 +26,10 @@
 #include "light_tree_test.spv.h"
 #include "render/obscurance_renderer.h"
 #include "render/one_shot.h"
-#include "render/scene/light_selection.h"
-#include "render/scene/light_set.h"
-#include "render/scene/light_tree.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/light_selection.h"
+#include "render/scene_data/light_set.h"
+#include "render/scene_data/light_tree.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 
 namespace obscura::test {

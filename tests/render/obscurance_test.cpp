@@ -11,7 +11,7 @@
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "render/obscurance_renderer.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 #include "scene/gltf_loader.h"
 

@@ -19,7 +19,7 @@
 #include "gpu_test.h"
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 #include "scene/gltf_loader.h"
 #include "shared/host_device.h"

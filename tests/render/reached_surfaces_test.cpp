@@ -1,4 +1,4 @@
-// The surfaces a light reaches (render/scene/reached_surfaces.h) and the ambient term built on
+// The surfaces a light reaches (render/scene_data/reached_surfaces.h) and the ambient term built on
 // them [RTO §6 future work], and the default dmax: two closed rooms of equal area, a lamp in one. The lamp reaches its
 // own room only, so its flux is shared by half the scene's area with that room's reflectance,
 // where the paper's formula spreads it over both rooms with their mean reflectance. In the lit
@@ -13,10 +13,10 @@
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "render/one_shot.h"
-#include "render/scene/ambient.h"
-#include "render/scene/free_path.h"
-#include "render/scene/reached_surfaces.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/ambient.h"
+#include "render/scene_data/free_path.h"
+#include "render/scene_data/reached_surfaces.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene_edit.h"
@@ -164,7 +164,7 @@ TEST(ReachedSurfaces, RemeasureAfterAMoveEqualsMeasuringTheMovedScene) {
   EXPECT_NE(stale.rays.firstSeenTry, fresh.rays.firstSeenTry) << "the move changes what some samples see";
 }
 
-// The default dmax (render/scene/free_path.h), on the same rooms: from inside a closed cube of side
+// The default dmax (render/scene_data/free_path.h), on the same rooms: from inside a closed cube of side
 // 2, half the median free path lies in the paper's 1/4 .. 1/2 of the side; classroom, whose 221 m
 // ground plane makes the paper's 1/4 of the box 55 m, gets a room-sized dmax.
 TEST(DefaultDMax, RoomSizedInsideARoomAndInClassroom) {

@@ -7,7 +7,7 @@
 
 #include "gpu_test.h"
 #include "render/passes/shading_inputs.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 #include "shadow.spv.h"
 

@@ -1,4 +1,4 @@
-// Important secondary reflectors [RTO §2.2, §6; render/scene/secondary_reflectors.h]: the paper's
+// Important secondary reflectors [RTO §2.2, §6; render/scene_data/secondary_reflectors.h]: the paper's
 // hard case, a lamp pointed at a wall. A closed room [0, 2]^3 with a small lamp 0.3 from its
 // x = 2 wall, facing it: every other surface is lit only by what that wall reflects.
 #include <cmath>
@@ -10,11 +10,11 @@
 #include "gpu_test.h"
 #include "render/one_shot.h"
 #include "render/obscurance_renderer.h"
-#include "render/scene/ambient.h"
-#include "render/scene/light_set.h"
-#include "render/scene/reached_surfaces.h"
-#include "render/scene/scene_buffers.h"
-#include "render/scene/secondary_reflectors.h"
+#include "render/scene_data/ambient.h"
+#include "render/scene_data/light_set.h"
+#include "render/scene_data/reached_surfaces.h"
+#include "render/scene_data/scene_buffers.h"
+#include "render/scene_data/secondary_reflectors.h"
 #include "render/test_scenes.h"
 
 namespace obscura::test {

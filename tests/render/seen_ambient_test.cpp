@@ -1,4 +1,4 @@
-// The Seen ambient model (render/scene/reached_surfaces.h, ambient.h): the first bounce of I_a
+// The Seen ambient model (render/scene_data/reached_surfaces.h, ambient.h): the first bounce of I_a
 // fitted to the light the lamp's landing points send to the surfaces the camera sees.
 //   - Its scale: in a closed room of one reflectance with a vanishing dmax (W_c = R everywhere),
 //     the fit is the mean over the seen points of E_1(P) / (pi R). The test measures E_1
@@ -14,9 +14,9 @@
 #include <gtest/gtest.h>
 
 #include "bvh/bvh.h"
-#include "render/scene/ambient.h"
-#include "render/scene/reached_surfaces.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/ambient.h"
+#include "render/scene_data/reached_surfaces.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 
 namespace obscura::test {

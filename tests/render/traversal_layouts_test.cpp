@@ -1,4 +1,4 @@
-// Traversal per device (render/scene/bvh_layout.h): the binary layout a GPU traverses renders the
+// Traversal per device (render/scene_data/bvh_layout.h): the binary layout a GPU traverses renders the
 // frames lavapipe's wide layout renders, bit for bit in every AOV. Both find every hit with the
 // same triangle test and the same tie rule (lower primitive id at equal t); only the order in
 // which they visit boxes differs, and a shadow ray's answer does not depend on it. Run here on
@@ -14,8 +14,8 @@
 #include "render/obscurance_renderer.h"
 #include "render/one_shot.h"
 #include "render/path_tracer.h"
-#include "render/scene/bvh_layout.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/bvh_layout.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/test_scenes.h"
 #include "scene/gltf_loader.h"
 

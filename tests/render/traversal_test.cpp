@@ -21,8 +21,8 @@
 #include "bench/bench_rays.h"
 #include "bench/ray_tracer.h"
 #include "core/error.h"
-#include "render/scene/bvh_layout.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/bvh_layout.h"
+#include "render/scene_data/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
 namespace obscura::test {
@@ -151,7 +151,7 @@ TEST_F(GpuTraversal, GpuAndOneRayPerInvocationShapesMatchBruteForce) {
   expectAgreement(traceAndCompare(soup, 100000, 1, fromStorage), "random soup, GPU shape, BVH from an SSBO");
 }
 
-// The binary layout with both its loops (render/scene/bvh_layout.h: a GPU's traversal), run here
+// The binary layout with both its loops (render/scene_data/bvh_layout.h: a GPU's traversal), run here
 // on lavapipe: the same closest hits as the brute force, the same occlusion as the CPU's any hit.
 TEST_F(GpuTraversal, BinaryLayoutMatchesBruteForceAndCpuAnyHit) {
   const scene::Scene soup = soupScene(randomSoup(3000, 1));

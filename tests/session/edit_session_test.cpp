@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "gpu_test.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "scene/gltf_loader.h"
 #include "session/edit_session.h"
 

@@ -12,7 +12,7 @@
 #include "gpu_test.h"
 #include "shared/host_device.h"
 #include "intersect_test.spv.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 #include "shaders/shader_runner.h"
 
 namespace obscura::test {

@@ -1,7 +1,7 @@
 #version 460
 // Runs the production lights.glsl selection (the light tree beyond kMaxSpatialLights lights, the
 // flat weights up to it) so tests/render/light_tree_test.cpp can compare it with the C++ twins
-// (render/scene/light_selection.h) and check its distribution.
+// (render/scene_data/light_selection.h) and check its distribution.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/sampling.glsl"

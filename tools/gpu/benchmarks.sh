@@ -6,7 +6,7 @@
 # "quick" shrinks every size (and lets modern-hall stand in for Sponza) so that the script itself
 # can be tried on lavapipe first, as tests/scripts/gpu_benchmarks_smoke.sh does.
 #
-#   bench-rays, both scenes, with the device's own traversal and tree (render/scene/bvh_layout.h)
+#   bench-rays, both scenes, with the device's own traversal and tree (render/scene_data/bvh_layout.h)
 #     and with each other traversal (--traversal): closest-hit and shadow rays per second (4M random
 #     rays, the best of 5 timed repeats, the first 100k checked against the CPU traversal, on
 #     Sponza the first 1M), on modern-hall the paper's budget at 800x600 per pass (--passes) with

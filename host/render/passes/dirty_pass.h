@@ -8,7 +8,7 @@
 
 #include "gpu/kernel.h"
 #include "render/frame/obscurance_frame.h"
-#include "render/scene/light_set.h"
+#include "render/scene_data/light_set.h"
 #include "scene/scene.h"
 #include "shared/host_device.h"
 

@@ -5,7 +5,7 @@
 
 #include "gpu/kernel.h"
 #include "render/frame/obscurance_frame.h"
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 
 namespace obscura::render {
 

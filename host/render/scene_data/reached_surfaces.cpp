@@ -1,6 +1,6 @@
-#include "render/scene/reached_surfaces.h"
+#include "render/scene_data/reached_surfaces.h"
 
-#include "render/scene/camera_grid.h"
+#include "render/scene_data/camera_grid.h"
 
 #include <algorithm>
 #include <cmath>

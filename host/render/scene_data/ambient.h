@@ -12,8 +12,8 @@
 
 #include <glm/glm.hpp>
 
-#include "render/scene/light_set.h"
-#include "render/scene/reached_surfaces.h"
+#include "render/scene_data/light_set.h"
+#include "render/scene_data/reached_surfaces.h"
 #include "core/names.h"
 #include "scene/scene.h"
 

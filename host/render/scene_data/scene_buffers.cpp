@@ -1,4 +1,4 @@
-#include "render/scene/scene_buffers.h"
+#include "render/scene_data/scene_buffers.h"
 
 #include <bit>
 #include <cmath>
@@ -11,7 +11,7 @@
 
 #include "core/error.h"
 #include "shading/bsdf.h"
-#include "render/scene/texture_fit.h"
+#include "render/scene_data/texture_fit.h"
 
 namespace obscura::render {
 

@@ -1,4 +1,4 @@
-#include "render/scene/texture_fit.h"
+#include "render/scene_data/texture_fit.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "render/scene/ambient.h"
+#include "render/scene_data/ambient.h"
 
 #include <cmath>
 #include <numbers>

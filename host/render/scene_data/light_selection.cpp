@@ -1,4 +1,4 @@
-#include "render/scene/light_selection.h"
+#include "render/scene_data/light_selection.h"
 
 #include <algorithm>
 #include <cmath>

@@ -26,7 +26,7 @@
 
 #include <glm/glm.hpp>
 
-#include "render/scene/reached_surfaces.h"
+#include "render/scene_data/reached_surfaces.h"
 #include "scene/scene.h"
 
 namespace obscura::render {

@@ -9,7 +9,7 @@
 #include "gpu/buffer.h"
 #include "gpu/context.h"
 #include "gpu/kernel.h"
-#include "render/scene/bvh_layout.h"
+#include "render/scene_data/bvh_layout.h"
 #include "render/status_counters.h"
 #include "scene/scene.h"
 

@@ -1,6 +1,6 @@
-#include "render/scene/free_path.h"
+#include "render/scene_data/free_path.h"
 
-#include "render/scene/camera_grid.h"
+#include "render/scene_data/camera_grid.h"
 
 #include <algorithm>
 #include <cmath>

@@ -47,7 +47,7 @@
 #include <glm/glm.hpp>
 
 #include "bvh/bvh.h"
-#include "render/scene/light_set.h"
+#include "render/scene_data/light_set.h"
 #include "scene/scene.h"
 
 namespace obscura::render {

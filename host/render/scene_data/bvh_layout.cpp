@@ -1,5 +1,5 @@
 // bvh_layout.cpp — the traversal per device and the binary layout's texels (bvh_layout.h).
-#include "render/scene/bvh_layout.h"
+#include "render/scene_data/bvh_layout.h"
 
 #include <bit>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "render/scene/light_tree.h"
+#include "render/scene_data/light_tree.h"
 
 #include <algorithm>
 #include <array>
@@ -9,7 +9,7 @@
 
 #include <glm/glm.hpp>
 
-#include "render/scene/light_selection.h"
+#include "render/scene_data/light_selection.h"
 
 namespace obscura::render {
 namespace {

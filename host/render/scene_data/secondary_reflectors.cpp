@@ -1,4 +1,4 @@
-#include "render/scene/secondary_reflectors.h"
+#include "render/scene_data/secondary_reflectors.h"
 
 #include <algorithm>
 #include <cmath>

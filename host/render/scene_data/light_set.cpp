@@ -1,4 +1,4 @@
-#include "render/scene/light_set.h"
+#include "render/scene_data/light_set.h"
 
 #include <algorithm>
 #include <bit>

@@ -1,4 +1,4 @@
-#include "render/scene/camera_grid.h"
+#include "render/scene_data/camera_grid.h"
 
 #include <cmath>
 
