@@ -41,7 +41,7 @@ constexpr std::optional<E> valueNamed(const NameTable<E, N>& table, std::string_
   return std::nullopt;
 }
 
-// Every name, in the table's order (the first is the default where an option has one).
+// Every name, in the table's order (the order --help and the panel list them in).
 template <typename E, std::size_t N> std::vector<std::string> namesOf(const NameTable<E, N>& table) {
   std::vector<std::string> names;
   for (const Named<E>& entry : table) names.emplace_back(entry.name);
