@@ -1,9 +1,6 @@
 #include "render/obscurance_renderer.h"
 
 #include <algorithm>
-#include <atomic>
-#include <future>
-#include <thread>
 #include <chrono>
 
 #include <fmt/format.h>
@@ -55,18 +52,6 @@ std::uint32_t keptRaySamples(const gpu::Context& context, const ObscuranceSettin
   return static_cast<std::uint32_t>(std::min<std::uint64_t>(settings.keptRaySamples, budget / std::max<std::uint64_t>(perSample, 1)));
 }
 
-// Runs an edit's GPU work while a reach measurement runs on threads of its own; on an exception,
-// waits for the measurement before passing it on (it reads the renderer).
-template <class T, class Work>
-void besideMeasurement(std::future<T>& measurement, Work&& gpuWork) {
-  try {
-    gpuWork();
-  } catch (...) {
-    if (measurement.valid()) measurement.wait();
-    throw;
-  }
-}
-
 } // namespace
 
 bool sceneHasGlossy(const scene::Scene& scene) {
@@ -95,15 +80,14 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
       obscurance_(context, shadingKernels()), specularPass_(context, shadingKernels()),
       compose_(context, frame_.layout().bandCount()), tonemap_(context, frame_.layout().bandCount()),
       resolve_(context, frame_.layout().bandCount()), lightMix_(context, frame_.layout().bandCount()),
-      dirty_(context, frame_.layout().bandCount()), sceneScale_(sceneScale(scene.bounds)),
+      geometry_(context, frame_.layout(), bvh), sceneScale_(sceneScale(scene.bounds)),
       stream_(context), timestamps_(context) {
-  bvhOrder_ = bvh.order;
-  bvhNodes_ = bvh.nodes.size();
   for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
   if (settings.ambient != AmbientModel::Global) ambient_.model = settings.ambient;
   defaultDMax_ = defaultDMax(scene, bvh, settings.camera); // first: the Seen fit needs dmax
-  if (settings.ambient != AmbientModel::Global || settings.secondaryReflectors > 0.0f) measureReach(scene, bvh);
+  if (settings.ambient != AmbientModel::Global || settings.secondaryReflectors > 0.0f)
+    reach_.measure(scene, bvh, reachInputs(), ambient_);
   emissions_ = lights_.emission;
   configure(settings);
   if (reflectorsOn()) markReflectors();
@@ -116,48 +100,10 @@ gpu::GpuCamera ObscuranceRenderer::primaryCamera() const {
                    sky < lights_.size() ? static_cast<std::uint32_t>(sky) : gpu::kInvalidIndex);
 }
 
-void ObscuranceRenderer::measureReach(const scene::Scene& scene, const bvh::Bvh& bvh,
-                                      const std::vector<scene::Bounds>* changed) {
-  applyReach(measureReachOf(scene, bvh, changed));
-}
-
-ObscuranceRenderer::ReachMeasurement ObscuranceRenderer::measureReachOf(const scene::Scene& scene, const bvh::Bvh& bvh,
-                                                                        const std::vector<scene::Bounds>* changed) const {
-  const auto start = Clock::now();
-  ReachMeasurement m;
-  // Every triangle's mean reflectance: a move or a removal keeps them (averaging modern-hall's
-  // textures takes ~0.25 s); an insert brings its own.
-  if (!changed || reachReflectance_.size() != scene.triangles.size()) {
-    std::vector<glm::vec3> meanAlbedo;
-    for (const auto& material : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(material));
-    m.reflectance = triangleReflectances(scene, meanAlbedo);
-  } else {
-    m.reflectance = reachReflectance_;
-  }
-  m.reached = std::make_unique<ReachedSurfaces>(scene, bvh, m.reflectance);
-  if (ambient_.model == AmbientModel::Seen) m.reached->setSeenView(seenView());
-  std::vector<scene::Bounds> padded;
-  if (changed && reached_) {
-    const float pad = changedBoxPadding();
-    for (scene::Bounds b : *changed) padded.push_back({b.lo - pad, b.hi + pad});
-  }
-  m.reach = reachOfEveryLight(*m.reached, changed ? reached_.get() : nullptr, padded);
-  for (const LightReach& r : m.reach) m.update.rays += r.rays.traced;
-  m.update.ms = 1e3 * secondsSince(start); // the reflectances and surface samples included
-  return m;
-}
-
-void ObscuranceRenderer::applyReach(ReachMeasurement m) {
-  reachReflectance_ = std::move(m.reflectance);
-  reached_ = std::move(m.reached);
-  ambient_.reach = std::move(m.reach);
-  ambient_.depth = settings_.maxDepth;
-  updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
-  lastReach_ = m.update;
-}
-
-void ObscuranceRenderer::finishReach() {
-  if (pendingReach_.valid()) applyReach(pendingReach_.get());
+LightReachModel::Inputs ObscuranceRenderer::reachInputs() const {
+  return {.lights = lights_,
+          .seen = ambient_.model == AmbientModel::Seen ? std::optional<SeenView>(seenView()) : std::nullopt,
+          .depth = settings_.maxDepth, .colourBleeding = settings_.colourBleeding};
 }
 
 SeenView ObscuranceRenderer::seenView() const {
@@ -169,44 +115,10 @@ SeenView ObscuranceRenderer::seenView() const {
           .averageReflectance = ambient_.averageReflectance};
 }
 
-std::vector<LightReach> ObscuranceRenderer::reachOfEveryLight(const ReachedSurfaces& reached,
-                                                             const ReachedSurfaces* before,
-                                                             const std::vector<scene::Bounds>& changed) const {
-  const bool incremental = before && ambient_.reach.size() == lights_.size();
-  const std::vector<LightReach>& previous = ambient_.reach;
-  // Lights spread over the cores (measure is const and draws its own numbers): the CPU rays of
-  // modern-hall's 13 lights take ~0.3 s on one core when measured whole.
-  std::vector<LightReach> reach(lights_.size());
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t s = next++; s < lights_.size(); s = next++)
-      reach[s] = incremental ? reached.remeasure(*before, previous[s], lights_, s, changed) : reached.measure(lights_, s);
-  };
-  std::vector<std::future<void>> workers;
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  for (unsigned w = 1; w < std::min<std::size_t>(cores, lights_.size()); ++w) workers.push_back(std::async(std::launch::async, worker));
-  worker();
-  for (auto& w : workers) w.get();
-  return reach;
-}
-
-void ObscuranceRenderer::measureAllReach() {
-  const auto start = Clock::now();
-  ambient_.reach = reachOfEveryLight(*reached_, nullptr, {});
-  updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
-  lastReach_ = {0, 1e3 * secondsSince(start)};
-  for (const LightReach& r : ambient_.reach) lastReach_.rays += r.rays.traced;
-}
-
-float ObscuranceRenderer::changedBoxPadding() const {
-  const scene::Bounds& bounds = scene_->bounds;
-  return 1e-3f * (glm::length(bounds.extent()) + glm::length(glm::max(glm::abs(bounds.lo), glm::abs(bounds.hi))));
-}
-
 void ObscuranceRenderer::markReflectors() {
   SecondaryReflectorMarks marks;
   if (reflectorsOn())
-    marks = markSecondaryReflectors(*scene_, ambient_.reach, settings_.secondaryReflectors, reached_->totalArea(),
+    marks = markSecondaryReflectors(*scene_, ambient_.reach, settings_.secondaryReflectors, reach_.surfaces().totalArea(),
                                     ambient_.model != AmbientModel::Global);
   reflectorsMarked_ = marks.count;
   unmarkedFirstBounce_ = marks.unmarkedFirstBounce;
@@ -242,7 +154,7 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
     throw InputError("secondary reflectors choose among all lights by importance, which per-light shadow sampling "
                      "(each light's transport independent of the others' power) does not allow");
   const bool bleedChanged = settings.colourBleeding != settings_.colourBleeding;
-  if (settings.secondaryReflectors > 0.0f && !reached_)
+  if (settings.secondaryReflectors > 0.0f && !reach_.measured())
     throw std::logic_error("ObscuranceRenderer::configure: secondary reflectors need the lights' reach; make the "
                            "renderer with them or with the Reached ambient model");
   const bool remark = settings.secondaryReflectors != settings_.secondaryReflectors;
@@ -250,12 +162,12 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
   settings_ = settings;
   if (remark) markReflectors();
   dMax_ = settings.dMax > 0.0f ? settings.dMax : defaultDMax_;
-  const bool depthChanged = ambient_.depth != (reached_ ? settings.maxDepth : 0u);
-  ambient_.depth = reached_ ? settings.maxDepth : 0u;
+  const bool depthChanged = ambient_.depth != (reach_.measured() ? settings.maxDepth : 0u);
+  ambient_.depth = reach_.measured() ? settings.maxDepth : 0u;
   // The Seen fit depends on the camera and the obscurance settings: fitted again when they change.
-  if (ambient_.model == AmbientModel::Seen && reached_ && !(fittedTo == seenView())) {
-    reached_->setSeenView(seenView());
-    measureAllReach();
+  if (ambient_.model == AmbientModel::Seen && reach_.measured() && !(fittedTo == seenView())) {
+    reach_.setSeenView(seenView());
+    reach_.measureAll(reachInputs(), ambient_);
   } else if (bleedChanged || depthChanged) {
     updateAmbientWeights(ambient_, lights_, settings.colourBleeding);
   }
@@ -269,7 +181,7 @@ void ObscuranceRenderer::markResolveStale(std::uint32_t fromLight, bool ambient)
 
 void ObscuranceRenderer::reset() {
   markResolveStale(0, true);
-  keptRaysValid_ = true; // the samples to come write them anew
+  geometry_.keptRaysRenderedAnew();
   samples_ = 0;
   gbufferSample_ = kNoSample;
   primaryRays_ = 0;
@@ -302,7 +214,7 @@ void ObscuranceRenderer::uploadLights() {
   lightBuffers_.tree = gpu::uploadArray(*context_, buildLightTree(lights_.lights), "lights.tree");
   lightBuffers_.scales = gpu::uploadArray(*context_, emissionRows(lights_.emission), "lights.render_scales");
   emissionBuffer_ = gpu::uploadArray(*context_, emissionRows(emissions_), "compose.emissions");
-  lightBounds_ = gpu::uploadArray(*context_, lightBounds(lights_), "dirty.light_bounds");
+  geometry_.setLights(*context_, lights_);
   bindAll();
 }
 
@@ -317,7 +229,7 @@ void ObscuranceRenderer::bindAll() {
     tonemap_.bind(b, frame_);
     resolve_.bind(b, frame_);
     lightMix_.bind(b, frame_, emissionBuffer_);
-    dirty_.bind(b, frame_, lightBounds_);
+    geometry_.bind(b, frame_);
   }
 }
 
@@ -332,7 +244,7 @@ std::uint32_t ObscuranceRenderer::keptRaysFlag(std::uint32_t sample, bool replay
   const bool kept = sample < frame_.contents().keptRaySamples && settings_.maxDepth <= gpu::kPathHitsPerSample + 1 &&
                     settings_.shadowRays <= frame_.contents().keptShadowRays &&
                     settings_.shadowSampling == ShadowSampling::Selection;
-  return kept && (!replaying || keptRaysValid_) ? gpu::kShadeFlagKeptRays : 0u;
+  return kept && (!replaying || geometry_.keptRaysValid()) ? gpu::kShadeFlagKeptRays : 0u;
 }
 
 gpu::ShadePush ObscuranceRenderer::forLight(gpu::ShadePush push, std::uint32_t light) {
@@ -467,7 +379,7 @@ std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, con
   const double wallBefore = wallSeconds_;
   const bool emittersMoved = replaceScene(edited, bvh, &changed);
   std::uint64_t retraced = 0;
-  besideMeasurement(pendingReach_, [&] { retraced = retraceDirty(changed, emittersMoved); });
+  reach_.beside([&] { retraced = retraceDirty(changed, emittersMoved); });
   finishReach();
   wallSeconds_ = wallBefore + secondsSince(start);
   return retraced;
@@ -500,23 +412,19 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
   const bool sameSurfaces = edited.materials.size() == scene_->materials.size() &&
                             edited.textures.size() == scene_->textures.size();
   scene_ = &edited;
-  // A rebuilt BVH lays the triangles out anew: the kept lobe hits name other triangles now.
-  if (bvh.nodes.size() != bvhNodes_ || bvh.order != bvhOrder_) {
-    keptRaysValid_ = false;
-    bvhOrder_ = bvh.order;
-    bvhNodes_ = bvh.nodes.size();
-  }
+  geometry_.useBvh(bvh); // a rebuilt BVH lays the triangles out anew: the kept lobe hits name other triangles
+
   // Moved occluders change what every light reaches: where the emitters and surfaces stayed, only
   // the rays that meet the changed boxes are traced again.
-  if (reached_) {
+  if (reach_.measured()) {
     const std::vector<scene::Bounds>* boxes = emittersMoved || !sameSurfaces ? nullptr : changed;
     if (reflectorsOn()) {
-      measureReach(edited, bvh, boxes); // markReflectors below needs it
+      reach_.measure(edited, bvh, reachInputs(), ambient_, boxes); // markReflectors below needs it
     } else {
       // Compose needs it, the passes do not: measured on threads of their own beside the GPU work
       // of the edit, and applied when that is done (finishReach). The edit's callers keep `edited`,
       // `bvh` and `changed` alive until then.
-      pendingReach_ = std::async(std::launch::async, [this, &edited, &bvh, boxes] { return measureReachOf(edited, bvh, boxes); });
+      reach_.start(edited, bvh, reachInputs(), ambient_, boxes);
     }
   }
   bool rebind = true;
@@ -536,90 +444,27 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
 
 std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>& changed, bool everyPixel,
                                                std::uint32_t tracedLight) {
-  const FrameLayout& layout = frame_.layout();
-  const gpu::GpuCamera camera = primaryCamera();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
-  // Ray origins leave their surfaces by a few hundred ulps of their coordinates (lib/ray.glsl):
-  // a changed box grown by 1e-3 of the scene's size and reach covers them.
-  const float dirtyPad = changedBoxPadding();
   // The sky lights every pixel from every direction: any edit may change any pixel.
   // So do secondary reflectors: what the edit lights or shades anew is marked anew.
   const bool all = everyPixel || backgroundLight(lights_) < lights_.size() || reflectorsOn();
-  // Probing replays the rays the frame traced, so not after addEmitter: its new light changed how
-  // lights are chosen, and the replayed rays would not be those traced.
-  // Auto probes where the frame has specular paths (a path that left the scene bounds nothing) or
-  // keeps every sample's rays (a probe then draws no light sample: cheaper than the retrace it saves).
   const bool keptAll = samples_ <= frame_.contents().keptRaySamples && keptRaysFlag(0, true) != 0;
-  const bool probing = settings_.dirtyTest == DirtyTest::Probe || (settings_.dirtyTest == DirtyTest::Auto && (runSpecular_ || keptAll));
-  const bool probe = probing && !all && tracedLight == gpu::kInvalidIndex && samples_ > 0;
-  for (std::uint32_t b = 0; b < layout.bandCount(); ++b)
-    dirty_.prepare(b, layout, camera, changed, dirtyPad, dMax_, lightCount, all, tracedLight, probe);
-  const std::uint32_t dirtyBefore = frame_.statusWords()[gpu::kStatusDirtyPixels];
-  const auto clear = [&](const vk::raii::CommandBuffer& cmd) {
-    gpu::computeBarrier(cmd);
-    for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.recordClear(cmd, b, layout, lightCount, runSpecular_);
-  };
-  stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
-    timestamps_.reset(cmd);
-    timestamps_.time(cmd, "dirty", [&] {
-      for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.record(cmd, b, layout);
-      if (!probe) clear(cmd);
-    });
-  });
-  timestamps_.collect();
-  if (probe) {
-    probeCandidates();
-    stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
-      timestamps_.reset(cmd);
-      timestamps_.time(cmd, "dirty", [&] {
-        for (std::uint32_t b = 0; b < layout.bandCount(); ++b) dirty_.recordList(cmd, b, layout);
-        clear(cmd);
-      });
-    });
-    timestamps_.collect();
-  }
-  const std::uint64_t retraced = frame_.statusWords()[gpu::kStatusDirtyPixels] - dirtyBefore;
-  const std::uint32_t primaryFlags = gpu::kPrimaryFlagDirtyOnly | (settings_.primaryAovs ? 0u : gpu::kPrimaryFlagNoAovs);
-  for (std::uint32_t first = 0; retraced > 0 && first < samples_; first += kSamplesPerSubmission) {
-    const std::uint32_t last = std::min(samples_, first + kSamplesPerSubmission);
-    stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
-      timestamps_.reset(cmd);
-      for (std::uint32_t s = first; s < last; ++s) {
-        gpu::computeBarrier(cmd);
-        recordSample(cmd, s, primaryFlags, gpu::kShadeFlagDirtyOnly);
-      }
-    });
-    timestamps_.collect();
-    primaryRays_ += retraced * (last - first) * cameraRaysPerSample();
-  }
-  // The retraced pixels' G-buffer now holds the last sample; the others' still hold theirs.
-  if (retraced > 0 && gbufferSample_ + 1 != samples_) gbufferSample_ = kNoSample;
+  const GeometryRetrace::Result r = geometry_.retrace(
+      {.stream = stream_, .timestamps = timestamps_, .recorder = *this, .buffers = frame_, .camera = primaryCamera(),
+       .lights = lightCount, .samples = samples_, .gbufferSample = gbufferSample_, .dMax = dMax_,
+       .changedBoxPadding = changedBoxPadding(scene_->bounds), .specular = runSpecular_,
+       .primaryAovs = settings_.primaryAovs},
+      {.changed = changed, .everyPixel = all, .tracedLight = tracedLight,
+       .probe = GeometryRetrace::probing(settings_.dirtyTest, runSpecular_, keptAll)});
+  primaryRays_ += r.pixels * samples_ * cameraRaysPerSample();
+  // The retraced pixels' (and the probed candidates') G-buffer now holds the last sample; the
+  // others' still hold theirs.
+  if ((r.probed || r.pixels > 0) && gbufferSample_ + 1 != samples_) gbufferSample_ = kNoSample;
   // Only the listed pixels changed: where the rest is resolved, the next light mix resolves them
   // alone (the lists stay until the next edit, so a second edit before it resolves everything).
-  if (resolveFrom_ >= lightCount && !resolveAmbient_ && !resolveDirty_) resolveDirty_ = retraced > 0;
+  if (resolveFrom_ >= lightCount && !resolveAmbient_ && !resolveDirty_) resolveDirty_ = r.pixels > 0;
   else markResolveStale(0, true);
-  return retraced;
-}
-
-void ObscuranceRenderer::probeCandidates() {
-  // Every sample in order over the candidates: the G-buffer holds sample 0 already only where the
-  // frame has one sample; else each sample's primary hits are traced again (G-buffer only: the
-  // candidates' camera rays miss the changed boxes, so they find what the frame's did).
-  const std::uint32_t primaryFlags = gpu::kPrimaryFlagDirtyOnly | gpu::kPrimaryFlagGBufferOnly;
-  const std::uint32_t shadeFlags = gpu::kShadeFlagDirtyOnly | gpu::kShadeFlagProbe;
-  for (std::uint32_t first = 0; first < samples_; first += kSamplesPerSubmission) {
-    const std::uint32_t last = std::min(samples_, first + kSamplesPerSubmission);
-    stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
-      timestamps_.reset(cmd);
-      for (std::uint32_t s = first; s < last; ++s) {
-        gpu::computeBarrier(cmd);
-        recordSample(cmd, s, primaryFlags, shadeFlags, !(s == 0 && gbufferSample_ == 0));
-      }
-    });
-    timestamps_.collect();
-  }
-  // The candidates' G-buffer now holds the last sample; the others' still hold theirs.
-  if (gbufferSample_ + 1 != samples_) gbufferSample_ = kNoSample;
+  return r.pixels;
 }
 
 void ObscuranceRenderer::render(const ProgressFn& progress) {
@@ -636,12 +481,12 @@ void ObscuranceRenderer::setEmissions(const std::vector<glm::vec3>& emissions) {
 }
 
 void ObscuranceRenderer::setAmbientModel(AmbientModel model) {
-  if (model != AmbientModel::Global && !reached_)
+  if (model != AmbientModel::Global && !reach_.measured())
     throw std::logic_error("setAmbientModel: this renderer did not measure what the lights reach");
   ambient_.model = model;
-  if (model == AmbientModel::Seen && reached_->seenPoints() == 0) { // fitted on first use
-    reached_->setSeenView(seenView());
-    measureAllReach();
+  if (model == AmbientModel::Seen && reach_.surfaces().seenPoints() == 0) { // fitted on first use
+    reach_.setSeenView(seenView());
+    reach_.measureAll(reachInputs(), ambient_);
   }
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding); // the resolved A_t stays: I_a is a push
 }
@@ -833,19 +678,11 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
   uploadLights();
   // What the new light reaches (CPU rays, for I_a) is measured on a thread of its own while its
   // rays are traced: compose needs it, the passes do not (lights_ stays as it is meanwhile).
-  std::future<LightReach> reach;
-  if (reached_) {
-    reach = std::async(std::launch::async, [this, index] {
-      const auto start = Clock::now();
-      LightReach r = reached_->measure(lights_, index);
-      lastReach_ = {r.rays.traced, 1e3 * secondsSince(start)};
-      return r;
-    });
-  }
   const auto reachIn = [&] {
-    if (reach.valid()) ambient_.reach.push_back(reach.get());
-    updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
+    if (reach_.measured()) finishReach();
+    else updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   };
+  if (reach_.measured()) reach_.startLight(lights_, index);
   if (reflectorsOn()) {
     // What the new light marks reflects every light's light: all of it again.
     reachIn();
@@ -853,7 +690,7 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
     retraceAll();
     return index;
   }
-  besideMeasurement(reach, [&] { traceAddedLight(static_cast<std::uint32_t>(index)); });
+  reach_.beside([&] { traceAddedLight(static_cast<std::uint32_t>(index)); });
   reachIn();
   return index;
 }
@@ -929,7 +766,7 @@ std::uint64_t ObscuranceRenderer::addEmitter(const scene::Scene& edited, const b
   insertAt(lights_.power, fresh.power[index]);
   updateSelection(lights_);
   insertAt(emissions_, fresh.emission[index]);
-  if (reached_) ambient_.reach.insert(ambient_.reach.begin() + static_cast<std::ptrdiff_t>(index), LightReach{});
+  if (reach_.measured()) ambient_.reach.insert(ambient_.reach.begin() + static_cast<std::ptrdiff_t>(index), LightReach{});
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   // The quad is geometry too: replaceScene uploads it, measures what every light reaches anew,
   // and the pixels it can change are retraced for every light (the new one included).
@@ -939,7 +776,7 @@ std::uint64_t ObscuranceRenderer::addEmitter(const scene::Scene& edited, const b
     retraceAll();
     retraced = frame_.layout().pixels();
   } else {
-    besideMeasurement(pendingReach_, [&] {
+    reach_.beside([&] {
       traceAddedLight(static_cast<std::uint32_t>(index));
       retraced = retraceDirty(changed, everyPixel, static_cast<std::uint32_t>(index));
     });
@@ -961,7 +798,7 @@ void ObscuranceRenderer::removeLight(std::size_t index) {
   frame_.removeLightSlot(stream_, static_cast<std::uint32_t>(index));
   markResolveStale(static_cast<std::uint32_t>(index), false);
   removePunctual(lights_, index);
-  if (reached_) ambient_.reach.erase(ambient_.reach.begin() + static_cast<std::ptrdiff_t>(index));
+  if (reach_.measured()) ambient_.reach.erase(ambient_.reach.begin() + static_cast<std::ptrdiff_t>(index));
   emissions_.erase(emissions_.begin() + static_cast<std::ptrdiff_t>(index));
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   uploadLights();

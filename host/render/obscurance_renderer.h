@@ -19,7 +19,6 @@
 //            reruns this alone (composeDisplay: resolve once, then the light mix).
 #pragma once
 #include <cstdint>
-#include <future>
 #include <map>
 #include <memory>
 #include <string>
@@ -32,8 +31,9 @@
 #include "io/image_io.h"
 #include "render/aovs.h"
 #include "render/frame/obscurance_frame.h"
+#include "render/geometry_retrace.h"
+#include "render/light_reach_model.h"
 #include "render/passes/compose_pass.h"
-#include "render/passes/dirty_pass.h"
 #include "render/passes/light_mix_pass.h"
 #include "render/passes/resolve_pass.h"
 #include "render/passes/obscurance_pass.h"
@@ -68,11 +68,6 @@ enum class ShadowSampling {
 
 inline constexpr NameTable<ShadowSampling, 2> kShadowSamplingNames{
     {{"selection", ShadowSampling::Selection}, {"per-light", ShadowSampling::PerLight}}};
-
-// The dirty test of a geometry edit (ObscuranceSettings::dirtyTest).
-enum class DirtyTest { Auto, Bounds, Probe };
-inline constexpr NameTable<DirtyTest, 3> kDirtyTestNames{
-    {{"auto", DirtyTest::Auto}, {"probe", DirtyTest::Probe}, {"bounds", DirtyTest::Bounds}}};
 
 // The obscurance rays' directions (ObscuranceSettings::systematic) and the rays at a specular
 // path's vertices (ObscuranceSettings::vertexRaysByThroughput): two-valued options with names.
@@ -164,7 +159,10 @@ const std::vector<std::string>& obscuranceAovNames();
 // Whether any triangle has a glossy material: only then does the specular pass run.
 bool sceneHasGlossy(const scene::Scene& scene);
 
-class ObscuranceRenderer {
+// Its jobs beside the sample loop, compose and read-back live in units of their own:
+// GeometryRetrace (render/geometry_retrace.h) finds and retraces what a geometry edit changes,
+// LightReachModel (render/light_reach_model.h) measures what each light reaches for I_a.
+class ObscuranceRenderer : private SampleRecorder {
 public:
   ObscuranceRenderer(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
                      const ObscuranceSettings& settings);
@@ -264,11 +262,8 @@ public:
   RenderStats stats() const;
   // The last measurement of what the lights reach (the Reached ambient model, CPU rays): rays
   // traced and wall ms; after a move, only the rays it could change.
-  struct ReachUpdate {
-    std::uint64_t rays = 0;
-    double ms = 0.0;
-  };
-  ReachUpdate lastReachUpdate() const { return lastReach_; }
+  using ReachUpdate = LightReachModel::Update;
+  ReachUpdate lastReachUpdate() const { return reach_.lastUpdate(); }
   // Triangles marked as important secondary reflectors (0 when they are off).
   std::uint32_t secondaryReflectors() const { return reflectorsMarked_; }
   // Bytes of device memory held: scene, lights and frame (the real allocations).
@@ -295,33 +290,9 @@ private:
       for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b) record(b);
     });
   }
-  // The Reached ambient model: what every light reaches in `scene`. After a geometry edit that
-  // kept the lights, `changed` (the edited objects' old and new boxes) lets each light re-trace
-  // only the rays the edit can change (ReachedSurfaces::remeasure: the same numbers).
-  void measureReach(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<scene::Bounds>* changed = nullptr);
-  // What measureReach measures, without changing the renderer (so that it can run beside an edit's
-  // GPU work), and its application.
-  struct ReachMeasurement {
-    std::vector<glm::vec3> reflectance; // per triangle
-    std::unique_ptr<ReachedSurfaces> reached;
-    std::vector<LightReach> reach;      // per light
-    ReachUpdate update;
-  };
-  ReachMeasurement measureReachOf(const scene::Scene& scene, const bvh::Bvh& bvh,
-                                  const std::vector<scene::Bounds>* changed) const;
-  void applyReach(ReachMeasurement measurement);
-  // Applies the measurement replaceScene started beside the edit's GPU work, if any.
-  void finishReach();
-  // Every light's reach (and Seen fit) with `reached`; with `before` (the reach of the scene before
-  // an edit), re-tracing only the rays `changed` (padded) can change.
-  std::vector<LightReach> reachOfEveryLight(const ReachedSurfaces& reached, const ReachedSurfaces* before,
-                                            const std::vector<scene::Bounds>& changed) const;
-  // Every light's reach with reached_ as it is, then I_a's weights.
-  void measureAllReach();
+  // What the reach model reads of the renderer: the lights, the Seen view (with that model), I_a's depth.
+  LightReachModel::Inputs reachInputs() const;
   SeenView seenView() const; // the camera and obscurance settings the Seen fit uses
-  // How far beyond a changed box the rays' offset origins may start: 1e-3 of the scene's size and
-  // reach (lib/ray.glsl offsets by a few hundred ulps of the coordinates).
-  float changedBoxPadding() const;
   // Marks the secondary reflectors from the measured reach (settings_.secondaryReflectors > 0).
   void markReflectors();
   bool reflectorsOn() const { return settings_.secondaryReflectors > 0.0f; }
@@ -340,6 +311,8 @@ private:
   // shadow-segment test. Returns how many.
   std::uint64_t retraceDirty(const std::vector<scene::Bounds>& changed, bool everyPixel,
                              std::uint32_t tracedLight = gpu::kInvalidIndex);
+  // The reach of an edited scene was measured beside the edit's GPU work: applied now.
+  void finishReach() { reach_.finish(reachInputs(), ambient_); }
   gpu::ShadePush shadePush(std::uint32_t sample) const;
   // kShadeFlagKeptRays where the frame keeps sample `sample`'s lobe hits: for a pass that writes
   // them, or (`replaying`) for one that follows them, only while they are the current scene's.
@@ -361,9 +334,6 @@ private:
   SceneBuffers sceneBuffers_;
   LightSet lights_;
   AmbientTerm ambient_;
-  ReachUpdate lastReach_;
-  std::vector<glm::vec3> reachReflectance_; // mean reflectance per triangle of the measured scene
-  std::unique_ptr<ReachedSurfaces> reached_; // the light rays of the Reached model and the reflectors (CPU)
   std::uint32_t reflectorsMarked_ = 0;       // triangles marked as secondary reflectors
   float unmarkedFirstBounce_ = 1.0f;         // r of secondary_reflectors.h
   LightBuffers lightBuffers_;
@@ -378,12 +348,6 @@ private:
   // so that an added light's rays start from it without a primary pass.
   static constexpr std::uint32_t kNoSample = ~0u;
   std::uint32_t gbufferSample_ = kNoSample;
-  // The kept rays (frame_.contents().keptRaySamples): their lobe hits name triangles by their
-  // texel in the BVH's layout: they stay valid across a refit (a move, a removal) and not across a rebuild
-  // (an insert, a quad), until the next reset renders them anew.
-  bool keptRaysValid_ = true;
-  std::vector<std::uint32_t> bvhOrder_; // the layout the hits refer to: triangle order...
-  std::size_t bvhNodes_ = 0;            // ...after this many nodes
 
   // Passes. Those that trace (primary to specular) are specialised for the scene
   // (sceneKernels_: the compact traversal stack its BVH needs, the texture kinds its materials
@@ -397,19 +361,15 @@ private:
   TonemapPass tonemap_;
   ResolvePass resolve_;
   LightMixPass lightMix_;
-  DirtyPass dirty_;
-  gpu::Buffer lightBounds_; // for dirty.comp
+  GeometryRetrace geometry_; // the dirty test and retrace of geometry edits, the kept rays' validity
   float sceneScale_ = 1.0f; // the ray-origin offset's scale, kept across geometry edits
   // Sample `sample`'s passes. With kShadeFlagProbe in `shadeFlags` they probe the dirty list's
   // candidates (lib/probe.glsl), timed as "probe.<pass>"; `tracePrimary` false: the G-buffer holds the
   // sample already.
   void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, std::uint32_t primaryFlags,
-                    std::uint32_t shadeFlags, bool tracePrimary = true);
+                    std::uint32_t shadeFlags, bool tracePrimary = true) override;
   // Camera rays a summing primary pass traces per pixel and sample: its own, and the emission rays.
   std::uint64_t cameraRaysPerSample() const;
-  // The probing half of a geometry edit's dirty test: every sample so far replayed over the
-  // candidates dirty.comp listed, each ray tested against the changed boxes (lib/probe.glsl).
-  void probeCandidates();
   // The shadow pass for `light` alone (kShadeFlagPerLight), over every band.
   void recordShadowForLight(const vk::raii::CommandBuffer& cmd, gpu::ShadePush push, std::uint32_t light) const;
   // The resolved transport is current for lights before resolveFrom_ (and the ambient unless
@@ -423,9 +383,9 @@ private:
   gpu::CommandStream stream_;
   gpu::Timestamps timestamps_;
   double wallSeconds_ = 0.0;
-  // The reach of an edited scene, measured beside the edit's GPU work (replaceScene). Last: its
-  // destructor waits for the measurement, which reads the members above.
-  std::future<ReachMeasurement> pendingReach_;
+  // What each light reaches (CPU rays, for I_a and the reflectors). Last: its destructor waits for
+  // a measurement still running beside an edit, which reads the members above.
+  LightReachModel reach_;
 };
 
 } // namespace obscura::render
