@@ -14,10 +14,10 @@ layout(std430, binding = kBindingClearSpecularAmbient) buffer SpecularAmbient { 
 
 void main() {
   uint pixel = gl_GlobalInvocationID.x;
-  uint pixelCount = pc.frame.x * pc.frame.y;
+  uint pixelCount = pc.width * pc.rows;
   if (pixel >= pixelCount || dirty[pixel] == 0u) return;
-  const bool withSpecular = pc.frame.w != 0u;
-  for (uint s = 0u; s < pc.frame.z; ++s) {
+  const bool withSpecular = pc.specular != 0u;
+  for (uint s = 0u; s < pc.lightCount; ++s) {
     uint i = 2u * (s * pixelCount + pixel);
     basis[i] = vec4(0.0);
     basis[i + 1u] = vec4(0.0);

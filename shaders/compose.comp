@@ -22,14 +22,14 @@ layout(std430, binding = kBindingComposeSampleCounts) readonly buffer SampleCoun
 
 void main() {
   uint pixel = gl_GlobalInvocationID.x;
-  uint pixelCount = pc.frame.x * pc.frame.y;
+  uint pixelCount = pc.width * pc.rows;
   if (pixel >= pixelCount) return;
   float inv = 1.0 / float(max(sampleCounts[pixel], 1u));
   vec3 direct = vec3(0.0);
   vec3 seen = vec3(0.0);
   vec3 specular = vec3(0.0);
-  const bool withSpecular = pc.ambient.w != 0.0;
-  for (uint s = 0u; s < pc.frame.w; ++s) {
+  const bool withSpecular = pc.specular != 0u;
+  for (uint s = 0u; s < pc.lightCount; ++s) {
     vec3 e = emission[s].rgb;
     direct += e * OBS_SUM_TEXEL(basis, s * pixelCount + pixel).rgb;
     seen += e * OBS_SUM_TEXEL(emissionBasis, s * pixelCount + pixel).rgb;
@@ -37,12 +37,12 @@ void main() {
   }
   direct *= inv;
   seen *= inv;
-  if (withSpecular) specular = (specular + pc.ambient.rgb * OBS_SUM_TEXEL(specularAmbient, pixel).rgb) * inv;
+  if (withSpecular) specular = (specular + pc.ambient * OBS_SUM_TEXEL(specularAmbient, pixel).rgb) * inv;
   vec4 a = OBS_SUM_TEXEL(ambient, pixel) * inv;
-  vec3 indirect = pc.ambient.rgb * a.rgb;
-  uint o = pixel * pc.slots.x;
+  vec3 indirect = pc.ambient * a.rgb;
+  uint o = pixel * pc.slots;
   composed[o + kComposeCombined] = vec4(direct + indirect + seen + specular, 1.0);
-  if (pc.slots.x == 1u) return; // only combined was asked for
+  if (pc.slots == 1u) return; // only combined was asked for
   composed[o + kComposeDirect] = vec4(direct, 1.0);
   composed[o + kComposeIndirect] = vec4(indirect, 1.0);
   composed[o + kComposeSpecular] = vec4(specular, 1.0);

@@ -45,7 +45,7 @@ void main() {
     OBS_WRITE_ILLUM(filtered, pixel, c)
     return;
   }
-  const int step = int(pc.params.x);
+  const int step = int(pc.step);
   const float sigmaZ = params.weights.x, sigmaA = params.weights.y, sigmaL = params.weights.z;
   const vec3 x = pixelPoint(params.camera, p, size, g.depth);
   const float planeScale = sigmaZ * pixelFootprint(params.camera, g.depth, size) * float(step);

@@ -21,7 +21,7 @@ layout(std430, binding = kBindingGatherEmission) writeonly buffer EmissionOut { 
 
 void main() {
   const uint local = gl_GlobalInvocationID.x;
-  const uint width = params.frame.x, firstRow = pc.params.x, rows = pc.params.y, slots = pc.params.z;
+  const uint width = params.frame.x, firstRow = pc.firstRow, rows = pc.rows, slots = pc.composedSlots;
   if (local >= width * rows) return;
   const uint pixel = firstRow * width + local;
   const uint samples = sampleCounts[local];

@@ -5,7 +5,7 @@
 // test bounds what rays can reach with boxes and convex hulls, so a pixel it leaves clean cannot
 // change (GeometryEdit.* check the result against a full render bit for bit).
 //
-// With probing (params.w = 1) it runs twice (DirtyStagePush): kDirtyStageMark marks the pixels a
+// With probing (probing = 1) it runs twice (DirtyStagePush): kDirtyStageMark marks the pixels a
 // changed box covers on screen certain (2) and those only a bound flags candidates (1), and lists
 // the candidates; the probing passes (lib/probe.glsl) replay the candidates' rays and mark 2 those
 // one of whose rays meets a changed box; kDirtyStageList then keeps the 2s (as 1) and lists them.
@@ -28,8 +28,8 @@ bool maybeTouched(uint pixel) {
   if (hi.w == 0.0) return false; // no sample hit anything: only its camera rays could change
   if (lo.w != 0.0) return true;  // a specular path left the scene: it may pass anywhere
   vec3 ac = 0.5 * (lo.xyz + hi.xyz), ah = 0.5 * (hi.xyz - lo.xyz);
-  const float dMax = pc.params.x;
-  const uint traced = floatBitsToUint(pc.params.z);
+  const float dMax = pc.dMax;
+  const uint traced = pc.tracedLight;
   for (uint b = 0u; b < kMaxChangedBoxes; ++b) {
     if (pc.boxLo[b].w == 0.0) continue;
     vec3 blo = pc.boxLo[b].xyz, bhi = pc.boxHi[b].xyz;
@@ -37,7 +37,7 @@ bool maybeTouched(uint pixel) {
     if (length(max(vec3(0.0), max(lo.xyz - bhi, blo - hi.xyz))) <= dMax) return true;
     vec3 bc = 0.5 * (blo + bhi), bh = 0.5 * (bhi - blo);
     // Shadow rays run from a hit point to a point of a light.
-    for (uint s = 0u; s < pc.frame.w; ++s) {
+    for (uint s = 0u; s < pc.lightCount; ++s) {
       if (s == traced) continue; // a new light, traced at every pixel
       vec4 light = lightBounds[2u * s], extent = lightBounds[2u * s + 1u];
       bool meets = light.w != 0.0 ? meetsInfiniteShaft(bc, bh, ac, ah, extent.xyz)
@@ -51,7 +51,7 @@ bool maybeTouched(uint pixel) {
 // 2: a changed box covers the pixel on screen (or every pixel is dirty); 1: a bound says one of
 // its rays may meet a changed box; 0: none can.
 uint touched(uint pixel, uvec2 framePixel) {
-  if (pc.params.y != 0.0) return kDirtyCertain;
+  if (pc.all != 0u) return kDirtyCertain;
   for (uint b = 0u; b < kMaxChangedBoxes; ++b) {
     if (pc.boxLo[b].w == 0.0) continue;
     uvec4 r = pc.rects[b];
@@ -63,7 +63,7 @@ uint touched(uint pixel, uvec2 framePixel) {
 // Appends `pixel` to the band's list (lib/queue_append.glsl: one atomic per SIMD group), and with
 // `counted` counts it in the status (one atomic per group too).
 void list(uint pixel, bool counted) {
-  OBS_QUEUE_APPEND(dirty, dirtyListBase(pc.frame.x * pc.frame.y), pixel)
+  OBS_QUEUE_APPEND(dirty, dirtyListBase(pc.width * pc.rows), pixel)
   if (counted) {
     const uint listed = subgroupBallotBitCount(subgroupBallot(true));
     if (subgroupElect()) atomicAdd(status[kStatusDirtyPixels], listed);
@@ -72,16 +72,16 @@ void list(uint pixel, bool counted) {
 
 void main() {
   uint pixel = gl_GlobalInvocationID.x;
-  uint width = pc.frame.x;
-  if (pixel >= width * pc.frame.y) return;
-  const bool probing = pc.params.w != 0.0;
-  if (stage.stage.x == kDirtyStageList) { // after the probes: what they (or the screen) made certain
+  uint width = pc.width;
+  if (pixel >= width * pc.rows) return;
+  const bool probing = pc.probing != 0u;
+  if (stage.stage == kDirtyStageList) { // after the probes: what they (or the screen) made certain
     bool d = dirty[pixel] == kDirtyCertain;
     dirty[pixel] = d ? 1u : 0u;
     if (d) list(pixel, true);
     return;
   }
-  uint t = touched(pixel, uvec2(pixel % width, pixel / width + pc.frame.z));
+  uint t = touched(pixel, uvec2(pixel % width, pixel / width + pc.firstRow));
   if (!probing) t = min(t, 1u);
   dirty[pixel] = t;
   if (!probing && t != 0u) atomicAdd(status[kStatusDirtyPixels], 1u);

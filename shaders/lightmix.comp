@@ -18,14 +18,14 @@ layout(std430, binding = kBindingLightMixOutput) writeonly buffer Out { uint dis
 
 void main() {
   const uint quad = gl_GlobalInvocationID.x;
-  const uint pixelCount = pc.frame.x * pc.frame.y;
+  const uint pixelCount = pc.width * pc.rows;
   const uint first = quad * kResolvedPixelAlign;
   if (first >= pixelCount) return;
   const uint rowTexels = resolvedStride(pixelCount) / kResolvedPixelAlign; // texels per light
-  uvec4 a = texelFetch(resolved, int(pc.frame.w * rowTexels + quad));
-  vec3 c0 = pc.ambient.rgb * unpackRgb9e5(a.x), c1 = pc.ambient.rgb * unpackRgb9e5(a.y);
-  vec3 c2 = pc.ambient.rgb * unpackRgb9e5(a.z), c3 = pc.ambient.rgb * unpackRgb9e5(a.w);
-  for (uint s = 0u; s < pc.frame.z; ++s) {
+  uvec4 a = texelFetch(resolved, int(pc.lightSlots * rowTexels + quad));
+  vec3 c0 = pc.ambient * unpackRgb9e5(a.x), c1 = pc.ambient * unpackRgb9e5(a.y);
+  vec3 c2 = pc.ambient * unpackRgb9e5(a.z), c3 = pc.ambient * unpackRgb9e5(a.w);
+  for (uint s = 0u; s < pc.lightCount; ++s) {
     const uvec4 t = texelFetch(resolved, int(s * rowTexels + quad));
     const vec3 e = emission[s].rgb;
     c0 += e * unpackRgb9e5(t.x);
@@ -33,8 +33,8 @@ void main() {
     c2 += e * unpackRgb9e5(t.z);
     c3 += e * unpackRgb9e5(t.w);
   }
-  display[first] = displayRgba8(c0, pc.ambient.w);
-  if (first + 1u < pixelCount) display[first + 1u] = displayRgba8(c1, pc.ambient.w);
-  if (first + 2u < pixelCount) display[first + 2u] = displayRgba8(c2, pc.ambient.w);
-  if (first + 3u < pixelCount) display[first + 3u] = displayRgba8(c3, pc.ambient.w);
+  display[first] = displayRgba8(c0, pc.exposureScale);
+  if (first + 1u < pixelCount) display[first + 1u] = displayRgba8(c1, pc.exposureScale);
+  if (first + 2u < pixelCount) display[first + 2u] = displayRgba8(c2, pc.exposureScale);
+  if (first + 3u < pixelCount) display[first + 3u] = displayRgba8(c3, pc.exposureScale);
 }

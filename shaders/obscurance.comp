@@ -24,7 +24,7 @@
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
 void main() {
-  gSceneScale = pc.eye.w;
+  gSceneScale = pc.sceneSize;
   BandPixel bp = shadedPixel(); // every pixel of the band, or the dirty ones of a retrace
   if (!bp.inside) return;
   uvec2 p = bp.frame;
@@ -33,14 +33,14 @@ void main() {
   GBufferTexel g = gbufferAt(pixel);
   if (g.albedo.a == 0.0) return;
 
-  ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);
-  uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x9e3779b9u);
-  gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
+  ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye);
+  uint rng = rngSeed(p, pc.sampleIndex, pc.seed ^ 0x9e3779b9u);
+  gLightSampling = (pc.renderFlags & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
   StepBudget budget = newStepBudget();
   // A probe too (not in the macro): N_obs rays at every primary hit.
-  const vec4 gathered = gatherObscurance(sp, rng, budget, pixel, bp.count, pc.counts.z);
+  const vec4 gathered = gatherObscurance(sp, rng, budget, pixel, bp.count, pc.obscuranceRays);
   OBS_ACCUMULATE_TEXEL(ambient, pixel, gathered)
   if (kProbe) endProbe(pixel);
-  else atomicAdd(status[kStatusObscuranceRays], pc.counts.z);
+  else atomicAdd(status[kStatusObscuranceRays], pc.obscuranceRays);
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

@@ -76,31 +76,31 @@ float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
 void main() {
   gSceneScale = pc.camera.right.w;
-  uvec2 size = pc.frame.xy;
-  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, size, pc.band.xy);
+  uvec2 size = uvec2(pc.width, pc.height);
+  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, size, uvec2(pc.firstRow, pc.rows));
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;
-  const uint lightCount = pc.params.x;
-  const uint maxDepth = pc.params.y;
-  const uint rrDepth = pc.params.z;
-  const uint strategy = pc.params.w;
-  gLightSampling = pc.band.z;
+  const uint lightCount = pc.lightCount;
+  const uint maxDepth = pc.maxDepth;
+  const uint rrDepth = pc.rrDepth;
+  const uint strategy = pc.strategy;
+  gLightSampling = pc.lightSampling;
   // --emission-samples K: K > 1 estimates the emission the camera ray sees from K rays of their own
   // (lib/emission_samples.glsl), as the obscurance renderer's M_s does; the path's vertex 1 then
   // adds none.
-  const uint emissionSamples = min(pc.band.w, kMaxEmissionSamples);
+  const uint emissionSamples = min(pc.emissionSamples, kMaxEmissionSamples);
   const bool ownEmissionRays = emissionSamples > 1u;
 
   // The camera ray exactly as primary.comp makes it: the same per-pixel shift of the same R2
   // sub-pixel sequence, so sample i of both renderers goes through the same point of the pixel.
-  uint rng = rngSeed(p, 0u, pc.frame.w);
+  uint rng = rngSeed(p, 0u, pc.seed);
   vec2 shift = vec2(rngNext(rng), rngNext(rng));
-  vec2 position = vec2(p) + pixelSampleOffset(pc.frame.z, shift);
+  vec2 position = vec2(p) + pixelSampleOffset(pc.sampleIndex, shift);
   vec3 origin = pc.camera.origin.xyz;
   vec3 direction = cameraRayDirection(pc.camera, position, vec2(size));
   // The path's own stream (a constant of ours keeps it apart from the shading passes' streams).
-  rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu);
+  rng = rngSeed(p, pc.sampleIndex, pc.seed ^ 0x27d4eb2fu);
 
   StepBudget budget = newStepBudget();
   uint rays = 1u;
@@ -110,7 +110,7 @@ void main() {
   if (ownEmissionRays) {
     uint sky = floatBitsToUint(pc.camera.up.w);
     for (uint j = 0u; j < emissionSamples; ++j) {
-      SeenEmitter e = traceEmissionSample(budget, pc.camera, p, vec2(size), pc.frame.z, j, emissionSamples, shift, lightCount);
+      SeenEmitter e = traceEmissionSample(budget, pc.camera, p, vec2(size), pc.sampleIndex, j, emissionSamples, shift, lightCount);
       L += (e.sky ? emissionScale[sky].rgb : e.radiance) / float(emissionSamples);
     }
     rays += emissionSamples;

@@ -37,29 +37,29 @@ void accumulate(uint pixel, uint slot, vec4 value, bool first) {
 }
 
 void main() {
-  uvec2 size = pc.frame.xy;
+  uvec2 size = uvec2(pc.width, pc.height);
   // Every pixel of the band, or (a retrace) the band's dirty list, dispatched indirectly.
   BandPixel bp;
-  if ((pc.band.w & kPrimaryFlagDirtyOnly) == 0u) {
-    bp = bandPixel(gl_GlobalInvocationID.xy, size, pc.band.xy);
+  if ((pc.flags & kPrimaryFlagDirtyOnly) == 0u) {
+    bp = bandPixel(gl_GlobalInvocationID.xy, size, uvec2(pc.firstRow, pc.rows));
   } else {
-    const uint base = dirtyListBase(size.x * pc.band.y), entry = listEntry(), count = dirty[base + kQueueCount];
-    bp = listedPixel(entry, count, entry < count ? dirty[base + kQueueHeader + entry] : 0u, size, pc.band.xy);
+    const uint base = dirtyListBase(size.x * pc.rows), entry = listEntry(), count = dirty[base + kQueueCount];
+    bp = listedPixel(entry, count, entry < count ? dirty[base + kQueueHeader + entry] : 0u, size, uvec2(pc.firstRow, pc.rows));
   }
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;
-  uint sampleIndex = pc.frame.z;
+  uint sampleIndex = pc.sampleIndex;
   // A farm's part (render --samples A:B) accumulates from sample A of the frame's sequence.
-  const uint firstSample = pc.accumulation.x;
+  const uint firstSample = pc.firstSample;
   bool first = sampleIndex == firstSample;
-  const uint lightCount = pc.band.z;
-  const bool accumulateSums = (pc.band.w & kPrimaryFlagGBufferOnly) == 0u;
-  const bool accumulateAovs = kAovs && accumulateSums && (pc.band.w & kPrimaryFlagNoAovs) == 0u;
+  const uint lightCount = pc.lightCount;
+  const bool accumulateSums = (pc.flags & kPrimaryFlagGBufferOnly) == 0u;
+  const bool accumulateAovs = kAovs && accumulateSums && (pc.flags & kPrimaryFlagNoAovs) == 0u;
   // --emission-samples K: K > 1 estimates M_s from K rays of their own (lib/emission_samples.glsl).
-  const uint emissionSamples = min(pc.band.w >> kPrimaryEmissionSamplesShift, kMaxEmissionSamples);
+  const uint emissionSamples = min(pc.flags >> kPrimaryEmissionSamplesShift, kMaxEmissionSamples);
 
-  uint rng = rngSeed(p, 0u, pc.frame.w); // the shift is per pixel, fixed over samples
+  uint rng = rngSeed(p, 0u, pc.seed); // the shift is per pixel, fixed over samples
   vec2 shift = vec2(rngNext(rng), rngNext(rng));
   vec2 position = vec2(p) + pixelSampleOffset(sampleIndex, shift);
   vec3 origin = pc.camera.origin.xyz;
@@ -129,7 +129,7 @@ void main() {
   // consecutive rays on the same light are summed first.
   // A whole frame's sample 0 follows ObscuranceRenderer::reset(), which has zeroed every light's
   // sum; a dirty pixel's retrace restarts its own here (a store per light per pixel).
-  if (first && (pc.band.w & kPrimaryFlagDirtyOnly) != 0u)
+  if (first && (pc.flags & kPrimaryFlagDirtyOnly) != 0u)
     for (uint s = 0u; s < lightCount; ++s) OBS_ACCUMULATE_FIRST(emissionBasis, s * bp.count + pixel, vec4(0.0))
   const bool ownRays = kEmissionRays && emissionSamples > 1u;
   const uint rays = ownRays ? emissionSamples : 1u;

@@ -21,24 +21,24 @@ layout(std430, binding = kBindingResolveDirty) readonly buffer Dirty { uint dirt
 
 void main() {
   uint pixel = gl_GlobalInvocationID.x;
-  uint pixelCount = pc.frame.x * pc.frame.y;
-  if (pc.capacity.y != 0u) { // the dirty list's pixels only (a geometry edit's retrace)
+  uint pixelCount = pc.width * pc.rows;
+  if (pc.dirtyOnly != 0u) { // the dirty list's pixels only (a geometry edit's retrace)
     const uint base = dirtyListBase(pixelCount);
     if (pixel >= dirty[base + kQueueCount]) return;
     pixel = dirty[base + kQueueHeader + pixel];
   }
   if (pixel >= pixelCount) return;
   float inv = 1.0 / float(max(sampleCounts[pixel], 1u));
-  const bool withSpecular = pc.flags.x != 0u;
+  const bool withSpecular = pc.specular != 0u;
   const uint stride = resolvedStride(pixelCount);
-  for (uint s = pc.flags.y; s < pc.frame.w; ++s) {
+  for (uint s = pc.firstLight; s < pc.lightCount; ++s) {
     uint i = s * pixelCount + pixel;
     vec3 t = OBS_SUM_TEXEL(basis, i).rgb + OBS_SUM_TEXEL(emissionBasis, i).rgb;
     if (withSpecular) t += OBS_SUM_TEXEL(specularBasis, i).rgb;
     resolved[s * stride + pixel] = packRgb9e5(t * inv);
   }
-  if (pc.flags.z == 0u) return;
+  if (pc.ambient == 0u) return;
   vec3 a = OBS_SUM_TEXEL(ambient, pixel).rgb;
   if (withSpecular) a += OBS_SUM_TEXEL(specularAmbient, pixel).rgb;
-  resolved[pc.capacity.x * stride + pixel] = packRgb9e5(a * inv);
+  resolved[pc.lightSlots * stride + pixel] = packRgb9e5(a * inv);
 }

@@ -27,8 +27,8 @@
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
 void main() {
-  gSceneScale = pc.eye.w;
-  gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
+  gSceneScale = pc.sceneSize;
+  gLightSampling = (pc.renderFlags & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
   BandPixel bp = shadedPixel(); // every pixel of the band, or the dirty ones of a retrace
   if (!bp.inside) return;
   uvec2 p = bp.frame;
@@ -38,20 +38,20 @@ void main() {
   GBufferTexel g = gbufferAt(pixel);
   if (g.albedo.a == 0.0) return; // no hit: nothing to light
 
-  ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye.xyz);
+  ShadingPoint sp = shadingPointFromGBuffer(g, pc.eye);
   if (kReplayRays) { // a probe by the kept rays (never for one light alone: those are not kept)
-    probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.frame.z, pixel, pixelCount, 0u, pc.counts.y);
+    probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.sampleIndex, pixel, pixelCount, 0u, pc.shadowRays);
     endProbe(pixel);
     return;
   }
   // A probe whose shafts from the hit to the lights all miss the boxes draws no light sample.
-  const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, pc.counts.x);
+  const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, pc.lightCount);
   if (!drawn) return;
-  uint rng = rngSeed(p, pc.frame.z, pc.frame.w ^ 0x5bd1e995u);
+  uint rng = rngSeed(p, pc.sampleIndex, pc.seed ^ 0x5bd1e995u);
   StepBudget budget = newStepBudget();
   const vec4 lightShift = rngNext4(rng); // the hit's light samples: one shifted low-discrepancy set
   if (shadesOneLight()) {
-    const uint light = pc.band.w;
+    const uint light = pc.light;
     uint taken;
     vec3 direct = directLightFromOne(sp, light, lightShift, budget, taken);
     OBS_ACCUMULATE_TEXEL(basis, light * pixelCount + pixel, vec4(direct, 0.0))
@@ -60,16 +60,16 @@ void main() {
     if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
     return;
   }
-  uint count = drawn ? pc.counts.y : 0u;
-  const bool keepRays = !kProbe && !kPerLight && (pc.band.z & kShadeFlagKeptRays) != 0u;
+  uint count = drawn ? pc.shadowRays : 0u;
+  const bool keepRays = !kProbe && !kPerLight && (pc.dispatchFlags & kShadeFlagKeptRays) != 0u;
   float invCount = 1.0 / float(count);
-  float misSamples = (pc.counts.w & kFlagGlossyMis) != 0u ? float(count) : 0.0;
+  float misSamples = (pc.renderFlags & kFlagGlossyMis) != 0u ? float(count) : 0.0;
   for (uint k = 0u; k < count; ++k) {
     vec4 u = kroneckerPoint4(k, lightShift);
     vec3 contribution;
     uint light;
-    directLightSample(sp, u, pc.counts.x, misSamples, budget, contribution, light);
-    if (keepRays) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, pixelCount, 0u, k)] = gShadowRay;
+    directLightSample(sp, u, pc.lightCount, misSamples, budget, contribution, light);
+    if (keepRays) keptShadowRays[keptShadowRaySlot(pc.sampleIndex, pixel, pixelCount, 0u, k)] = gShadowRay;
     OBS_ACCUMULATE_TEXEL(basis, light * pixelCount + pixel, vec4(contribution * invCount, 0.0))
   }
   if (kProbe) endProbe(pixel);

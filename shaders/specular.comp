@@ -108,16 +108,16 @@ struct SpecularConstants {
 
 SpecularConstants specularConstants() {
   SpecularConstants c;
-  c.pixelCount = pc.frame.x * pc.band.y;
-  c.lightCount = pc.counts.x;
-  c.shadowRays = c.lightCount > 0u ? pc.counts.y : 0u;
-  c.maxDepth = uint(pc.params.w);
+  c.pixelCount = pc.width * pc.rows;
+  c.lightCount = pc.lightCount;
+  c.shadowRays = c.lightCount > 0u ? pc.shadowRays : 0u;
+  c.maxDepth = uint(pc.maxDepth);
   c.oneLight = shadesOneLight();
-  c.addedLight = pc.band.w;
-  c.noDirect = (pc.band.z & kShadeFlagNoDirect) != 0u;
-  c.glossyMis = (pc.counts.w & kFlagGlossyMis) != 0u;
-  c.raysByThroughput = (pc.counts.w & kFlagVertexRaysByThroughput) != 0u;
-  c.keepRays = !kProbe && !kPerLight && !kReplayRays && (pc.band.z & kShadeFlagKeptRays) != 0u;
+  c.addedLight = pc.light;
+  c.noDirect = (pc.dispatchFlags & kShadeFlagNoDirect) != 0u;
+  c.glossyMis = (pc.renderFlags & kFlagGlossyMis) != 0u;
+  c.raysByThroughput = (pc.renderFlags & kFlagVertexRaysByThroughput) != 0u;
+  c.keepRays = !kProbe && !kPerLight && !kReplayRays && (pc.dispatchFlags & kShadeFlagKeptRays) != 0u;
   return c;
 }
 
@@ -135,12 +135,12 @@ uint raysAtVertex(SpecularConstants c, uint perHit, vec3 throughput) {
 }
 
 PathState startPath(SpecularConstants c, uint pixel) {
-  BandPixel bp = bandPixelFromIndex(pixel, pc.frame.xy, pc.band.xy);
+  BandPixel bp = bandPixelFromIndex(pixel, uvec2(pc.width, pc.height), uvec2(pc.firstRow, pc.rows));
   PathState path;
-  path.sp = shadingPointFromGBuffer(gbufferAt(pixel), pc.eye.xyz);
+  path.sp = shadingPointFromGBuffer(gbufferAt(pixel), pc.eye);
   path.throughput = vec3(1.0);
-  path.pathRng = rngSeed(bp.frame, pc.frame.z, pc.frame.w ^ 0x27d4eb2fu);
-  path.rng = rngSeed(bp.frame, pc.frame.z, pc.frame.w ^ 0x6c8e9cf5u);
+  path.pathRng = rngSeed(bp.frame, pc.sampleIndex, pc.seed ^ 0x27d4eb2fu);
+  path.rng = rngSeed(bp.frame, pc.sampleIndex, pc.seed ^ 0x6c8e9cf5u);
   path.pathLo = path.sp.position;
   path.pathHi = path.sp.position;
   path.escaped = false;
@@ -172,7 +172,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
   const vec3 throughput = path.throughput;
   if (all(equal(throughput, vec3(0.0)))) return false;
   vec3 origin = offsetRayOrigin(sp.position, sp.ng);
-  const uint hitSlot = pathHitSlot(pc.frame.z, pixel, c.pixelCount, depth);
+  const uint hitSlot = pathHitSlot(pc.sampleIndex, pixel, c.pixelCount, depth);
   RayHit h;
   if (kReplayRays) {
     h = probedPathHit(hitSlot, origin, wi);
@@ -215,14 +215,14 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
   const uint shadowRays = raysAtVertex(c, c.shadowRays, throughput);
   // A metal vertex reflects none of the ambient (R(P) = 0, lib/shade.glsl): no obscurance ray.
   const bool reflectsAmbient = any(greaterThan(obscuranceReflectance(sp), vec3(0.0)));
-  const uint obscuranceRays = reflectsAmbient ? raysAtVertex(c, pc.counts.z, throughput) : 0u;
+  const uint obscuranceRays = reflectsAmbient ? raysAtVertex(c, pc.obscuranceRays, throughput) : 0u;
   // MIS only where a lobe sample follows from this vertex (the path goes on past it).
   float misSamples = c.glossyMis && depth + 1u < c.maxDepth ? float(shadowRays) : 0.0;
   const vec4 lightShift = rngNext4(path.rng); // this vertex's light samples: one shifted low-discrepancy set
   if (kProbe && kReplayRays) {
     // The vertex's kept shadow rays (never kept for one light alone, nor without direct light:
     // the host keeps no rays with per-light shadow sampling).
-    probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.frame.z, pixel, c.pixelCount, depth, shadowRays);
+    probeKeptShadowRays(offsetRayOrigin(sp.position, sp.ng), pc.sampleIndex, pixel, c.pixelCount, depth, shadowRays);
   } else {
     // A probe whose shafts from the vertex to the lights all miss the boxes draws no light sample.
     const bool drawn = !kProbe || probeShadowRaysMayMeet(sp.position, c.lightCount);
@@ -239,7 +239,7 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
       vec3 contribution;
       uint light;
       directLightSample(sp, u, c.lightCount, misSamples, budget, contribution, light);
-      if (c.keepRays) keptShadowRays[keptShadowRaySlot(pc.frame.z, pixel, c.pixelCount, depth, k)] = gShadowRay;
+      if (c.keepRays) keptShadowRays[keptShadowRaySlot(pc.sampleIndex, pixel, c.pixelCount, depth, k)] = gShadowRay;
       OBS_ACCUMULATE_TEXEL(specularBasis, light * c.pixelCount + pixel, vec4(throughput * contribution / float(shadowRays), 0.0))
     }
   }
@@ -294,12 +294,12 @@ PathState loadPath(uint pixel) {
   return path;
 }
 
-// One vertex (depth pc.rAve.w) of each path in this depth's queue.
+// One vertex (depth pc.pathDepth) of each path in this depth's queue.
 void main() {
-  gSceneScale = pc.eye.w;
-  gLightSampling = (pc.counts.w & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
+  gSceneScale = pc.sceneSize;
+  gLightSampling = (pc.renderFlags & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
   const SpecularConstants c = specularConstants();
-  const uint depth = uint(pc.rAve.w);
+  const uint depth = uint(pc.pathDepth);
   const uint queued = specularQueueBase(depth, c.pixelCount);
   const uint entry = gl_GlobalInvocationID.x;
   if (entry >= queue[queued + kQueueCount]) return;

@@ -12,7 +12,7 @@
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 
 void main() {
-  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, pc.frame.xy, pc.band.xy);
+  BandPixel bp = bandPixel(gl_GlobalInvocationID.xy, uvec2(pc.width, pc.height), uvec2(pc.firstRow, pc.rows));
   if (!bp.inside) return;
   uvec2 p = bp.frame;
   uint pixel = bp.index;

@@ -12,7 +12,7 @@ layout(std430, binding = kBindingTonemapOutput) writeonly buffer Out { uint disp
 
 void main() {
   uint pixel = gl_GlobalInvocationID.x;
-  if (pixel >= pc.frame.x * pc.frame.y) return;
-  vec4 v = composed[pixel * pc.slots.x + pc.frame.z];
-  display[pixel] = displayRgba8(pc.frame.w == 1u ? v.xxx : v.rgb, pc.params.x);
+  if (pixel >= pc.width * pc.rows) return;
+  vec4 v = composed[pixel * pc.composedSlots + pc.slot];
+  display[pixel] = displayRgba8(pc.channels == 1u ? v.xxx : v.rgb, pc.exposureScale);
 }

@@ -26,7 +26,7 @@ layout(set = 0, binding = kBindingPassFirst + 2, r32ui) uniform writeonly uimage
 // rays that arrive in a coherent order are traced side by side.
 uint rayIndex(uint k) {
   uint g = gl_GlobalInvocationID.x;
-  return pc.params.w + (g / 8u) * 8u * kRaysPerLane + k * 8u + g % 8u;
+  return pc.firstRay + (g / 8u) * 8u * kRaysPerLane + k * 8u + g % 8u;
 }
 
 GpuRay streamRay(uint k) {
@@ -53,9 +53,9 @@ void streamHit(uint k, RayHit h) {
 void main() {
   if (kRaysPerLane == 1u) { // one ray per invocation: straight through traverseBvh
     const uint i = rayIndex(0u);
-    if (i >= pc.params.x) return;
+    if (i >= pc.rayCount) return;
     GpuRay ray = streamRay(0u);
-    RayHit h = traverseBvh(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, pc.params.y != 0u,
+    RayHit h = traverseBvh(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, pc.anyHit != 0u,
                            kMaxTraversalSteps);
     if (h.primitive == kTruncatedHit) atomicAdd(status[kStatusTruncated], 1u);
     imageStore(hits, int(i), vec4(h.t, h.u, h.v, uintBitsToFloat(h.primitive)));
@@ -63,12 +63,12 @@ void main() {
     return;
   }
   uint count = 0u;
-  while (count < kRaysPerLane && rayIndex(count) < pc.params.x) ++count;
+  while (count < kRaysPerLane && rayIndex(count) < pc.rayCount) ++count;
   // An if, not ?: — glslang evaluates both sides of a ?: whose condition is a specialisation
   // constant (then selects), which ran both loops over one layout.
   uint truncated;
-  if (kBinaryLayout) truncated = traverseBinaryStream(count, pc.params.y != 0u, kMaxTraversalSteps);
-  else truncated = traverseStream(count, pc.params.y != 0u, kMaxTraversalSteps);
+  if (kBinaryLayout) truncated = traverseBinaryStream(count, pc.anyHit != 0u, kMaxTraversalSteps);
+  else truncated = traverseStream(count, pc.anyHit != 0u, kMaxTraversalSteps);
   if (truncated != 0u) atomicAdd(status[kStatusTruncated], truncated);
   for (uint k = 0u; k < count; ++k) {
     uvec2 stored = sHits[hitSlot(k)];

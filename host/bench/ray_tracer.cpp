@@ -110,8 +110,8 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
       timestamps_.begin(cmd, repeatLabel(r));
       for (std::uint32_t first = 0; first < n; first += raysPerDispatch) {
         std::uint32_t count = std::min(raysPerDispatch, n - first);
-        gpu::TracePush push{.params = glm::uvec4(n, static_cast<std::uint32_t>(mode), 0u, first)};
-        kernel.dispatch(cmd, gpu::groupsFor(count, raysPerGroup), 1, 1, &push);
+        const gpu::TracePush push{.rayCount = n, .anyHit = static_cast<std::uint32_t>(mode), .unused = 0u, .firstRay = first};
+        kernel.dispatch(cmd, gpu::groupsFor(count, raysPerGroup), 1, 1, push);
       }
       timestamps_.end(cmd, repeatLabel(r));
     }

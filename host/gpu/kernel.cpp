@@ -116,26 +116,20 @@ void Kernel::bind(std::uint32_t binding, const TexelBuffer& buffer, std::uint32_
       nullptr);
 }
 
-void Kernel::bindCommon(const vk::raii::CommandBuffer& cmd, const void* push, std::uint32_t set) const {
+void Kernel::bindCommon(const vk::raii::CommandBuffer& cmd, const void* push, std::uint32_t bytes,
+                        std::uint32_t set) const {
+  if (bytes != pushBytes_)
+    throw std::logic_error(fmt::format("{}: push constants of {} bytes for a kernel that declares {}", name_, bytes,
+                                       pushBytes_));
   compile();
   cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *shared_->pipeline);
   cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *shared_->layout, 0, {*descriptorSet(set)}, {});
-  if (pushBytes_) {
-    if (!push) throw std::logic_error(fmt::format("{}: push constants missing", name_));
+  if (pushBytes_)
     cmd.pushConstants<std::uint8_t>(*shared_->layout, vk::ShaderStageFlagBits::eCompute, 0,
                                     vk::ArrayProxy<const std::uint8_t>(pushBytes_, static_cast<const std::uint8_t*>(push)));
-  }
 }
 
-void Kernel::dispatch(const vk::raii::CommandBuffer& cmd, std::uint32_t groupsX, std::uint32_t groupsY,
-                      std::uint32_t groupsZ, const void* push, std::uint32_t set) const {
-  bindCommon(cmd, push, set);
-  cmd.dispatch(groupsX, groupsY, groupsZ);
-}
-
-void Kernel::dispatchIndirect(const vk::raii::CommandBuffer& cmd, const Buffer& args,
-                              vk::DeviceSize offset, const void* push, std::uint32_t set) const {
-  bindCommon(cmd, push, set);
+void Kernel::recordIndirect(const vk::raii::CommandBuffer& cmd, const Buffer& args, vk::DeviceSize offset) const {
   cmd.dispatchIndirect(args.handle(), offset);
 }
 

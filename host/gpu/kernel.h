@@ -11,6 +11,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <vulkan/vulkan_raii.hpp>
@@ -49,6 +50,10 @@ KernelDesc storageKernelDesc(std::string name, std::span<const std::uint32_t> sp
                              std::uint32_t pushConstantBytes, std::initializer_list<std::uint32_t> uniformTexelBindings,
                              std::uint32_t setCount = 1);
 
+// The push constants of a kernel that declares none.
+struct NoPush {};
+inline constexpr NoPush kNoPush{};
+
 class Kernel {
 public:
   Kernel(const Context& context, const KernelDesc& desc);
@@ -60,12 +65,26 @@ public:
   void bind(std::uint32_t binding, const Buffer& buffer, std::uint32_t set = 0);
   void bind(std::uint32_t binding, const TexelBuffer& buffer, std::uint32_t set = 0);
 
-  // Records push constants + dispatch of groups. `push` must be pushConstantBytes long.
+  // Records `push` (the kernel's push-constant struct from shaders/shared/host_device.h, or
+  // kNoPush) and a dispatch of groups over descriptor set `set`. A struct of another size than the
+  // kernel declared (KernelDesc::pushConstantBytes) is a logic_error naming the kernel.
+  template <class Push>
   void dispatch(const vk::raii::CommandBuffer& cmd, std::uint32_t groupsX, std::uint32_t groupsY,
-                std::uint32_t groupsZ, const void* push = nullptr, std::uint32_t set = 0) const;
-  // Records an indirect dispatch whose group counts come from `args` at `offset`.
+                std::uint32_t groupsZ, const Push& push, std::uint32_t set = 0) const {
+    bindCommon(cmd, pushBytes(push), pushSize(push), set);
+    cmd.dispatch(groupsX, groupsY, groupsZ);
+  }
+  void dispatch(const vk::raii::CommandBuffer& cmd, std::uint32_t groupsX, std::uint32_t groupsY,
+                std::uint32_t groupsZ) const {
+    dispatch(cmd, groupsX, groupsY, groupsZ, kNoPush);
+  }
+  // The same, its group counts read from `args` at `offset` (an indirect dispatch).
+  template <class Push>
   void dispatchIndirect(const vk::raii::CommandBuffer& cmd, const Buffer& args, vk::DeviceSize offset,
-                        const void* push = nullptr, std::uint32_t set = 0) const;
+                        const Push& push, std::uint32_t set = 0) const {
+    bindCommon(cmd, pushBytes(push), pushSize(push), set);
+    recordIndirect(cmd, args, offset);
+  }
 
   // Creates the pipeline now (before a timed dispatch), if no dispatch has yet.
   void compile() const;
@@ -78,7 +97,18 @@ public:
   std::uint32_t setCount() const { return static_cast<std::uint32_t>(sets_.size()); }
 
 private:
-  void bindCommon(const vk::raii::CommandBuffer& cmd, const void* push, std::uint32_t set) const;
+  template <class Push>
+  static const void* pushBytes(const Push& push) {
+    static_assert(std::is_trivially_copyable_v<Push> && !std::is_pointer_v<Push>,
+                  "push constants are a struct of host_device.h, passed by reference");
+    return std::is_same_v<Push, NoPush> ? nullptr : &push;
+  }
+  template <class Push>
+  static std::uint32_t pushSize(const Push&) {
+    return std::is_same_v<Push, NoPush> ? 0u : static_cast<std::uint32_t>(sizeof(Push));
+  }
+  void bindCommon(const vk::raii::CommandBuffer& cmd, const void* push, std::uint32_t bytes, std::uint32_t set) const;
+  void recordIndirect(const vk::raii::CommandBuffer& cmd, const Buffer& args, vk::DeviceSize offset) const;
   const vk::raii::DescriptorSet& descriptorSet(std::uint32_t set) const;
 
   const Context* context_;

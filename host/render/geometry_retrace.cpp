@@ -61,14 +61,13 @@ GeometryRetrace::Result GeometryRetrace::retrace(const Frame& frame, const Edit&
     });
   }
   const Result result{.pixels = markedPixels() - dirtyBefore, .probed = probe};
-  const std::uint32_t primaryFlags = gpu::kPrimaryFlagDirtyOnly | (frame.primaryAovs ? 0u : gpu::kPrimaryFlagNoAovs);
   for (std::uint32_t first = 0; result.pixels > 0 && first < frame.samples; first += kSamplesPerSubmission) {
     const std::uint32_t last = std::min(frame.samples, first + kSamplesPerSubmission);
     frame.stream.submit([&](const vk::raii::CommandBuffer& cmd) {
       frame.timestamps.reset(cmd);
       for (std::uint32_t s = first; s < last; ++s) {
         gpu::computeBarrier(cmd);
-        frame.recorder.recordSample(cmd, s, primaryFlags, gpu::kShadeFlagDirtyOnly, true);
+        frame.recorder.recordSample(cmd, s, SampleMode::Retrace, true);
       }
     });
     frame.timestamps.collect();
@@ -80,15 +79,13 @@ void GeometryRetrace::probeCandidates(const Frame& frame) {
   // Every sample in order over the candidates: the G-buffer holds sample 0 already only where the
   // frame has one sample; else each sample's primary hits are traced again (G-buffer only: the
   // candidates' camera rays miss the changed boxes, so they find what the frame's did).
-  const std::uint32_t primaryFlags = gpu::kPrimaryFlagDirtyOnly | gpu::kPrimaryFlagGBufferOnly;
-  const std::uint32_t shadeFlags = gpu::kShadeFlagDirtyOnly | gpu::kShadeFlagProbe;
   for (std::uint32_t first = 0; first < frame.samples; first += kSamplesPerSubmission) {
     const std::uint32_t last = std::min(frame.samples, first + kSamplesPerSubmission);
     frame.stream.submit([&](const vk::raii::CommandBuffer& cmd) {
       frame.timestamps.reset(cmd);
       for (std::uint32_t s = first; s < last; ++s) {
         gpu::computeBarrier(cmd);
-        frame.recorder.recordSample(cmd, s, primaryFlags, shadeFlags, !(s == 0 && frame.gbufferSample == 0));
+        frame.recorder.recordSample(cmd, s, SampleMode::Probe, !(s == 0 && frame.gbufferSample == 0));
       }
     });
     frame.timestamps.collect();

@@ -27,13 +27,17 @@ enum class DirtyTest { Auto, Bounds, Probe };
 inline constexpr NameTable<DirtyTest, 3> kDirtyTestNames{
     {{"auto", DirtyTest::Auto}, {"probe", DirtyTest::Probe}, {"bounds", DirtyTest::Bounds}}};
 
-// The renderer's sample loop as a retrace drives it: sample `sample`'s passes, with the primary
-// pass's flags (kPrimaryFlag*) and the shading passes' (kShadeFlag*); `tracePrimary` false: the
-// G-buffer holds the sample already.
+// How a sample's passes run: over every pixel (a render), over the dirty list (a geometry edit's
+// retrace), or probing the dirty list's candidates (the primary pass remakes their G-buffer, the
+// shading passes test their rays against the changed boxes: lib/probe.glsl).
+enum class SampleMode { Render, Retrace, Probe };
+
+// The renderer's sample loop as a retrace drives it: sample `sample`'s passes in `mode`;
+// `tracePrimary` false: the G-buffer holds the sample already.
 class SampleRecorder {
 public:
-  virtual void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, std::uint32_t primaryFlags,
-                            std::uint32_t shadeFlags, bool tracePrimary) = 0;
+  virtual void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, SampleMode mode,
+                            bool tracePrimary) = 0;
 
 protected:
   ~SampleRecorder() = default;
@@ -68,7 +72,6 @@ public:
     float dMax = 0.0f;
     float changedBoxPadding = 0.0f;   // render/light_reach_model.h
     bool specular = false;            // the frame has specular paths
-    bool primaryAovs = true;          // the frame keeps the primary pass's AOVs
   };
   // The edit.
   struct Edit {

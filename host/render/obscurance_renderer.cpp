@@ -239,41 +239,37 @@ void ObscuranceRenderer::prepareForEdits() const {
   specularPass_.compileEditKernels(frame_.contents().keptRaySamples > 0);
 }
 
-std::uint32_t ObscuranceRenderer::keptRaysFlag(std::uint32_t sample, bool replaying) const {
+bool ObscuranceRenderer::keptRays(std::uint32_t sample, bool replaying) const {
   // Per-light shadow sampling takes 4 to 64 rays per light: those are not kept.
   const bool kept = sample < frame_.contents().keptRaySamples && settings_.maxDepth <= gpu::kPathHitsPerSample + 1 &&
                     settings_.shadowRays <= frame_.contents().keptShadowRays &&
                     settings_.shadowSampling == ShadowSampling::Selection;
-  return kept && (!replaying || geometry_.keptRaysValid()) ? gpu::kShadeFlagKeptRays : 0u;
+  return kept && (!replaying || geometry_.keptRaysValid());
 }
 
-gpu::ShadePush ObscuranceRenderer::forLight(gpu::ShadePush push, std::uint32_t light) {
-  push.band.z |= gpu::kShadeFlagPerLight;
-  push.band.w = light;
-  return push;
+ShadeSample ObscuranceRenderer::shadeSample(std::uint32_t sample) const {
+  return {.width = settings_.width, .height = settings_.height, .sample = settings_.firstSample + sample,
+          .seed = settings_.seed, .lights = static_cast<std::uint32_t>(lights_.size()),
+          .shadowRays = settings_.shadowRays, .obscuranceRays = settings_.obscuranceRays,
+          .dMax = dMax_, .tau = settings_.tau, .rho = static_cast<std::uint32_t>(settings_.rho),
+          .maxDepth = settings_.maxDepth, .systematic = settings_.systematic,
+          .colourBleeding = settings_.colourBleeding,
+          .areaLightSampling = settings_.lightSampling == LightSampling::Area,
+          // Glossy MIS needs the specular pass's lobe sample and light samples drawn over all lights.
+          .glossyMis = settings_.lightSampling == LightSampling::Spatial &&
+                       settings_.shadowSampling == ShadowSampling::Selection && runSpecular_,
+          .secondaryReflectors = reflectorsOn(), .vertexRaysByThroughput = settings_.vertexRaysByThroughput,
+          .averageReflectance = ambient_.averageReflectance, .eye = settings_.camera.position,
+          .sceneSize = sceneScale_,
+          .kappa = ambientShareBeyondFirstBounce(ambient_.averageReflectance,
+                                                 ambient_.model != AmbientModel::Global ? ambient_.depth : 0u),
+          .unmarkedFirstBounce = unmarkedFirstBounce_};
 }
 
-gpu::ShadePush ObscuranceRenderer::shadePush(std::uint32_t sample) const {
-  // Glossy MIS needs the specular pass's lobe sample and light samples drawn over all lights.
-  const bool glossyMis = settings_.lightSampling == LightSampling::Spatial &&
-                         settings_.shadowSampling == ShadowSampling::Selection && runSpecular_;
-  const std::uint32_t flags = (settings_.systematic ? gpu::kFlagSystematic : 0u) |
-                              (settings_.colourBleeding ? gpu::kFlagBleed : 0u) |
-                              (settings_.lightSampling == LightSampling::Area ? gpu::kFlagAreaLightSampling : 0u) |
-                              (glossyMis ? gpu::kFlagGlossyMis : 0u) |
-                              (reflectorsOn() ? gpu::kFlagSecondaryReflectors : 0u) |
-                              (settings_.vertexRaysByThroughput ? gpu::kFlagVertexRaysByThroughput : 0u);
-  return {.frame = glm::uvec4(settings_.width, settings_.height, settings_.firstSample + sample, settings_.seed),
-          .counts = glm::uvec4(static_cast<std::uint32_t>(lights_.size()), settings_.shadowRays,
-                               settings_.obscuranceRays, flags),
-          .params = glm::vec4(dMax_, settings_.tau, static_cast<float>(settings_.rho),
-                              static_cast<float>(settings_.maxDepth)),
-          .rAve = glm::vec4(ambient_.averageReflectance, 0.0f),
-          .eye = glm::vec4(settings_.camera.position, sceneScale_),
-          .band = glm::uvec4(0u),
-          .reflectors = glm::vec4(ambientShareBeyondFirstBounce(ambient_.averageReflectance,
-                                                                ambient_.model != AmbientModel::Global ? ambient_.depth : 0u),
-                                  unmarkedFirstBounce_)};
+PrimaryPass::Dispatch ObscuranceRenderer::primaryDispatch(std::uint32_t sample) const {
+  return {.sample = settings_.firstSample + sample, .firstSample = settings_.firstSample, .seed = settings_.seed,
+          .lights = static_cast<std::uint32_t>(lights_.size()), .aovs = settings_.primaryAovs,
+          .emissionSamples = settings_.emissionSamples};
 }
 
 void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progress) {
@@ -288,7 +284,7 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
       timestamps_.reset(cmd);
       for (std::uint32_t s = samples_; s < last; ++s) {
         if (s > samples_) gpu::computeBarrier(cmd);
-        recordSample(cmd, s, settings_.primaryAovs ? 0u : gpu::kPrimaryFlagNoAovs, 0u);
+        recordSample(cmd, s, SampleMode::Render);
       }
     });
     timestamps_.collect();
@@ -304,73 +300,65 @@ std::uint64_t ObscuranceRenderer::cameraRaysPerSample() const {
   return settings_.emissionSamples > 1 ? 1u + settings_.emissionSamples : 1u;
 }
 
-void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t s, std::uint32_t primaryFlags,
-                                      std::uint32_t shadeFlags, bool tracePrimary) {
-  const FrameLayout& layout = frame_.layout();
-  const std::uint32_t bands = layout.bandCount();
+void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t s, SampleMode mode,
+                                      bool tracePrimary) {
+  const std::uint32_t bands = frame_.layout().bandCount();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
-  const gpu::GpuCamera camera = primaryCamera();
-  gpu::ShadePush push = shadePush(s);
-  push.band.z = shadeFlags;
-  // A probe follows the kept lobe hits; every other pass writes them (a per-light shadow sampling's
+  const ShadeSample sample = shadeSample(s);
+  const bool probe = mode == SampleMode::Probe;
+  // A retrace and a probe run over the dirty pixels' list (dirty.comp), dispatched indirectly. A
+  // probe follows the kept rays; every other pass writes them (a per-light shadow sampling's
   // per-light dispatches follow the hits the plain dispatch just wrote for the same pixels).
-  const bool probe = (shadeFlags & gpu::kShadeFlagProbe) != 0;
-  push.band.z |= keptRaysFlag(s, probe);
-  // A retrace runs over the dirty pixels' list (dirty.comp), dispatched indirectly.
-  const bool dirtyOnly = (shadeFlags & gpu::kShadeFlagDirtyOnly) != 0;
-  if (dirtyOnly != ((primaryFlags & gpu::kPrimaryFlagDirtyOnly) != 0))
-    throw std::logic_error("recordSample: the primary and shading passes retrace different pixels");
-  const ObscuranceFrame* dirtyOf = dirtyOnly ? &frame_ : nullptr;
+  const ShadeDispatch dispatch{.probe = probe, .dirtyOnly = mode != SampleMode::Render, .keptRays = keptRays(s, probe)};
+  const auto forLight = [](ShadeDispatch d, std::uint32_t light) {
+    d.light = light;
+    return d;
+  };
   // A probe's passes are timed as probe.<pass>.
   const auto label = [probe](const char* pass) { return probe ? "probe." + std::string(pass) : std::string(pass); };
-  // The emission rays go with every primary pass that sums (its flags ask for them).
-  if ((primaryFlags & gpu::kPrimaryFlagGBufferOnly) == 0 && settings_.emissionSamples > 1)
-    primaryFlags |= settings_.emissionSamples << gpu::kPrimaryEmissionSamplesShift;
   if (tracePrimary) {
-    recordBands(cmd, label("primary"), [&](std::uint32_t b) {
-      primary_.record(cmd, b, layout, camera, {.index = settings_.firstSample + s, .first = settings_.firstSample},
-                      settings_.seed, lightCount, primaryFlags, dirtyOf);
-    });
+    PrimaryPass::Dispatch primary = primaryDispatch(s);
+    primary.dirtyOnly = dispatch.dirtyOnly;
+    // A probe's candidates' camera rays miss the changed boxes, so they find what the frame's did:
+    // their G-buffer is made again, and nothing is summed.
+    primary.gbufferOnly = probe;
+    if (probe) primary.aovs = true;
+    const gpu::GpuCamera camera = primaryCamera();
+    recordBands(cmd, label("primary"), [&](std::uint32_t b) { primary_.record(cmd, b, frame_, camera, primary); });
     gpu::computeBarrier(cmd);
   }
   if (settings_.shadowSampling == ShadowSampling::PerLight) {
     timestamps_.time(cmd, label("shadow"), [&] {
-      for (std::uint32_t light = 0; light < lightCount; ++light) recordShadowForLight(cmd, push, light);
+      for (std::uint32_t light = 0; light < lightCount; ++light)
+        for (std::uint32_t b = 0; b < bands; ++b) shadow_.record(cmd, b, frame_, sample, forLight(dispatch, light));
     });
   } else if (lights_.anySampled() && settings_.shadowRays > 0) {
-    recordBands(cmd, label("shadow"), [&](std::uint32_t b) { shadow_.record(cmd, b, layout, push, dirtyOf); });
+    recordBands(cmd, label("shadow"), [&](std::uint32_t b) { shadow_.record(cmd, b, frame_, sample, dispatch); });
   }
   if (settings_.obscuranceRays > 0) {
-    recordBands(cmd, label("obscurance"), [&](std::uint32_t b) { obscurance_.record(cmd, b, layout, push, dirtyOf); });
+    recordBands(cmd, label("obscurance"), [&](std::uint32_t b) { obscurance_.record(cmd, b, frame_, sample, dispatch); });
   }
   if (runSpecular_) {
     if (probe) gpu::computeBarrier(cmd); // the costly specular probe skips what the others found
     timestamps_.time(cmd, label("specular"), [&] {
-      const auto specularBands = [&](const gpu::ShadePush& p) {
-        for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, layout, frame_, p);
+      const auto specularBands = [&](const ShadeDispatch& d) {
+        for (std::uint32_t b = 0; b < bands; ++b) specularPass_.record(cmd, b, frame_, sample, d);
       };
       if (settings_.shadowSampling == ShadowSampling::PerLight) {
         // The ambient along the paths once, then every light alone along the same paths: each
         // light's S_s is as independent of the others' powers as its D_s.
-        gpu::ShadePush ambientOnly = push;
-        ambientOnly.band.z |= gpu::kShadeFlagNoDirect;
+        ShadeDispatch ambientOnly = dispatch;
+        ambientOnly.noDirect = true;
         specularBands(ambientOnly);
         for (std::uint32_t light = 0; light < lightCount; ++light) {
           gpu::computeBarrier(cmd);
-          specularBands(forLight(push, light));
+          specularBands(forLight(dispatch, light));
         }
       } else {
-        specularBands(push);
+        specularBands(dispatch);
       }
     });
   }
-}
-
-void ObscuranceRenderer::recordShadowForLight(const vk::raii::CommandBuffer& cmd, gpu::ShadePush push,
-                                              std::uint32_t light) const {
-  const bool dirtyOnly = (push.band.z & gpu::kShadeFlagDirtyOnly) != 0;
-  for (std::uint32_t b = 0; b < frame_.layout().bandCount(); ++b)
-    shadow_.record(cmd, b, frame_.layout(), forLight(push, light), dirtyOnly ? &frame_ : nullptr);
 }
 
 std::uint64_t ObscuranceRenderer::updateGeometry(const scene::Scene& edited, const bvh::Bvh& bvh,
@@ -448,12 +436,11 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
   // The sky lights every pixel from every direction: any edit may change any pixel.
   // So do secondary reflectors: what the edit lights or shades anew is marked anew.
   const bool all = everyPixel || backgroundLight(lights_) < lights_.size() || reflectorsOn();
-  const bool keptAll = samples_ <= frame_.contents().keptRaySamples && keptRaysFlag(0, true) != 0;
+  const bool keptAll = samples_ <= frame_.contents().keptRaySamples && keptRays(0, true);
   const GeometryRetrace::Result r = geometry_.retrace(
       {.stream = stream_, .timestamps = timestamps_, .recorder = *this, .buffers = frame_, .camera = primaryCamera(),
        .lights = lightCount, .samples = samples_, .gbufferSample = gbufferSample_, .dMax = dMax_,
-       .changedBoxPadding = changedBoxPadding(scene_->bounds), .specular = runSpecular_,
-       .primaryAovs = settings_.primaryAovs},
+       .changedBoxPadding = changedBoxPadding(scene_->bounds), .specular = runSpecular_},
       {.changed = changed, .everyPixel = all, .tracedLight = tracedLight,
        .probe = GeometryRetrace::probing(settings_.dirtyTest, runSpecular_, keptAll)});
   primaryRays_ += r.pixels * samples_ * cameraRaysPerSample();
@@ -720,18 +707,18 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
         const std::uint32_t s = order[k];
         if (k > first) gpu::computeBarrier(cmd);
         if (s != gbufferSample_) {
-          recordBands(cmd, "primary", [&](std::uint32_t b) {
-            primary_.record(cmd, b, layout, camera, {.index = settings_.firstSample + s, .first = settings_.firstSample},
-                            settings_.seed, lightCount, gpu::kPrimaryFlagGBufferOnly);
-          });
+          const PrimaryPass::Dispatch gbuffer{.sample = settings_.firstSample + s, .firstSample = settings_.firstSample,
+                                              .seed = settings_.seed, .lights = lightCount, .gbufferOnly = true};
+          recordBands(cmd, "primary", [&](std::uint32_t b) { primary_.record(cmd, b, frame_, camera, gbuffer); });
           gpu::computeBarrier(cmd);
           primaryPixels += layout.pixels();
         }
-        gpu::ShadePush push = forLight(shadePush(s), light);
-        push.band.z |= keptRaysFlag(s, true); // the specular paths by their kept hits
-        recordBands(cmd, "shadow", [&](std::uint32_t b) { shadow_.record(cmd, b, layout, push); });
+        const ShadeSample sample = shadeSample(s);
+        // The light alone, the specular paths by their kept hits.
+        const ShadeDispatch alone{.light = light, .keptRays = keptRays(s, true)};
+        recordBands(cmd, "shadow", [&](std::uint32_t b) { shadow_.record(cmd, b, frame_, sample, alone); });
         if (runSpecular_)
-          recordBands(cmd, "specular", [&](std::uint32_t b) { specularPass_.record(cmd, b, layout, frame_, push); });
+          recordBands(cmd, "specular", [&](std::uint32_t b) { specularPass_.record(cmd, b, frame_, sample, alone); });
       }
     });
     timestamps_.collect();

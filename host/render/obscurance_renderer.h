@@ -313,12 +313,13 @@ private:
                              std::uint32_t tracedLight = gpu::kInvalidIndex);
   // The reach of an edited scene was measured beside the edit's GPU work: applied now.
   void finishReach() { reach_.finish(reachInputs(), ambient_); }
-  gpu::ShadePush shadePush(std::uint32_t sample) const;
-  // kShadeFlagKeptRays where the frame keeps sample `sample`'s lobe hits: for a pass that writes
-  // them, or (`replaying`) for one that follows them, only while they are the current scene's.
-  std::uint32_t keptRaysFlag(std::uint32_t sample, bool replaying) const;
-  // `push` for a dispatch of `light` alone (kShadeFlagPerLight).
-  static gpu::ShadePush forLight(gpu::ShadePush push, std::uint32_t light);
+  // What every shading dispatch of sample `sample` shares (the settings, I_a's constants).
+  ShadeSample shadeSample(std::uint32_t sample) const;
+  // Sample `sample`'s primary dispatch over every pixel, summing.
+  PrimaryPass::Dispatch primaryDispatch(std::uint32_t sample) const;
+  // Whether the frame keeps sample `sample`'s rays: for a pass that writes them, or (`replaying`)
+  // for one that follows them, only while they are the current scene's.
+  bool keptRays(std::uint32_t sample, bool replaying) const;
   gpu::GpuCamera primaryCamera() const; // with the background's slot
   std::vector<glm::vec4> downloadBand(const gpu::Buffer& buffer) const;
 
@@ -363,15 +364,13 @@ private:
   LightMixPass lightMix_;
   GeometryRetrace geometry_; // the dirty test and retrace of geometry edits, the kept rays' validity
   float sceneScale_ = 1.0f; // the ray-origin offset's scale, kept across geometry edits
-  // Sample `sample`'s passes. With kShadeFlagProbe in `shadeFlags` they probe the dirty list's
-  // candidates (lib/probe.glsl), timed as "probe.<pass>"; `tracePrimary` false: the G-buffer holds the
-  // sample already.
-  void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, std::uint32_t primaryFlags,
-                    std::uint32_t shadeFlags, bool tracePrimary = true) override;
+  // Sample `sample`'s passes over every pixel, or the dirty list's (a retrace), or probing its
+  // candidates (lib/probe.glsl, timed as "probe.<pass>"); `tracePrimary` false: the G-buffer holds
+  // the sample already.
+  void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, SampleMode mode,
+                    bool tracePrimary = true) override;
   // Camera rays a summing primary pass traces per pixel and sample: its own, and the emission rays.
   std::uint64_t cameraRaysPerSample() const;
-  // The shadow pass for `light` alone (kShadeFlagPerLight), over every band.
-  void recordShadowForLight(const vk::raii::CommandBuffer& cmd, gpu::ShadePush push, std::uint32_t light) const;
   // The resolved transport is current for lights before resolveFrom_ (and the ambient unless
   // resolveAmbient_); a new sample makes all of it stale, an added light only itself.
   std::uint32_t resolveFrom_ = 0;

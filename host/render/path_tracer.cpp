@@ -106,11 +106,11 @@ void PathTracer::iterate(std::uint32_t samples, const ProgressFn& progress) {
   gpu::PathPush push{.camera = gpuCamera(settings_.camera, settings_.width, settings_.height,
                                          sky < lights_.size() && lightCount > 0 ? static_cast<std::uint32_t>(sky)
                                                                                 : gpu::kInvalidIndex),
-                     .frame = glm::uvec4(settings_.width, settings_.height, 0u, settings_.seed),
-                     .params = glm::uvec4(lightCount, settings_.maxDepth, settings_.rrDepth,
-                                          static_cast<std::uint32_t>(settings_.strategy)),
-                     .band = glm::uvec4(0u, 0u, static_cast<std::uint32_t>(settings_.lightSampling),
-                                         settings_.emissionSamples)};
+                     .width = settings_.width, .height = settings_.height, .sampleIndex = 0u, .seed = settings_.seed,
+                     .lightCount = lightCount, .maxDepth = settings_.maxDepth, .rrDepth = settings_.rrDepth,
+                     .strategy = static_cast<std::uint32_t>(settings_.strategy), .firstRow = 0u, .rows = 0u,
+                     .lightSampling = static_cast<std::uint32_t>(settings_.lightSampling),
+                     .emissionSamples = settings_.emissionSamples};
   push.camera.right.w = sceneScale(scene_->bounds); // the ray-origin offset's scale (ray.glsl)
   const std::uint32_t end = samples_ + samples;
   while (samples_ < end) {
@@ -120,12 +120,12 @@ void PathTracer::iterate(std::uint32_t samples, const ProgressFn& progress) {
       timestamps_.begin(cmd, "pathtrace");
       for (std::uint32_t s = samples_; s < last; ++s) {
         if (s > samples_) gpu::computeBarrier(cmd);
-        push.frame.z = settings_.firstSample + s;
+        push.sampleIndex = settings_.firstSample + s;
         for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
-          push.band.x = layout_.bands[b].firstRow;
-          push.band.y = layout_.bands[b].rows;
+          push.firstRow = layout_.bands[b].firstRow;
+          push.rows = layout_.bands[b].rows;
           kernel_.dispatch(cmd, gpu::groupsFor(settings_.width, gpu::kWorkgroupSizeX),
-                           gpu::groupsFor(layout_.bands[b].rows, gpu::kWorkgroupSizeY), 1, &push, b);
+                           gpu::groupsFor(layout_.bands[b].rows, gpu::kWorkgroupSizeY), 1, push, b);
         }
       }
       timestamps_.end(cmd, "pathtrace");

@@ -63,9 +63,9 @@ RayHit probedPathHit(uint slot, vec3 origin, vec3 direction) {
 }
 
 // Where shadow ray `k` of `pixel`'s sample `s` is kept, at its primary hit (`vertex` 0) or at a
-// specular path's vertex (1..kPathHitsPerSample): N_s = pc.counts.y per vertex.
+// specular path's vertex (1..kPathHitsPerSample): N_s = pc.shadowRays per vertex.
 uint keptShadowRaySlot(uint s, uint pixel, uint pixelCount, uint vertex, uint k) {
-  return ((s * pixelCount + pixel) * (kPathHitsPerSample + 1u) + vertex) * pc.counts.y + k;
+  return ((s * pixelCount + pixel) * (kPathHitsPerSample + 1u) + vertex) * pc.shadowRays + k;
 }
 
 // A probe's test of the `count` kept shadow rays of a shading point whose rays leave from `origin`.

@@ -41,7 +41,7 @@ void reflectedDirectLight(Surface s, vec3 direction, vec4 u, inout StepBudget bu
   vec3 ns = dot(s.shadingNormal, wo) < 0.0 ? -s.shadingNormal : s.shadingNormal;
   GpuMaterial m = materialAt(s.material);
   ShadingPoint q = shadingPoint(s.position, s.geometricNormal, ns, wo, materialBaseColor(m, s.uv).rgb, s.material);
-  directLightSample(q, u, pc.counts.x, 0.0, budget, contribution, light);
+  directLightSample(q, u, pc.lightCount, 0.0, budget, contribution, light);
 }
 
 // n cosine-distributed rays (N_obs at a primary hit; a specular path's vertex may take fewer,
@@ -61,11 +61,11 @@ void reflectedDirectLight(Surface s, vec3 direction, vec4 u, inout StepBudget bu
 // render, so I_a stays linear in every emission; secondary_reflectors.h).
 vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, uint reflectorPixel, uint pixelCount,
                       uint n) {
-  const bool systematic = (pc.counts.w & kFlagSystematic) != 0u;
-  const bool bleed = !kGreyObscurance && (pc.counts.w & kFlagBleed) != 0u;
-  const bool reflectors = kReflectors && reflectorPixel != kInvalidIndex && (pc.counts.w & kFlagSecondaryReflectors) != 0u;
-  const float dMax = pc.params.x;
-  const uint rhoKind = uint(pc.params.z);
+  const bool systematic = (pc.renderFlags & kFlagSystematic) != 0u;
+  const bool bleed = !kGreyObscurance && (pc.renderFlags & kFlagBleed) != 0u;
+  const bool reflectors = kReflectors && reflectorPixel != kInvalidIndex && (pc.renderFlags & kFlagSecondaryReflectors) != 0u;
+  const float dMax = pc.dMax;
+  const uint rhoKind = uint(pc.rhoKind);
   uvec2 grid = systematicGrid(n);
   vec2 offset = vec2(rngNext(rng), rngNext(rng)); // systematic: ONE random pair per hit
   // The reflectors' light samples come from a stream of their own, so the obscurance rays are
@@ -92,16 +92,16 @@ vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, 
     if (dot(direction, sp.ng) > 0.0) {
       RayHit h = traceWithBudget(budget, origin, direction, 0.0, dMax, false);
       if (rayHitValid(h) && h.primitive != kInvalidIndex) {
-        r = rho(h.t, dMax, rhoKind, pc.params.y);
+        r = rho(h.t, dMax, rhoKind, pc.tau);
         bool reflector = reflectors && triangleShadingAt(h.primitive).n2.w != 0.0;
         // An unmarked surface keeps the later bounces and the first scaled by r (the marked
         // ones hold more than the mean direct light, the rest less; secondary_reflectors.h).
-        if (reflectors && !reflector && pc.reflectors.w != 1.0) share = pc.reflectors.rgb + pc.reflectors.w * (1.0 - pc.reflectors.rgb);
+        if (reflectors && !reflector && pc.unmarkedFirstBounce != 1.0) share = pc.kappa + pc.unmarkedFirstBounce * (1.0 - pc.kappa);
         if (bleed || reflector) {
           Surface s = surfaceAt(h, origin, direction);
           reflectance = bleed ? reflectanceAt(s) : vec3(0.0);
           if (reflector) {
-            share = pc.reflectors.rgb;
+            share = pc.kappa;
             vec3 contribution;
             uint light;
             uint tracedBefore = budget.traced;
@@ -114,7 +114,7 @@ vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, 
         }
       } else {
         r = 1.0;
-        reflectance = pc.rAve.rgb;
+        reflectance = pc.averageReflectance;
       }
     }
     w += r;

@@ -50,30 +50,30 @@ layout(push_constant) uniform Push { ShadePush pc; };
 // allocated over the whole shader).
 layout(constant_id = kSpecConstantPerLight) const bool kPerLight = false;
 
-// Whether this dispatch shades light pc.band.w alone (kShadeFlagPerLight): the per-light variant,
+// Whether this dispatch shades light pc.light alone (kShadeFlagPerLight): the per-light variant,
 // or a probe of a per-light dispatch. The host sends every other per-light dispatch to that variant.
-bool shadesOneLight() { return kPerLight || (kProbe && (pc.band.z & kShadeFlagPerLight) != 0u); }
+bool shadesOneLight() { return kPerLight || (kProbe && (pc.dispatchFlags & kShadeFlagPerLight) != 0u); }
 
 // Whether this pass skips `pixel`: a retrace after a geometry edit runs the dirty pixels only, and
 // a probing pass the candidates that no probe has found dirty yet (mask 1, dirty.comp).
 bool skipClean(uint pixel) {
-  if ((pc.band.z & kShadeFlagProbe) != 0u) return dirty[pixel] != 1u;
-  return (pc.band.z & kShadeFlagDirtyOnly) != 0u && dirty[pixel] == 0u;
+  if ((pc.dispatchFlags & kShadeFlagProbe) != 0u) return dirty[pixel] != 1u;
+  return (pc.dispatchFlags & kShadeFlagDirtyOnly) != 0u && dirty[pixel] == 0u;
 }
 
 // The pixel of this invocation: over the band in 2D, or (a retrace, kShadeFlagDirtyOnly) over the
 // band's dirty list, dispatched indirectly.
 BandPixel shadedPixel() {
-  if ((pc.band.z & kShadeFlagDirtyOnly) == 0u) return bandPixel(gl_GlobalInvocationID.xy, pc.frame.xy, pc.band.xy);
-  const uint base = dirtyListBase(pc.frame.x * pc.band.y), entry = listEntry(), count = dirty[base + kQueueCount];
-  return listedPixel(entry, count, entry < count ? dirty[base + kQueueHeader + entry] : 0u, pc.frame.xy, pc.band.xy);
+  if ((pc.dispatchFlags & kShadeFlagDirtyOnly) == 0u) return bandPixel(gl_GlobalInvocationID.xy, uvec2(pc.width, pc.height), uvec2(pc.firstRow, pc.rows));
+  const uint base = dirtyListBase(pc.width * pc.rows), entry = listEntry(), count = dirty[base + kQueueCount];
+  return listedPixel(entry, count, entry < count ? dirty[base + kQueueHeader + entry] : 0u, uvec2(pc.width, pc.height), uvec2(pc.firstRow, pc.rows));
 }
 
 // Starts a probing kernel (kProbe, dispatched with kShadeFlagProbe) if this is one: the changed
 // boxes from the dirty buffer's tail (DirtyPass::record). Returns whether it is.
 bool beginProbe() {
   if (!kProbe) return false;
-  const uint base = dirtyBoxesBase(pc.frame.x * pc.band.y);
+  const uint base = dirtyBoxesBase(pc.width * pc.rows);
   for (uint b = 0u; b < kMaxChangedBoxes; ++b) {
     uint at = base + 8u * b;
     gProbeUsed[b] = uintBitsToFloat(dirty[at + 3u]) != 0.0;
@@ -87,7 +87,7 @@ bool beginProbe() {
 // shafts from p to the lights' bounds (lib/shaft.glsl, as dirty.comp tests a hit box). Where none
 // does, a probe need not draw p's light samples: none of its shadow rays can meet a box.
 bool probeShadowRaysMayMeet(vec3 p, uint lightCount) {
-  const uint lightsAt = dirtyLightsBase(pc.frame.x * pc.band.y);
+  const uint lightsAt = dirtyLightsBase(pc.width * pc.rows);
   for (uint b = 0u; b < kMaxChangedBoxes; ++b) {
     if (!gProbeUsed[b]) continue;
     vec3 bc = 0.5 * (gProbeLo[b] + gProbeHi[b]), bh = 0.5 * (gProbeHi[b] - gProbeLo[b]);

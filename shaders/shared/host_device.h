@@ -12,6 +12,7 @@
 #include <glm/glm.hpp>
 namespace obscura::gpu {
 using vec2 = glm::vec2;
+using vec3 = glm::vec3;
 using vec4 = glm::vec4;
 using uvec4 = glm::uvec4;
 using ivec4 = glm::ivec4;
@@ -264,15 +265,28 @@ OBS_CONST uint kTexelsPerGBuffer = 4;
 // basis and compose buffers, and every per-pixel pass is dispatched once per band. Pixels are
 // addressed band-locally (index = local row * width + x) but sampled with their FRAME coordinates,
 // so a frame rendered in bands is bit-identical to the same frame rendered whole.
-// band = (first row of the band, rows in the band, light count, unused).
+// A pass's push constants name the band's first row and rows (firstRow, rows).
+//
+// Push constants are filled in one place on the host each (render/passes: PrimaryPass::record,
+// packShadePush) from a struct with named fields (PrimaryDispatch, ShadeSample + ShadeDispatch);
+// flag words carry the dispatch's choices to the shader as the kernel choice reads them.
 
 // ---- Push constants of primary.comp (<= 128 bytes, the guaranteed minimum).
 struct PrimaryPush {
   GpuCamera camera;   // 0
-  uvec4 frame;        // 64: width, height (of the whole frame), sample index, seed
-  uvec4 band;         // 80: first row, rows, light count, flags (kPrimaryFlag*)
-  uvec4 accumulation; // 96: x = the sample the accumulation started at (0 but for a farm's part,
-                      //     render --samples A:B), unused
+  uint width;         // 64: of the whole frame (a band's or a farm part's rows are rows of it)
+  uint height;
+  uint sampleIndex;   // the sample's index in the frame's sequence (seeds, sub-pixel position)
+  uint seed;
+  uint firstRow;      // 80: the band's rows
+  uint rows;
+  uint lightCount;
+  uint flags;         // kPrimaryFlag*, and the emission rays' K from kPrimaryEmissionSamplesShift up
+  uint firstSample;   // 96: the sample the accumulation started at (0 but for a farm's part,
+                      //     render --samples A:B)
+  uint unused0;       // to 112 bytes: GLSL rounds the struct to its 16-byte alignment
+  uint unused1;
+  uint unused2;
 };                    // 112 bytes
 // The primary pass re-creates the G-buffer of a sample without adding to the AOV and emission
 // accumulators (an added light traces its shadow rays from the same primary hits).
@@ -311,8 +325,11 @@ static_assert(kTraceWorkgroupSize * kTraceRaysPerLane * 12 <= 32768, "trace.comp
 static_assert(kTraceWorkgroupSize % 8 == 0, "lavapipe runs 8 invocations per SIMD group");
 #endif
 struct TracePush {
-  uvec4 params; // 0: ray count, mode (0 closest, 1 any), unused (steps: kSpecConstantTraceSteps), first ray index
-};              // 16 bytes
+  uint rayCount;  // 0
+  uint anyHit;    // 0: the closest hit, 1: any hit (a shadow ray)
+  uint unused;    // (the steps variant is kSpecConstantTraceSteps)
+  uint firstRay;  // the first ray's index in the buffer
+};                // 16 bytes
 
 // ---- Descriptor bindings (set 0) shared by every pass that traces rays.
 OBS_CONST uint kBindingBvhItems = 0;  // samplerBuffer RGBA32F: nodes, then triangles (64-byte items)
@@ -343,7 +360,7 @@ OBS_CONST uint kFlagAreaLightSampling = 4u; // the paper's light sampling (kLigh
 OBS_CONST uint kFlagGlossyMis = 8u;
 // Important secondary reflectors [RTO §2.2, §6]: an obscurance ray from a primary hit that lands
 // on a marked triangle (TriangleShading.n2.w) traces that point's direct light too, into D_s, and
-// keeps only the share kappa (ShadePush.reflectors) of the ambient there.
+// keeps only the share kappa (ShadePush.kappa) of the ambient there.
 OBS_CONST uint kFlagSecondaryReflectors = 16u;
 // A specular path's vertices gather with N_s and N_obs scaled by the path's throughput there, at
 // least one ray each (specular.comp, raysAtVertex); without it, N_s and N_obs at every vertex.
@@ -354,19 +371,33 @@ OBS_CONST uint kRhoExp = 1u;         // rho(d) = (1 - e^(-tau d/dmax)) / (1 - e^
 OBS_CONST uint kRhoAo = 2u;          // rho(d) = 0 below dmax (ambient occlusion)
 
 struct ShadePush {
-  uvec4 frame;  // 0:  width, height, sample index, seed
-  uvec4 counts; // 16: light count, shadow rays per hit, obscurance rays per hit, flags
-  vec4 params;  // 32: dMax, tau, rho kind (as float), maximum path depth (as float)
-  vec4 rAve;    // 48: R_ave rgb (the reflectance of a miss within dmax, SPEC §1.2), w = the path
-                //     depth of a specular.comp dispatch (as float)
-  vec4 eye;     // 64: camera position xyz (the view direction at primary hits), w = scene size
-                //     (largest bounding-box extent: scales the ray-origin offset, ray.glsl)
-  uvec4 band;   // 80: first row, rows, flags (kShadeFlag*), the light of a per-light dispatch
-  vec4 reflectors; // 96: kappa rgb, the share of I_a beyond the first bounce, w = r, the unmarked
-                   //     surfaces' first bounce against the mean (kFlagSecondaryReflectors)
-};              // 112 bytes
+  // What every dispatch of one sample shares (render/passes/shading_inputs.h, ShadeSample).
+  uint width;              // 0: of the whole frame
+  uint height;
+  uint sampleIndex;        // the sample's index in the frame's sequence
+  uint seed;
+  uint lightCount;         // 16
+  uint shadowRays;         // N_s per hit
+  uint obscuranceRays;     // N_obs per hit
+  uint renderFlags;        // kFlag*: how the render samples
+  float dMax;              // 32
+  float tau;               // for kRhoExp
+  float rhoKind;           // kRho* (as float)
+  float maxDepth;          // a specular path's scattering vertices, the primary hit is 1 (as float)
+  vec3 averageReflectance; // 48: R_ave (the reflectance of a miss within dmax, SPEC §1.2)
+  float pathDepth;         // the vertex depth of a specular.comp dispatch (as float)
+  vec3 eye;                // 64: the camera's position (the view direction at primary hits)
+  float sceneSize;         // the largest bounding-box extent: scales the ray-origin offset (ray.glsl)
+  // What this dispatch does (ShadeDispatch).
+  uint firstRow;           // 80: the band's rows
+  uint rows;
+  uint dispatchFlags;      // kShadeFlag*
+  uint light;              // the light of a per-light dispatch (kShadeFlagPerLight)
+  vec3 kappa;              // 96: the share of I_a beyond the first bounce (kFlagSecondaryReflectors)
+  float unmarkedFirstBounce; // r: the unmarked surfaces' first bounce against the mean
+};                         // 112 bytes
 OBS_CONST uint kShadeFlagDirtyOnly = 1u; // only pixels the dirty mask marks run
-// shadow.comp samples light band.w alone, the paper's way [IVR §3.1]: kPerLightRays rays per
+// shadow.comp samples light `light` alone, the paper's way [IVR §3.1]: kPerLightRays rays per
 // sample, up to kPerLightMaxRays where they disagree (a penumbra), one for a point, spot or
 // directional light (exact: every ray would go to the same point); one dispatch per light, so each
 // D_s is independent of the other lights' powers and each dispatch stays within the loop limiter.
@@ -524,12 +555,20 @@ OBS_CONST uint kSpecularPathTexels = 7;
 
 // ---- pathtrace.comp: push constants and its own bindings after the scene's (0..5).
 struct PathPush {
-  GpuCamera camera; // 0: camera.right.w = scene size (scales the ray-origin offset, ray.glsl)
-  uvec4 frame;      // 64: width, height, sample index, seed
-  uvec4 params;     // 80: light count (0 = no light with power), max depth d, RR depth, strategy
-  uvec4 band;       // 96: first row, rows, light sampling (kLightSampling*), emission samples K
-                    //     (K > 1: the camera ray's emission from K rays of their own)
-};                  // 112 bytes
+  GpuCamera camera;   // 0: camera.right.w = scene size (scales the ray-origin offset, ray.glsl)
+  uint width;         // 64
+  uint height;
+  uint sampleIndex;   // the sample's index in the frame's sequence
+  uint seed;
+  uint lightCount;    // 80: 0 = no light with power (no light sampling at all)
+  uint maxDepth;      // d: scattering vertices of a path
+  uint rrDepth;       // Russian roulette from this depth
+  uint strategy;      // kPathStrategy*
+  uint firstRow;      // 96: the band's rows
+  uint rows;
+  uint lightSampling; // kLightSampling*
+  uint emissionSamples; // K > 1: the camera ray's emission from K rays of their own
+};                    // 112 bytes
 OBS_CONST uint kPathStrategyMis = 0u;       // MIS of light and BSDF sampling (the reference)
 OBS_CONST uint kPathStrategyLightOnly = 1u; // area lights by light sampling only (tests)
 OBS_CONST uint kPathStrategyBsdfOnly = 2u;  // area lights by BSDF sampling only (tests)
@@ -550,10 +589,13 @@ OBS_CONST uint kComposeEmission = 5;   // sum_s E_s M_s: emission the camera see
 OBS_CONST uint kComposeSlots = 6;
 
 struct ComposePush {
-  uvec4 frame;     // 0:  width, rows (of the band), unused (samples are counted per pixel), light count
-  vec4 ambient;    // 16: I_a(E) rgb, w = 1 when the specular buffers hold data
-  uvec4 slots;     // 32: x = slots per pixel in the output: kComposeSlots, or 1 (combined only)
-};                 // 48 bytes
+  uint width;      // 0: of the band (samples are counted per pixel)
+  uint rows;
+  uint lightCount;
+  uint slots;      // slots per pixel in the output: kComposeSlots, or 1 (combined only)
+  vec3 ambient;    // 16: I_a(E)
+  uint specular;   // 1 when the specular buffers hold data
+};                 // 32 bytes
 
 // Bindings of compose.comp (its own set; no scene bindings).
 OBS_CONST uint kBindingComposeBasis = 0;           // vec4 pairs [light][pixel]: D_s sums
@@ -568,10 +610,13 @@ OBS_CONST uint kComposeBindingCount = 8;
 
 // ---- tonemap.comp: composed radiance -> display RGBA8 (exposure, then the sRGB curve).
 struct TonemapPush {
-  uvec4 frame;     // 0:  width, rows (of the band), compose slot to show, channels (1 or 3)
-  vec4 params;     // 16: exposure scale 2^stops, unused...
-  uvec4 slots;     // 32: x = slots per pixel in the composed buffer (ComposePush.slots.x)
-};                 // 48 bytes
+  uint width;         // 0: of the band
+  uint rows;
+  uint slot;          // the composed slot to show
+  uint channels;      // 1 or 3
+  float exposureScale; // 16: 2^stops
+  uint composedSlots; // slots per pixel in the composed buffer (ComposePush.slots)
+};                    // 24 bytes
 OBS_CONST uint kBindingTonemapInput = 0;  // vec4[pixel * kComposeSlots]
 OBS_CONST uint kBindingTonemapOutput = 1; // uint[pixel]: RGBA8, R in the low byte
 OBS_CONST uint kTonemapBindingCount = 2;
@@ -587,13 +632,16 @@ OBS_CONST uint kTonemapBindingCount = 2;
 OBS_CONST uint kResolvedPixelAlign = 4;
 OBS_FN uint resolvedStride(uint pixels) { return (pixels + kResolvedPixelAlign - 1u) / kResolvedPixelAlign * kResolvedPixelAlign; }
 struct ResolvePush {
-  uvec4 frame;     // 0:  width, rows (of the band), unused (samples are counted per pixel), light count
-  uvec4 flags;     // 16: x = 1 when the specular buffers hold data, y = first light to resolve (the
-                   //     ones before are current), z = 1 to resolve the ambient too
-  uvec4 capacity;  // 32: x = light slots of the frame (A_t lives after them), y = 1 to resolve only
-                   //     the pixels of the band's dirty list (after a geometry edit), dispatched
-                   //     indirectly; the others are current
-};                 // 48 bytes
+  uint width;      // 0: of the band (samples are counted per pixel)
+  uint rows;
+  uint lightCount;
+  uint specular;   // 1 when the specular buffers hold data
+  uint firstLight; // 16: the first light to resolve (the ones before are current)
+  uint ambient;    // 1 to resolve the ambient too
+  uint lightSlots; // light slots of the frame (A_t lives after them)
+  uint dirtyOnly;  // 1 to resolve only the pixels of the band's dirty list (after a geometry
+                   // edit), dispatched indirectly; the others are current
+};                 // 32 bytes
 OBS_CONST uint kBindingResolveBasis = 0;           // vec4 pairs [light][pixel]: D_s
 OBS_CONST uint kBindingResolveEmissionBasis = 1;   // vec4 pairs [light][pixel]: M_s
 OBS_CONST uint kBindingResolveSpecularBasis = 2;   // vec4 pairs [light][pixel]: S_s
@@ -605,8 +653,12 @@ OBS_CONST uint kBindingResolveDirty = 7;           // uint[]: the dirty mask and
 OBS_CONST uint kResolveBindingCount = 8;
 
 struct LightMixPush {
-  uvec4 frame;     // 0:  width, rows (of the band), light count, light slots (A_t lives after them)
-  vec4 ambient;    // 16: I_a(E) rgb, w = exposure scale 2^stops
+  uint width;      // 0: of the band
+  uint rows;
+  uint lightCount;
+  uint lightSlots; // A_t lives after them
+  vec3 ambient;    // 16: I_a(E)
+  float exposureScale; // 2^stops
 };                 // 32 bytes
 OBS_CONST uint kBindingLightMixResolved = 0;  // RGBA32UI texels of resolve.comp's words
 OBS_CONST uint kBindingLightMixEmissions = 1; // vec4[lights]: E_s
@@ -635,13 +687,18 @@ OBS_CONST uint kDirtyBoxWords = 8u * kMaxChangedBoxes;
 // with which a probe skips the light samples of a point none of whose shafts meets a box.
 OBS_FN uint dirtyLightsBase(uint pixels) { return dirtyBoxesBase(pixels) + kDirtyBoxWords; }
 struct DirtyPush {
-  uvec4 frame;        // 0:   width, rows (of the band), first row, light count
+  uint width;         // 0:   of the band
+  uint rows;
+  uint firstRow;
+  uint lightCount;
   vec4 boxLo[4];      // 16:  changed boxes, padded: lo xyz, w = 1 (used) or 0 (unused)
   vec4 boxHi[4];      // 80:  hi xyz
   uvec4 rects[4];     // 144: their screen rectangles in frame pixels: x0, y0, x1, y1 (inclusive)
-  vec4 params;        // 208: dMax, all dirty (1) or not, a light whose shadow rays are traced
-                      //      anew at every pixel anyway (uint bits; kInvalidIndex: none), 1 when
-                      //      the probing passes decide the candidates (kShadeFlagProbe)
+  float dMax;         // 208
+  uint all;           // 1: every pixel is dirty
+  uint tracedLight;   // a light whose shadow rays are traced anew at every pixel anyway
+                      // (kInvalidIndex: none): its shafts are not tested
+  uint probing;       // 1 when the probing passes decide the candidates (ShadeDispatch::probe)
 };                    // 224 bytes (> 128: passed in a uniform-like storage buffer, not push constants)
 // Probing in two steps, one dirty.comp dispatch each (its push constant, stage.x):
 // kDirtyStageMark: mask 2 where certain (a changed box covers the pixel on screen), 1 where only a
@@ -652,8 +709,8 @@ OBS_CONST uint kDirtyStageMark = 0u;
 OBS_CONST uint kDirtyStageList = 1u;
 OBS_CONST uint kDirtyCertain = 2u;
 struct DirtyStagePush {
-  uvec4 stage;        // 0: kDirtyStage*, unused x3
-};                    // 16 bytes
+  uint stage;         // 0: kDirtyStage*
+};                    // 4 bytes
 // Light bounds for dirty.comp, two vec4 per light: (centre xyz, w = 1 for a directional light,
 // whose segments run to infinity along -direction, else 0) and (the box's half extent xyz, or the
 // directional light's direction).
@@ -667,7 +724,10 @@ OBS_CONST uint kDirtyBindingCount = 5;
 // ---- clear.comp: zeroes the shading passes' sums (D_s, S_s, A, A^spec) of the dirty pixels
 // before they are retraced (primary.comp restarts the AOV and M_s sums itself at sample 0).
 struct ClearPush {
-  uvec4 frame;     // 0: width, rows (of the band), light count, 1 when specular buffers are used
+  uint width;      // 0: of the band
+  uint rows;
+  uint lightCount;
+  uint specular;   // 1 when specular buffers are used
 };                 // 16 bytes
 OBS_CONST uint kBindingClearDirty = 0;
 OBS_CONST uint kBindingClearBasis = 1;
@@ -700,8 +760,11 @@ OBS_CONST uint kDenoiseNoMaterial = 0xFFFFu; // the guide's material on a pixel 
 OBS_CONST uint kDenoiseIllumTexels = 2;      // texels per pixel of an illum buffer
 
 struct DenoisePush {
-  uvec4 params; // 0: gather: first row of the band, rows, composed slots, unused; a-trous: step, unused...
-};              // 16 bytes
+  uint firstRow;      // 0: gather: the band's rows and the composed slots per pixel
+  uint rows;
+  uint composedSlots;
+  uint step;          // a-trous: the filter's step (2^iteration)
+};                    // 16 bytes
 
 // Bindings, each pass its own set; binding 0 is the DenoiseParams of every pass.
 OBS_CONST uint kBindingDenoiseParams = 0;

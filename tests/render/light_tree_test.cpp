@@ -319,7 +319,7 @@ protected:
     kernel.bind(4, nodes);
     const glm::uvec4 push(static_cast<std::uint32_t>(cases.size()), static_cast<std::uint32_t>(set.size()), 0, 0);
     context().submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
-      kernel.dispatch(cmd, gpu::groupsFor(cases.size(), gpu::kWorkgroupSize1D), 1, 1, &push);
+      kernel.dispatch(cmd, gpu::groupsFor(cases.size(), gpu::kWorkgroupSize1D), 1, 1, push);
     });
     return out.download<glm::vec4>(context());
   }

@@ -413,7 +413,7 @@ TEST_F(LoopLimiter, TraversalBudgetStaysBelowTheDriverLimit) {
   kernel.bind(0, counts);
   auto run = [&](std::uint32_t n) {
     glm::uvec4 push(n, 0, 0, 0);
-    context().submitAndWait([&](const vk::raii::CommandBuffer& cmd) { kernel.dispatch(cmd, 1, 1, 1, &push); });
+    context().submitAndWait([&](const vk::raii::CommandBuffer& cmd) { kernel.dispatch(cmd, 1, 1, 1, push); });
     return counts.download<std::uint32_t>(context())[0];
   };
   // Our own budget always runs to completion...

@@ -19,6 +19,7 @@ layout(std430, binding = 0) writeonly buffer Out {
   TracePush tracePush;
   GpuLight light;
   GpuEmitter emitter;
+  ShadePush shadePush;
 };
 
 vec4 f4(float base) { return vec4(base, base + 1.0, base + 2.0, base + 3.0); }
@@ -34,8 +35,12 @@ void main() {
   hit = GpuHit(84.0, 85.0, 86.0, 87u);
   camera = GpuCamera(f4(88.0), f4(92.0), f4(96.0), f4(100.0));
   gtexel = GBufferTexel(f4(104.0), f4(108.0), f4(112.0), f4(116.0));
-  primaryPush = PrimaryPush(GpuCamera(f4(120.0), f4(124.0), f4(128.0), f4(132.0)), u4(136u), u4(140u), u4(144u));
-  tracePush = TracePush(u4(148u));
+  primaryPush = PrimaryPush(GpuCamera(f4(120.0), f4(124.0), f4(128.0), f4(132.0)), 136u, 137u, 138u, 139u, 140u,
+                            141u, 142u, 143u, 144u, 145u, 146u, 147u);
+  tracePush = TracePush(148u, 149u, 150u, 151u);
   light = GpuLight(f4(152.0), f4(156.0), u4(160u), f4(164.0));
   emitter = GpuEmitter(f4(168.0), f4(172.0), f4(176.0), f4(180.0));
+  shadePush = ShadePush(184u, 185u, 186u, 187u, 188u, 189u, 190u, 191u, 192.0, 193.0, 194.0, 195.0,
+                        vec3(196.0, 197.0, 198.0), 199.0, vec3(200.0, 201.0, 202.0), 203.0, 204u, 205u, 206u, 207u,
+                        vec3(208.0, 209.0, 210.0), 211.0);
 }

@@ -27,7 +27,7 @@ std::vector<Result> runCases(const gpu::Context& context, std::span<const std::u
   kernel.bind(1, out);
   glm::uvec4 push(static_cast<std::uint32_t>(cases.size()), 0, 0, 0);
   context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
-    kernel.dispatch(cmd, gpu::groupsFor(cases.size(), gpu::kWorkgroupSize1D), 1, 1, &push);
+    kernel.dispatch(cmd, gpu::groupsFor(cases.size(), gpu::kWorkgroupSize1D), 1, 1, push);
   });
   return out.download<Result>(context);
 }

@@ -34,8 +34,8 @@ void AtrousPass::bind(std::uint32_t parity, const DenoiseFrame& frame) {
 
 void AtrousPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t parity, std::uint32_t iteration,
                         const DenoiseFrame& frame) const {
-  const gpu::DenoisePush push{.params = glm::uvec4(1u << iteration, 0u, 0u, 0u)};
-  dispatchImage(kernel_, cmd, frame, &push, filterSourceSet(parity, filterSourceAfter(iteration)));
+  const gpu::DenoisePush push{.firstRow = 0u, .rows = 0u, .composedSlots = 0u, .step = 1u << iteration};
+  dispatchImage(kernel_, cmd, frame, push, filterSourceSet(parity, filterSourceAfter(iteration)));
 }
 
 } // namespace obscura::render

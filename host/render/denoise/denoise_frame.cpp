@@ -39,10 +39,4 @@ DenoiseFrame::DenoiseFrame(const gpu::Context& context, std::uint32_t w, std::ui
   display = gpu::Buffer(context, px * 4, kStorage, "denoise.display");
 }
 
-void dispatchImage(const gpu::Kernel& kernel, const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame,
-                   const void* push, std::uint32_t set) {
-  kernel.dispatch(cmd, gpu::groupsFor(frame.width, gpu::kWorkgroupSizeX), gpu::groupsFor(frame.height, gpu::kWorkgroupSizeY),
-                  1, push, set);
-}
-
 } // namespace obscura::render

@@ -35,8 +35,13 @@ struct DenoiseFrame {
   std::uint64_t pixels() const { return std::uint64_t(width) * height; }
 };
 
-// Workgroups covering a width x height image in 2D (kWorkgroupSizeX x kWorkgroupSizeY).
+// A dispatch of workgroups covering the frame's image in 2D (kWorkgroupSizeX x kWorkgroupSizeY),
+// with `push` (or gpu::kNoPush).
+template <class Push>
 void dispatchImage(const gpu::Kernel& kernel, const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame,
-                   const void* push, std::uint32_t set);
+                   const Push& push, std::uint32_t set) {
+  kernel.dispatch(cmd, gpu::groupsFor(frame.width, gpu::kWorkgroupSizeX), gpu::groupsFor(frame.height, gpu::kWorkgroupSizeY),
+                  1, push, set);
+}
 
 } // namespace obscura::render

@@ -24,9 +24,9 @@ void GatherPass::bind(std::uint32_t band, std::uint32_t parity, const Obscurance
 void GatherPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, std::uint32_t parity,
                         const ObscuranceFrame& source) const {
   const FrameLayout& layout = source.layout();
-  const gpu::DenoisePush push{.params = glm::uvec4(layout.bands[band].firstRow, layout.bands[band].rows,
-                                                   source.contents().composedSlots, 0u)};
-  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, 2 * band + parity);
+  const gpu::DenoisePush push{.firstRow = layout.bands[band].firstRow, .rows = layout.bands[band].rows,
+                              .composedSlots = source.contents().composedSlots, .step = 0u};
+  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, push, 2 * band + parity);
 }
 
 } // namespace obscura::render

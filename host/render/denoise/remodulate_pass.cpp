@@ -23,7 +23,7 @@ void RemodulatePass::bind(std::uint32_t parity, const DenoiseFrame& frame) {
 
 void RemodulatePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t parity, FilterSource source,
                             const DenoiseFrame& frame) const {
-  kernel_.dispatch(cmd, gpu::groupsFor(frame.pixels(), gpu::kWorkgroupSize1D), 1, 1, nullptr, filterSourceSet(parity, source));
+  kernel_.dispatch(cmd, gpu::groupsFor(frame.pixels(), gpu::kWorkgroupSize1D), 1, 1, gpu::kNoPush, filterSourceSet(parity, source));
 }
 
 } // namespace obscura::render

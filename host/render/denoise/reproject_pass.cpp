@@ -20,7 +20,7 @@ void ReprojectPass::bind(std::uint32_t parity, const DenoiseFrame& frame) {
 }
 
 void ReprojectPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t parity, const DenoiseFrame& frame) const {
-  dispatchImage(kernel_, cmd, frame, nullptr, parity);
+  dispatchImage(kernel_, cmd, frame, gpu::kNoPush, parity);
 }
 
 } // namespace obscura::render

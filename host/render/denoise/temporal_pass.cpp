@@ -17,7 +17,7 @@ void TemporalPass::bind(std::uint32_t parity, const DenoiseFrame& frame) {
 }
 
 void TemporalPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t parity, const DenoiseFrame& frame) const {
-  dispatchImage(kernel_, cmd, frame, nullptr, parity);
+  dispatchImage(kernel_, cmd, frame, gpu::kNoPush, parity);
 }
 
 } // namespace obscura::render

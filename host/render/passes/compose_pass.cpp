@@ -26,10 +26,9 @@ void ComposePass::bind(std::uint32_t band, const ObscuranceFrame& frame, const g
 void ComposePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
                          std::uint32_t lights, const glm::vec3& ambientIntensity,
                          bool specular, std::uint32_t slots) const {
-  gpu::ComposePush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, 0u, lights),
-                        .ambient = glm::vec4(ambientIntensity, specular ? 1.0f : 0.0f),
-                        .slots = glm::uvec4(slots, 0u, 0u, 0u)};
-  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+  const gpu::ComposePush push{.width = layout.width, .rows = layout.bands[band].rows, .lightCount = lights,
+                              .slots = slots, .ambient = ambientIntensity, .specular = specular ? 1u : 0u};
+  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, push, band);
 }
 
 } // namespace obscura::render

@@ -92,7 +92,10 @@ void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu
                         const std::vector<scene::Bounds>& changed, float pad, float dMax, std::uint32_t lights,
                         bool all, std::uint32_t tracedLight, bool probe) {
   gpu::DirtyPush push{};
-  push.frame = glm::uvec4(layout.width, layout.bands[band].rows, layout.bands[band].firstRow, lights);
+  push.width = layout.width;
+  push.rows = layout.bands[band].rows;
+  push.firstRow = layout.bands[band].firstRow;
+  push.lightCount = lights;
   const bool tooMany = changed.size() > gpu::kMaxChangedBoxes;
   for (std::uint32_t i = 0; i < gpu::kMaxChangedBoxes; ++i) {
     if (i < changed.size() && !changed[i].empty()) {
@@ -106,7 +109,10 @@ void DirtyPass::prepare(std::uint32_t band, const FrameLayout& layout, const gpu
       push.rects[i] = glm::uvec4(1u, 1u, 0u, 0u);
     }
   }
-  push.params = glm::vec4(dMax, all || tooMany ? 1.0f : 0.0f, std::bit_cast<float>(tracedLight), probe ? 1.0f : 0.0f);
+  push.dMax = dMax;
+  push.all = all || tooMany ? 1u : 0u;
+  push.tracedLight = tracedLight;
+  push.probing = probe ? 1u : 0u;
   params_[band].upload(*context_, &push, sizeof(push));
   for (std::uint32_t i = 0; i < gpu::kMaxChangedBoxes; ++i) {
     boxes_[band][2 * i] = push.boxLo[i];
@@ -128,21 +134,22 @@ void DirtyPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, c
   const vk::DeviceSize lightBytes = std::min<vk::DeviceSize>(lightBounds_->size(), vk::DeviceSize(frame_->lightCapacity()) * 32);
   if (lightBytes > 0) cmd.copyBuffer(lightBounds_->handle(), frame_->band(band).dirty.handle(), vk::BufferCopy{0, lightsAt, lightBytes});
   gpu::computeBarrier(cmd);
-  const gpu::DirtyStagePush push{.stage = glm::uvec4(gpu::kDirtyStageMark, 0u, 0u, 0u)};
-  mark_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+  const gpu::DirtyStagePush push{.stage = gpu::kDirtyStageMark};
+  mark_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, push, band);
 }
 
 void DirtyPass::recordList(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout) const {
   resetList(cmd, band);
   gpu::computeBarrier(cmd);
-  const gpu::DirtyStagePush push{.stage = glm::uvec4(gpu::kDirtyStageList, 0u, 0u, 0u)};
-  mark_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+  const gpu::DirtyStagePush push{.stage = gpu::kDirtyStageList};
+  mark_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, push, band);
 }
 
 void DirtyPass::recordClear(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
                             std::uint32_t lights, bool specular) const {
-  gpu::ClearPush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, lights, specular ? 1u : 0u)};
-  clear_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+  const gpu::ClearPush push{.width = layout.width, .rows = layout.bands[band].rows, .lightCount = lights,
+                            .specular = specular ? 1u : 0u};
+  clear_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, push, band);
 }
 
 } // namespace obscura::render

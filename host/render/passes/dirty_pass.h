@@ -1,7 +1,7 @@
 // dirty_pass.h — the pixels a geometry edit can change (dirty.comp), and the clearing of their
 // shading sums before they are retraced (clear.comp). With probing, dirty.comp runs twice: record
 // marks the certain pixels and lists the candidates, the shading passes probe the candidates
-// (kShadeFlagProbe, lib/probe.glsl), and recordList lists the pixels found dirty.
+// (ShadeDispatch::probe, lib/probe.glsl), and recordList lists the pixels found dirty.
 #pragma once
 #include <array>
 #include <vector>

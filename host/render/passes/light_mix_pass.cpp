@@ -19,10 +19,11 @@ void LightMixPass::bind(std::uint32_t band, const ObscuranceFrame& frame, const 
 void LightMixPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
                           std::uint32_t lights, std::uint32_t slots, const glm::vec3& ambientIntensity,
                           float exposureStops) const {
-  gpu::LightMixPush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, lights, slots),
-                         .ambient = glm::vec4(ambientIntensity, std::exp2(exposureStops))};
+  const gpu::LightMixPush push{.width = layout.width, .rows = layout.bands[band].rows, .lightCount = lights,
+                               .lightSlots = slots, .ambient = ambientIntensity,
+                               .exposureScale = std::exp2(exposureStops)};
   const std::uint64_t quads = (layout.bandPixels(band) + gpu::kResolvedPixelAlign - 1) / gpu::kResolvedPixelAlign;
-  kernel_.dispatch(cmd, gpu::groupsFor(quads, gpu::kWorkgroupSize1D), 1, 1, &push, band);
+  kernel_.dispatch(cmd, gpu::groupsFor(quads, gpu::kWorkgroupSize1D), 1, 1, push, band);
 }
 
 } // namespace obscura::render

@@ -12,19 +12,19 @@ namespace obscura::render {
 // The specialised variants a pixel shading pass compiles beside its kernel and its probing kernel.
 struct ShadingVariants {
   // The shader gathers the secondary reflectors' light when specialised for it
-  // (kSpecConstantReflectors, lib/obscurance.glsl): that kernel takes the dispatches with
-  // kFlagSecondaryReflectors, and the others leave that code out.
+  // (kSpecConstantReflectors, lib/obscurance.glsl): that kernel takes the dispatches of a sample
+  // with ShadeSample::secondaryReflectors, and the others leave that code out.
   bool reflectors = false;
   // The shader has a variant without colour bleeding (kSpecConstantGreyObscurance,
-  // lib/obscurance.glsl): it takes the dispatches without kFlagBleed that neither probe nor
-  // gather reflectors.
+  // lib/obscurance.glsl): it takes the dispatches without ShadeSample::colourBleeding that
+  // neither probe nor gather reflectors.
   bool grey = false;
   // The shader shades one light alone when specialised for it (kSpecConstantPerLight): that kernel
-  // takes the kShadeFlagPerLight dispatches that do not probe.
+  // takes the dispatches of one light that do not probe (ShadeDispatch::perLightVariant).
   bool perLight = false;
   // The shader's probing kernel has a variant that tests the frame's kept rays instead of drawing
   // them (kSpecConstantReplayRays, lib/kept_rays.glsl): it takes the probing dispatches with
-  // kShadeFlagKeptRays that do not shade one light alone.
+  // ShadeDispatch::keptRays that do not shade one light alone.
   bool replayKeptRays = false;
 };
 
@@ -59,32 +59,32 @@ public:
     if (perLight_) perLight_->compile();
   }
 
-  // Every pixel of the band; or, with `dirtyOf` (and kShadeFlagDirtyOnly in the push), only the
-  // pixels of that frame's dirty list for the band, dispatched indirectly. kShadeFlagProbe in the
-  // push runs the probing kernel (over a dirty list's candidates).
-  void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-              const gpu::ShadePush& push, const ObscuranceFrame* dirtyOf = nullptr) const {
-    const gpu::ShadePush p = forBand(push, layout, band);
-    const bool probe = (push.band.z & gpu::kShadeFlagProbe) != 0;
-    const bool reflectors = reflectors_ && (push.counts.w & gpu::kFlagSecondaryReflectors) != 0;
+  // Band `band` of `frame`: every pixel, or the band's dirty list (dispatch.dirtyOnly, an
+  // indirect dispatch). The kernel follows from the dispatch: the probing one to probe (following
+  // the kept rays where it may), the reflectors' where the render gathers them, the per-light one
+  // for one light, the grey one without colour bleeding.
+  void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const ObscuranceFrame& frame,
+              const ShadeSample& sample, const ShadeDispatch& dispatch) const {
+    const FrameLayout& layout = frame.layout();
+    const gpu::ShadePush push = packShadePush(sample, dispatch, layout, band);
+    const bool reflectors = reflectors_ && sample.secondaryReflectors;
     // A geometry edit retraces every pixel while the reflectors are on (they are marked anew), so
     // nothing probes with them; the probing kernel has no reflectors' code.
-    if (probe && reflectors) throw std::logic_error("PixelShadingPass: no probing variant with secondary reflectors");
+    if (dispatch.probe && reflectors) throw std::logic_error("PixelShadingPass: no probing variant with secondary reflectors");
     // Only the per-light variant (and the probe) shades one light alone: the plain kernel has no
     // code for it.
-    const bool perLight = takesPerLightVariant(p);
+    const bool perLight = dispatch.perLightVariant();
     if (perLight && (!perLight_ || reflectors)) throw std::logic_error("PixelShadingPass: no per-light variant");
-    const bool replay = probeReplay_ && probe && (push.band.z & gpu::kShadeFlagKeptRays) != 0 &&
-                        (push.band.z & gpu::kShadeFlagPerLight) == 0;
-    const bool grey = grey_ && !probe && !reflectors && !perLight && (push.counts.w & gpu::kFlagBleed) == 0;
-    const gpu::Kernel& kernel = replay ? *probeReplay_ : probe ? probe_ : reflectors ? *reflectors_ : perLight ? *perLight_
-                              : grey ? *grey_ : kernel_;
-    if (dirtyOf != nullptr) {
-      kernel.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &p, band);
+    const bool replay = probeReplay_ && dispatch.probe && dispatch.keptRays && !dispatch.oneLight();
+    const bool grey = grey_ && !dispatch.probe && !reflectors && !perLight && !sample.colourBleeding;
+    const gpu::Kernel& kernel = replay ? *probeReplay_ : dispatch.probe ? probe_ : reflectors ? *reflectors_
+                              : perLight ? *perLight_ : grey ? *grey_ : kernel_;
+    if (dispatch.dirtyOnly) {
+      kernel.dispatchIndirect(cmd, frame.band(band).dirty, frame.dirtyListOffset(band), push, band);
       return;
     }
     kernel.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
-                     gpu::groupsFor(layout.bands[band].rows, gpu::kWorkgroupSizeY), 1, &p, band);
+                    gpu::groupsFor(layout.bands[band].rows, gpu::kWorkgroupSizeY), 1, push, band);
   }
 
 private:

@@ -45,10 +45,10 @@ PrimaryPass::PrimaryPass(const gpu::Context& context, std::uint32_t bands, const
                gpu::Kernel(context, primaryKernelDesc(bands, 2u, scene, hitBounds)),
                gpu::Kernel(context, primaryKernelDesc(bands, 3u, scene, hitBounds))} {}
 
-const gpu::Kernel& PrimaryPass::kernelFor(std::uint32_t flags) const {
-  const bool sums = (flags & gpu::kPrimaryFlagGBufferOnly) == 0;
-  const bool aovs = sums && (flags & gpu::kPrimaryFlagNoAovs) == 0;
-  const bool emissionRays = sums && (flags >> gpu::kPrimaryEmissionSamplesShift) > 1u;
+const gpu::Kernel& PrimaryPass::kernelFor(const Dispatch& dispatch) const {
+  const bool sums = !dispatch.gbufferOnly;
+  const bool aovs = sums && dispatch.aovs;
+  const bool emissionRays = sums && dispatch.emissionSamples > 1u;
   return kernels_[(aovs ? 1u : 0u) | (emissionRays ? 2u : 0u)];
 }
 
@@ -67,22 +67,29 @@ void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const Obsc
   }
 }
 
-void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-                         const gpu::GpuCamera& camera, Sample sample, std::uint32_t seed,
-                         std::uint32_t lights, std::uint32_t flags, const ObscuranceFrame* dirtyOf) const {
+void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const ObscuranceFrame& frame,
+                         const gpu::GpuCamera& camera, const Dispatch& dispatch) const {
+  const FrameLayout& layout = frame.layout();
   const FrameBand& rows = layout.bands[band];
+  // The emission rays go with a dispatch that accumulates.
+  const std::uint32_t emissionSamples = dispatch.gbufferOnly || dispatch.emissionSamples <= 1u ? 0u : dispatch.emissionSamples;
+  const std::uint32_t flags = (dispatch.gbufferOnly ? gpu::kPrimaryFlagGBufferOnly : 0u) |
+                              (dispatch.aovs ? 0u : gpu::kPrimaryFlagNoAovs) |
+                              (dispatch.dirtyOnly ? gpu::kPrimaryFlagDirtyOnly : 0u) |
+                              (emissionSamples << gpu::kPrimaryEmissionSamplesShift);
   // The camera sees the whole image (a tile's rows are rows of it).
-  gpu::PrimaryPush push{.camera = camera,
-                        .frame = glm::uvec4(layout.width, layout.imageHeight, sample.index, seed),
-                        .band = glm::uvec4(rows.firstRow, rows.rows, lights, flags),
-                        .accumulation = glm::uvec4(sample.first, 0u, 0u, 0u)};
-  const gpu::Kernel& kernel = kernelFor(flags);
-  if (dirtyOf != nullptr) {
-    kernel.dispatchIndirect(cmd, dirtyOf->band(band).dirty, dirtyOf->dirtyListOffset(band), &push, band);
+  const gpu::PrimaryPush push{.camera = camera, .width = layout.width, .height = layout.imageHeight,
+                              .sampleIndex = dispatch.sample, .seed = dispatch.seed,
+                              .firstRow = rows.firstRow, .rows = rows.rows, .lightCount = dispatch.lights,
+                              .flags = flags, .firstSample = dispatch.firstSample,
+                              .unused0 = 0u, .unused1 = 0u, .unused2 = 0u};
+  const gpu::Kernel& kernel = kernelFor(dispatch);
+  if (dispatch.dirtyOnly) {
+    kernel.dispatchIndirect(cmd, frame.band(band).dirty, frame.dirtyListOffset(band), push, band);
     return;
   }
   kernel.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
-                   gpu::groupsFor(rows.rows, gpu::kWorkgroupSizeY), 1, &push, band);
+                  gpu::groupsFor(rows.rows, gpu::kWorkgroupSizeY), 1, push, band);
 }
 
 } // namespace obscura::render

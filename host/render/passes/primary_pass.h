@@ -30,25 +30,33 @@ public:
   void bind(std::uint32_t band, const SceneBuffers& scene, const ObscuranceFrame& frame,
             const gpu::Buffer& lightScales);
 
-  // Which sample a dispatch draws: `index` in the frame's sample sequence (seeds, sub-pixel
-  // position); the accumulation started at sample `first` (0 but for a farm's part), which
-  // restarts the accumulators, so each pixel's count is index + 1 - first.
-  struct Sample {
-    std::uint32_t index = 0;
-    std::uint32_t first = 0;
+  // One dispatch of the primary pass, by name: PrimaryPass::record packs it into PrimaryPush.
+  struct Dispatch {
+    // Which sample it draws: `sample` in the frame's sample sequence (seeds, sub-pixel position);
+    // the accumulation started at sample `firstSample` (0 but for a farm's part), which restarts
+    // the accumulators, so each pixel's count is sample + 1 - firstSample.
+    std::uint32_t sample = 0;
+    std::uint32_t firstSample = 0;
+    std::uint32_t seed = 1;
+    std::uint32_t lights = 0;
+    // Make the G-buffer of the sample again and accumulate nothing (an added light's rays, a
+    // geometry edit's probes start from it).
+    bool gbufferOnly = false;
+    // Accumulate the primary AOVs (only where the frame keeps them).
+    bool aovs = true;
+    // Only the pixels of the frame's dirty list (a geometry edit's retrace), dispatched indirectly.
+    bool dirtyOnly = false;
+    // --emission-samples K: above 1 (and accumulating), M_s from K camera rays of their own.
+    std::uint32_t emissionSamples = 1;
   };
-  // Records sample `sample` of band `band`. `flags`:
-  // kPrimaryFlagGBufferOnly makes the G-buffer again and accumulates nothing; kPrimaryFlagNoAovs
-  // skips the AOV accumulators the frame does not keep. With kPrimaryFlagDirtyOnly, only the pixels
-  // of `dirtyOf`'s dirty list for the band run (an indirect dispatch).
-  void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-              const gpu::GpuCamera& camera, Sample sample, std::uint32_t seed, std::uint32_t lights,
-              std::uint32_t flags, const ObscuranceFrame* dirtyOf = nullptr) const;
+  // Records `dispatch` over band `band` of `frame`, whose whole image `camera` sees.
+  void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const ObscuranceFrame& frame,
+              const gpu::GpuCamera& camera, const Dispatch& dispatch) const;
 
 private:
-  // The variant for a dispatch's flags: with the AOV accumulators and/or the emission rays compiled
-  // in (kSpecConstantPrimaryAovs, kSpecConstantEmissionRays) only where the flags ask for them.
-  const gpu::Kernel& kernelFor(std::uint32_t flags) const;
+  // The variant for a dispatch: with the AOV accumulators and/or the emission rays compiled in
+  // (kSpecConstantPrimaryAovs, kSpecConstantEmissionRays) only where it asks for them.
+  const gpu::Kernel& kernelFor(const Dispatch& dispatch) const;
 
   // Indexed by (AOVs ? 1 : 0) | (emission rays ? 2 : 0); each compiled on its first dispatch.
   std::array<gpu::Kernel, 4> kernels_;

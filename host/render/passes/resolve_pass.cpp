@@ -27,14 +27,14 @@ void ResolvePass::bind(std::uint32_t band, const ObscuranceFrame& frame) {
 void ResolvePass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
                          std::uint32_t lights, std::uint32_t slots, bool specular,
                          std::uint32_t firstLight, bool ambient, bool dirtyOnly) const {
-  gpu::ResolvePush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, 0u, lights),
-                        .flags = glm::uvec4(specular ? 1u : 0u, firstLight, ambient ? 1u : 0u, 0u),
-                        .capacity = glm::uvec4(slots, dirtyOnly ? 1u : 0u, 0u, 0u)};
+  const gpu::ResolvePush push{.width = layout.width, .rows = layout.bands[band].rows, .lightCount = lights,
+                              .specular = specular ? 1u : 0u, .firstLight = firstLight, .ambient = ambient ? 1u : 0u,
+                              .lightSlots = slots, .dirtyOnly = dirtyOnly ? 1u : 0u};
   if (dirtyOnly) {
-    kernel_.dispatchIndirect(cmd, frame_->band(band).dirty, frame_->dirtyListOffset(band), &push, band);
+    kernel_.dispatchIndirect(cmd, frame_->band(band).dirty, frame_->dirtyListOffset(band), push, band);
     return;
   }
-  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, push, band);
 }
 
 } // namespace obscura::render

@@ -77,4 +77,30 @@ void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInp
   kernel.bind(gpu::kBindingKeptShadowRays, b.shadowRays, band);
 }
 
+gpu::ShadePush packShadePush(const ShadeSample& sample, const ShadeDispatch& dispatch, const FrameLayout& layout,
+                             std::uint32_t band, std::uint32_t pathDepth) {
+  const std::uint32_t renderFlags = (sample.systematic ? gpu::kFlagSystematic : 0u) |
+                                    (sample.colourBleeding ? gpu::kFlagBleed : 0u) |
+                                    (sample.areaLightSampling ? gpu::kFlagAreaLightSampling : 0u) |
+                                    (sample.glossyMis ? gpu::kFlagGlossyMis : 0u) |
+                                    (sample.secondaryReflectors ? gpu::kFlagSecondaryReflectors : 0u) |
+                                    (sample.vertexRaysByThroughput ? gpu::kFlagVertexRaysByThroughput : 0u);
+  const std::uint32_t dispatchFlags = (dispatch.dirtyOnly ? gpu::kShadeFlagDirtyOnly : 0u) |
+                                      (dispatch.oneLight() ? gpu::kShadeFlagPerLight : 0u) |
+                                      (dispatch.noDirect ? gpu::kShadeFlagNoDirect : 0u) |
+                                      (dispatch.probe ? gpu::kShadeFlagProbe : 0u) |
+                                      (dispatch.keptRays ? gpu::kShadeFlagKeptRays : 0u);
+  return {.width = sample.width, .height = sample.height, .sampleIndex = sample.sample, .seed = sample.seed,
+          .lightCount = sample.lights, .shadowRays = sample.shadowRays, .obscuranceRays = sample.obscuranceRays,
+          .renderFlags = renderFlags,
+          .dMax = sample.dMax, .tau = sample.tau, .rhoKind = static_cast<float>(sample.rho),
+          .maxDepth = static_cast<float>(sample.maxDepth),
+          .averageReflectance = sample.averageReflectance, .pathDepth = static_cast<float>(pathDepth),
+          .eye = sample.eye, .sceneSize = sample.sceneSize,
+          .firstRow = layout.bands[band].firstRow, .rows = layout.bands[band].rows, .dispatchFlags = dispatchFlags,
+          // The light word is read only with kShadeFlagPerLight; 0 otherwise.
+          .light = dispatch.oneLight() ? dispatch.light : 0u,
+          .kappa = sample.kappa, .unmarkedFirstBounce = sample.unmarkedFirstBounce};
+}
+
 } // namespace obscura::render

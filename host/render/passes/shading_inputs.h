@@ -52,18 +52,61 @@ gpu::KernelDesc perLightKernelDesc(const char* name, std::span<const std::uint32
 // The same shader's variant (of the per-light or probing one) that follows the frame's kept rays
 // instead of tracing or drawing them (kSpecConstantReplayRays): "<desc.name>.replay".
 gpu::KernelDesc replayingKeptRaysKernelDesc(gpu::KernelDesc desc);
-// Whether a dispatch with `push` goes to the per-light variant: one light, not probing.
-inline bool takesPerLightVariant(const gpu::ShadePush& push) {
-  return (push.band.z & gpu::kShadeFlagPerLight) != 0 && (push.band.z & gpu::kShadeFlagProbe) == 0;
-}
-
 // Binds descriptor set `band` of a shading kernel.
 void bindShadingInputs(gpu::Kernel& kernel, std::uint32_t band, const ShadingInputs& in);
 
-// Push constants of the shading passes for band `band` (the rest of `push` is the caller's).
-inline gpu::ShadePush forBand(gpu::ShadePush push, const FrameLayout& layout, std::uint32_t band) {
-  push.band = glm::uvec4(layout.bands[band].firstRow, layout.bands[band].rows, push.band.z, push.band.w);
-  return push;
-}
+// What every shading dispatch of one sample shares: the render's settings and the sample.
+struct ShadeSample {
+  std::uint32_t width = 0, height = 0; // of the whole frame
+  std::uint32_t sample = 0;            // its index in the frame's sequence (seeds)
+  std::uint32_t seed = 1;
+  std::uint32_t lights = 0;
+  std::uint32_t shadowRays = 0;        // N_s per hit
+  std::uint32_t obscuranceRays = 0;    // N_obs per hit
+  float dMax = 0.0f;
+  float tau = 3.0f;                    // for kRhoExp
+  std::uint32_t rho = gpu::kRhoSqrt;   // kRho*
+  std::uint32_t maxDepth = 1;          // a specular path's scattering vertices, the primary hit is 1
+  bool systematic = true;              // obscurance rays by systematic sampling [RTO §4.2]
+  bool colourBleeding = true;          // W_c [RTO eq. 6]
+  bool areaLightSampling = false;      // the paper's light sampling (kFlagAreaLightSampling)
+  bool glossyMis = false;              // kFlagGlossyMis
+  bool secondaryReflectors = false;    // kFlagSecondaryReflectors (with kappa and r below)
+  bool vertexRaysByThroughput = true;  // kFlagVertexRaysByThroughput
+  glm::vec3 averageReflectance{0.0f};  // R_ave (SPEC §1.2)
+  glm::vec3 eye{0.0f};                 // the camera's position
+  float sceneSize = 1.0f;              // scales the ray-origin offset (ray.glsl)
+  glm::vec3 kappa{1.0f};               // the share of I_a beyond the first bounce
+  float unmarkedFirstBounce = 1.0f;    // r (secondary_reflectors.h)
+};
+
+// What one dispatch of a shading pass does. The kernel a pass takes follows from it (probing,
+// per-light, replaying variants) and packShadePush writes it into the push constants.
+struct ShadeDispatch {
+  // One light alone (the relighting paper's per-light sampling, an added light's rays; the
+  // per-light variant unless probing); kInvalidIndex: every light.
+  std::uint32_t light = gpu::kInvalidIndex;
+  // A geometry edit's dirty test: the rays of the listed candidates tested against the changed
+  // boxes instead of shading (the probing variant, lib/probe.glsl).
+  bool probe = false;
+  // Only the pixels of the frame's dirty list (a geometry edit's retrace and probes), dispatched
+  // indirectly.
+  bool dirtyOnly = false;
+  // The frame keeps this sample's rays: a plain dispatch writes them, a probe or one light's
+  // dispatch follows them (the replaying variants, lib/kept_rays.glsl).
+  bool keptRays = false;
+  // specular.comp: the ambient alone along the paths (per-light sampling then follows them light
+  // by light).
+  bool noDirect = false;
+
+  bool oneLight() const { return light != gpu::kInvalidIndex; }
+  // Whether the per-light variant takes it: one light, not probing.
+  bool perLightVariant() const { return oneLight() && !probe; }
+};
+
+// The push constants of a shading dispatch over band `band`, at specular path depth `pathDepth`
+// (specular.comp; 0 elsewhere): the one place ShadePush is filled.
+gpu::ShadePush packShadePush(const ShadeSample& sample, const ShadeDispatch& dispatch, const FrameLayout& layout,
+                             std::uint32_t band, std::uint32_t pathDepth = 0);
 
 } // namespace obscura::render

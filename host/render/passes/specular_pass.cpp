@@ -25,12 +25,12 @@ void SpecularPass::bind(std::uint32_t band, const ShadingInputs& in) {
   bindShadingInputs(perLightReplay_, band, in);
 }
 
-void SpecularPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-                          const ObscuranceFrame& frame, const gpu::ShadePush& push) const {
+void SpecularPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const ObscuranceFrame& frame,
+                          const ShadeSample& sample, const ShadeDispatch& dispatch) const {
   // An empty queue dispatches (0, 1, 1) groups; specular_queue.comp and specular.comp raise x as
   // they append.
   static constexpr std::array<std::uint32_t, gpu::kQueueHeader> kEmptyQueue = {0u, 1u, 1u, 0u};
-  gpu::ShadePush p = forBand(push, layout, band);
+  const FrameLayout& layout = frame.layout();
   const gpu::Buffer& queue = frame.band(band).queue;
   const auto pixels = static_cast<std::uint32_t>(layout.bandPixels(band));
   auto clearQueue = [&](std::uint32_t depth) {
@@ -39,22 +39,23 @@ void SpecularPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band
   clearQueue(1);
   gpu::computeBarrier(cmd);
   queue_.dispatch(cmd, gpu::groupsFor(layout.width, gpu::kWorkgroupSizeX),
-                  gpu::groupsFor(layout.bands[band].rows, gpu::kWorkgroupSizeY), 1, &p, band);
+                  gpu::groupsFor(layout.bands[band].rows, gpu::kWorkgroupSizeY), 1,
+                  packShadePush(sample, dispatch, layout, band), band);
   gpu::computeBarrier(cmd);
-  const bool replay = (push.band.z & gpu::kShadeFlagKeptRays) != 0;
-  const gpu::Kernel& paths = (push.band.z & gpu::kShadeFlagProbe) != 0 ? (replay ? probeReplay_ : probe_)
-                             : takesPerLightVariant(p)                ? (replay ? perLightReplay_ : perLight_)
-                                                                      : paths_;
+  const bool replay = dispatch.keptRays;
+  const gpu::Kernel& paths = dispatch.probe              ? (replay ? probeReplay_ : probe_)
+                             : dispatch.perLightVariant() ? (replay ? perLightReplay_ : perLight_)
+                                                          : paths_;
   // One dispatch per vertex depth; each fills the queue of the next (specular.comp). A path
   // depth of 1 still runs depth 1, which only finishes the paths.
-  const std::uint32_t lastDepth = std::max(static_cast<std::uint32_t>(push.params.w), 2u) - 1u;
+  const std::uint32_t lastDepth = std::max(sample.maxDepth, 2u) - 1u;
   for (std::uint32_t depth = 1; depth <= lastDepth; ++depth) {
     if (depth < lastDepth) {
       clearQueue(depth + 1);
       gpu::computeBarrier(cmd);
     }
-    p.rAve.w = static_cast<float>(depth);
-    paths.dispatchIndirect(cmd, queue, vk::DeviceSize(gpu::specularQueueBase(depth, pixels)) * 4, &p, band);
+    paths.dispatchIndirect(cmd, queue, vk::DeviceSize(gpu::specularQueueBase(depth, pixels)) * 4,
+                           packShadePush(sample, dispatch, layout, band, depth), band);
     if (depth < lastDepth) gpu::computeBarrier(cmd);
   }
 }

@@ -19,15 +19,15 @@ public:
     (keptHits ? perLightReplay_ : perLight_).compile();
   }
   // Clears band `band`'s queue, fills it and dispatches the paths, one dispatch per depth
-  // (barriers included). A per-light
-  // or probing dispatch with kShadeFlagKeptRays follows the kept hits (the .replay kernels).
-  void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
-              const ObscuranceFrame& frame, const gpu::ShadePush& push) const;
+  // (barriers included). A per-light or probing dispatch with kept rays follows the kept hits
+  // (the .replay kernels).
+  void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const ObscuranceFrame& frame,
+              const ShadeSample& sample, const ShadeDispatch& dispatch) const;
 
 private:
   gpu::Kernel queue_;
   gpu::Kernel paths_;
-  gpu::Kernel probe_;    // paths_'s probing variant (kShadeFlagProbe)
+  gpu::Kernel probe_;    // paths_'s probing variant (ShadeDispatch::probe)
   gpu::Kernel perLight_; // paths_'s variant for an added light alone (kSpecConstantPerLight)
   // probe_ and perLight_ following the frame's kept lobe hits (kSpecConstantReplayRays)
   gpu::Kernel probeReplay_, perLightReplay_;

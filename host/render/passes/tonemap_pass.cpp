@@ -21,10 +21,9 @@ void TonemapPass::bind(std::uint32_t band, const gpu::Buffer& composed, const gp
 void TonemapPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const FrameLayout& layout,
                          std::uint32_t slot, std::uint32_t channels, float exposureStops,
                          std::uint32_t slots) const {
-  gpu::TonemapPush push{.frame = glm::uvec4(layout.width, layout.bands[band].rows, slot, channels),
-                        .params = glm::vec4(std::exp2(exposureStops), 0.0f, 0.0f, 0.0f),
-                        .slots = glm::uvec4(slots, 0u, 0u, 0u)};
-  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, &push, band);
+  const gpu::TonemapPush push{.width = layout.width, .rows = layout.bands[band].rows, .slot = slot,
+                              .channels = channels, .exposureScale = std::exp2(exposureStops), .composedSlots = slots};
+  kernel_.dispatch(cmd, gpu::groupsFor(layout.bandPixels(band), gpu::kWorkgroupSize1D), 1, 1, push, band);
 }
 
 } // namespace obscura::render
