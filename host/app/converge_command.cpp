@@ -6,12 +6,9 @@
 // the obscurance image at the paper's budget beside path tracing at equal GPU time (PNG), and
 // prints for each obscurance method: the equal-noise speed-up over path tracing, the error
 // against converged path tracing against time, the bias floor, and the crossover time after
-// which path tracing's error is lower.
-//
-// Every obscurance method estimates the same image (ray counts and light sampling change the
-// noise, not the expectation), so one converged obscurance render, made with the best
-// estimators, is the noise reference of all of them. The denoised methods (render/denoise/) are
-// measured the same way: one frame denoised alone, its GPU time counted.
+// which path tracing's error is lower. The renders and references are analysis::ConvergenceStudy's
+// (analysis/convergence_study.h), the figures analysis/convergence.h's; this file reads the
+// options and writes the report.
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -28,301 +25,24 @@
 #include "app/render_options.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
-#include "farm/merge.h"
 #include "io/image_io.h"
 #include "analysis/convergence.h"
+#include "analysis/convergence_study.h"
 #include "analysis/image_error.h"
-#include "render/denoise/denoiser.h"
 #include "render/method.h"
 #include "render/obscurance_renderer.h"
-#include "render/path_tracer.h"
 
 namespace obscura::app {
 namespace {
 namespace fs = std::filesystem;
 
-// The default emission rays per sample: the primary ray alone. They pay where bright emitters seen
-// directly set the error (the Cornell box: --emission-samples 16 --pt-emission-samples 4) and cost
-// more than they remove where the emitters are small on screen (modern-hall); docs/BENCHMARKS.md,
-// "Emission rays and the split of shading rays".
-constexpr std::uint32_t kObscuranceEmissionSamples = 1, kPathEmissionSamples = 1;
-
-struct ConvergeOptions {
-  std::string scenePath;
-  std::string outputDir;
-  std::uint32_t width = 256; // per-pixel noise as a user sees it
-  std::uint32_t obscuranceMaxSpp = 16;
-  std::uint32_t pathMaxSpp = 256;
-  std::uint32_t referenceFactor = 64;   // a reference has this many times the largest curve's spp
-  std::uint32_t pathReferenceSpp = 0;   // 0: referenceFactor x pathMaxSpp
-  // A merged farm render (`obscura merge`'s EXR of --method pathtrace parts) to take as the path
-  // tracing reference instead of rendering it here: the longest render of a study, spread over a
-  // cluster (tools/farm/).
-  std::string pathReferenceFile;
-  std::uint32_t seed = 1;
-  float dMax = 0.0f; // 0: the renderer's default
-  float secondaryReflectors = 0.0f; // > 0: one more method, obscurances with secondary reflectors
-  std::vector<float> background;    // R,G,B of a sky (render --background); empty: none
-  // Camera rays per sample for the emission the camera sees (render --emission-samples), each
-  // method family with the count that serves it best (docs/BENCHMARKS.md).
-  std::uint32_t emissionSamples = kObscuranceEmissionSamples;
-  std::uint32_t pathEmissionSamples = kPathEmissionSamples;
-  std::string commandLine;
+// The study's settings and the device's.
+struct ConvergeOptions : analysis::StudySettings {
   DeviceOptions device;
 };
 
-struct Method {
-  std::string name;
-  bool pathTrace = false;
-  render::LightSampling lightSampling = render::LightSampling::Spatial;
-  std::uint32_t raysPerHit = 5;   // shadow (and obscurance, see below) rays per hit (obscurance methods)
-  std::uint32_t budgetSpp = 8;    // the budget its summary is read at
-  std::string what;
-  float secondaryReflectors = 0.0f; // their marking threshold, 0 = off
-  bool denoise = false;             // the frame denoised (render/denoise/), its GPU time counted
-  std::uint32_t obscuranceRays = 0; // obscurance rays per hit; 0: raysPerHit
-  std::uint32_t emissionSamples = 0; // camera rays per sample for the seen emission; 0: the study's
-  bool vertexRaysByThroughput = true; // specular path vertices: rays scaled by throughput, or N per hit
-};
-
-// The paper's budget [RTO §4.1]: 8 primary samples x (5 obscurance + 5 shadow rays) per hit.
-constexpr std::uint32_t kPaperSpp = 8, kPaperRays = 5;
-
-// Each method with its best estimators, the paper's estimator for reproduction, and a real-time
-// budget (one primary sample with 1 + 1 rays per hit). Path tracing comes last.
-const std::vector<Method> kMethods = {
-    {"obscurance", false, render::LightSampling::Spatial, kPaperRays, kPaperSpp,
-     "spatial light sampling, 5+5 rays per hit, 8 spp (the paper's budget)"},
-    {"obscurance-paper", false, render::LightSampling::Area, kPaperRays, kPaperSpp,
-     "the paper's light sampling (by power, by area), 5+5 rays per hit, 8 spp"},
-    // The same 10 shading rays per hit, spent where modern-hall's noise is: its direct light
-    // holds 2/3 of the variance at 5 + 5, the obscurance 2 % (docs/BENCHMARKS.md).
-    {"obscurance-split", false, render::LightSampling::Spatial, 8, kPaperSpp,
-     "spatial light sampling, 8 shadow + 2 obscurance rays per hit, 8 spp", 0.0f, false, 2},
-    // What scaling a specular path vertex's rays by its throughput (the default) saves and costs.
-    {"obscurance-per-hit-vertices", false, render::LightSampling::Spatial, kPaperRays, kPaperSpp,
-     "as obscurance, 5+5 rays at every specular path vertex too (render --vertex-rays per-hit)", 0.0f, false, 0, 0,
-     false},
-    {"obscurance-realtime", false, render::LightSampling::Spatial, 1, 1, "spatial, 1+1 rays per hit, 1 spp"},
-    // The window's frames: the same, denoised (one frame alone, no history), error measured.
-    {"obscurance-denoised", false, render::LightSampling::Spatial, kPaperRays, 1,
-     "spatial, 5+5 rays per hit, denoised (a-trous on demodulated terms), 1 spp", 0.0f, true},
-    {"obscurance-realtime-denoised", false, render::LightSampling::Spatial, 1, 1,
-     "spatial, 1+1 rays per hit, denoised, 1 spp", 0.0f, true},
-    {"pathtrace", true, render::LightSampling::Spatial, 0, 1, "path tracing, NEE with spatial light sampling + MIS"},
-};
-
-// The methods a study runs: kMethods, and with --secondary-reflectors the best obscurance method
-// with them too (before path tracing, which stays last).
-std::vector<Method> studyMethods(const ConvergeOptions& o) {
-  std::vector<Method> methods = kMethods;
-  if (o.secondaryReflectors > 0.0f) {
-    Method m = methods.front();
-    m.name = "obscurance-reflectors";
-    m.what = fmt::format("as obscurance, with secondary reflectors marked at {:g} x mean direct irradiance",
-                         o.secondaryReflectors);
-    m.secondaryReflectors = o.secondaryReflectors;
-    methods.insert(methods.end() - 1, m);
-  }
-  if (o.emissionSamples > 1) { // what the emission rays change, in the same run
-    Method m = methods.front();
-    m.name = "obscurance-primary-emission";
-    m.what = "as obscurance, the seen emission from the primary rays alone (--emission-samples 1)";
-    m.emissionSamples = 1;
-    methods.insert(methods.begin() + 1, m);
-  }
-  return methods;
-}
-
-struct Rendered {
-  io::Image image;
-  double gpuMs = 0.0;
-  double rays = 0.0;
-};
-
-class Study {
-public:
-  Study(const ConvergeOptions& o, const LoadedScene& loaded, const gpu::Context& context)
-      : o_(o), loaded_(loaded), context_(context) {
-    camera_ = loaded.scene.cameras.empty() ? scene::defaultCamera(loaded.scene.bounds) : loaded.scene.cameras.front();
-    float aspect = camera_.aspectRatio > 0.0f ? camera_.aspectRatio : 1.0f;
-    width_ = o.width;
-    height_ = std::max(1u, static_cast<std::uint32_t>(std::lround(static_cast<float>(o.width) / aspect)));
-    stem_ = fs::path(o.scenePath).stem().string();
-    // Checked before anything is rendered: a wrong reference fails the study at once.
-    if (!o.pathReferenceFile.empty()) farmReference_ = farmReference();
-  }
-
-  // Renders with the study's persistent renderers: the scene is uploaded and the pipelines are
-  // made once per method family, not once per render.
-  Rendered render(const Method& m, std::uint32_t spp, std::uint32_t seed) {
-    Rendered r;
-    const render::RenderStats* stats = nullptr;
-    if (m.pathTrace) {
-      render::PathTraceSettings s{.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_,
-                                  .lightSampling = m.lightSampling, .emissionSamples = o_.pathEmissionSamples};
-      if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, loaded_.scene, loaded_.bvh, s);
-      pathTracer_->configure(s);
-      pathTracer_->render();
-      r.image = pathTracer_->image();
-      statsCopy_ = pathTracer_->stats();
-    } else {
-      render::ObscuranceSettings s;
-      s.editableGeometry = false;
-      s.width = width_;
-      s.height = height_;
-      s.spp = spp;
-      s.emissionSamples = m.emissionSamples ? m.emissionSamples : o_.emissionSamples;
-      s.seed = seed;
-      s.camera = camera_;
-      s.shadowRays = m.raysPerHit;
-      s.obscuranceRays = m.obscuranceRays ? m.obscuranceRays : m.raysPerHit;
-      s.lightSampling = m.lightSampling;
-      s.ambient = render::AmbientModel::Seen; // the least biased I_a; Reached and Global composed beside it
-      s.dMax = o_.dMax;
-      s.secondaryReflectors = m.secondaryReflectors;
-      s.vertexRaysByThroughput = m.vertexRaysByThroughput;
-      if (!obscurance_)
-        obscurance_ = std::make_unique<render::ObscuranceRenderer>(context_, loaded_.scene, loaded_.bvh, s);
-      obscurance_->configure(s);
-      obscurance_->render();
-      r.image = obscurance_->image();
-      statsCopy_ = obscurance_->stats();
-      if (m.denoise) {
-        if (!denoiser_) denoiser_ = std::make_unique<render::Denoiser>(context_, *obscurance_);
-        denoiser_->reset(); // each render is a frame of its own
-        denoiser_->denoise(*obscurance_);
-        r.image = denoiser_->image();
-        r.gpuMs += denoiser_->lastGpuMs();
-      }
-    }
-    stats = &statsCopy_;
-    if (stats->truncatedTraversals) throw DeviceError("traversals were truncated; the study would be wrong");
-    for (const auto& [name, pass] : stats->passes) {
-      r.gpuMs += pass.gpuMs;
-      r.rays += static_cast<double>(pass.rays);
-    }
-    r.rays /= static_cast<double>(width_) * height_;
-    return r;
-  }
-
-  // The path tracing reference from a merged farm render, checked to be of this study's image:
-  // the same scene (hash), camera, size, depth and sky.
-  io::Image farmReference() const {
-    const std::string& file = o_.pathReferenceFile;
-    const io::Image image = io::readImage(file);
-    const std::string* text = image.attribute(farm::kMergedAttribute);
-    if (!text) throw InputError(fmt::format("{}: not a merged farm render (no {} attribute; 'obscura merge' writes it)",
-                                            file, farm::kMergedAttribute));
-    const nlohmann::json job = nlohmann::json::parse(*text, nullptr, false);
-    auto mismatch = [&](const std::string& what, const nlohmann::json& theirs, const nlohmann::json& ours) {
-      return InputError(fmt::format("{}: a reference of another image: its {} is {}, this study's {}", file, what,
-                                    theirs.dump(), ours.dump()));
-    };
-    if (!job.is_object() || !job.contains("method")) throw InputError(fmt::format("{}: its job description is malformed", file));
-    const std::string pathTrace = nameString(render::kMethodNames, render::Method::PathTrace);
-    if (job.at("method") != pathTrace) throw mismatch("method", job.at("method"), pathTrace);
-    if (job.at("scene") != farm::sceneHash(o_.scenePath)) throw mismatch("scene", job.at("scene"), o_.scenePath);
-    if (job.at("width") != width_ || job.at("height") != height_)
-      throw mismatch("size", {job.at("width"), job.at("height")}, {width_, height_});
-    if (job.at("camera") != -1) throw mismatch("camera", job.at("camera"), -1);
-    if (job.at("max_depth") != render::PathTraceSettings{}.maxDepth)
-      throw mismatch("max depth", job.at("max_depth"), render::PathTraceSettings{}.maxDepth);
-    if (job.at("background") != nlohmann::json(o_.background)) throw mismatch("background", job.at("background"), o_.background);
-    if (image.channelIndex("combined.R") < 0) throw InputError(fmt::format("{}: no combined channels", file));
-    fmt::print("reference pathtrace: the farm render {} ({} spp)\n", file, job.at("spp").dump());
-    return combinedOnly(image);
-  }
-
-  // The converged image of a method, from the cache when the same settings made it.
-  io::Image reference(const Method& m) {
-    if (m.pathTrace && !o_.pathReferenceFile.empty()) return farmReference_;
-    std::uint32_t spp = m.pathTrace ? (o_.pathReferenceSpp ? o_.pathReferenceSpp : o_.referenceFactor * o_.pathMaxSpp)
-                                    : o_.referenceFactor * o_.obscuranceMaxSpp;
-    fs::path exr = fs::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
-    fs::path txt = exr;
-    txt.replace_extension(".txt");
-    std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} "
-                                          "emission_samples={} light_sampling={}{}{}",
-                                          o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
-                                          m.pathTrace ? o_.pathEmissionSamples : o_.emissionSamples,
-                                          nameOf(render::kLightSamplingNames, m.lightSampling),
-                                          m.pathTrace ? "" : fmt::format(" ambient=seen+reached+global dmax={} secondary_reflectors={}",
-                                                                         o_.dMax, m.secondaryReflectors),
-                                          o_.background.empty() ? "" : fmt::format(" background={}", fmt::join(o_.background, ",")));
-    if (fs::exists(exr) && fs::exists(txt)) {
-      std::ifstream in(txt);
-      std::string first;
-      std::getline(in, first);
-      if (first == description &&
-          (m.pathTrace || (fs::exists(otherPath(exr, "global")) && fs::exists(otherPath(exr, "reached"))))) {
-        fmt::print("reference {}: cached ({})\n", m.name, exr.string());
-        if (!m.pathTrace)
-          for (const char* model : {"global", "reached"})
-            otherReferences_[model][m.name] = io::readImage(otherPath(exr, model).string());
-        return io::readImage(exr.string());
-      }
-    }
-    fmt::print("reference {}: rendering {} spp at {}x{}...\n", m.name, spp, width_, height_);
-    std::fflush(stdout);
-    Rendered r = render(m, spp, o_.seed + 7919);
-    io::Image combined = combinedOnly(r.image);
-    io::writeExr(exr.string(), combined);
-    if (!m.pathTrace) {
-      // The same samples composed with the paper's whole-scene I_a and with the reached one
-      // (compose only, no ray).
-      for (auto [model, name] : {std::pair{render::AmbientModel::Global, "global"}, std::pair{render::AmbientModel::Reached, "reached"}}) {
-        obscurance_->setAmbientModel(model);
-        obscurance_->compose();
-        otherReferences_[name][m.name] = combinedOnly(obscurance_->image());
-        io::writeExr(otherPath(exr, name).string(), otherReferences_[name][m.name]);
-      }
-      obscurance_->setAmbientModel(render::AmbientModel::Seen);
-    }
-    std::ofstream(txt) << description << "\nmade by: " << o_.commandLine << "\ngpu_ms: " << r.gpuMs << "\n";
-    return combined;
-  }
-
-  static io::Image combinedOnly(const io::Image& image) {
-    io::Image out;
-    out.width = image.width;
-    out.height = image.height;
-    out.channels = {"combined.R", "combined.G", "combined.B"};
-    int c = image.channelIndex("combined.R");
-    out.pixels.reserve(std::size_t(image.width) * image.height * 3);
-    for (int y = 0; y < image.height; ++y)
-      for (int x = 0; x < image.width; ++x)
-        for (int k = 0; k < 3; ++k) out.pixels.push_back(image.at(x, y, c + k));
-    return out;
-  }
-
-  // Obscurance method `name`'s reference composed with the `model` I_a ("global": the paper's,
-  // "reached") instead of the Seen one (after reference() of it).
-  const io::Image& otherReference(const std::string& model, const std::string& name) const {
-    return otherReferences_.at(model).at(name);
-  }
-  static fs::path otherPath(fs::path exr, const std::string& model) {
-    return exr.replace_extension(fmt::format(".{}-ia.exr", model));
-  }
-
-  std::uint32_t width() const { return width_; }
-  std::uint32_t height() const { return height_; }
-  const std::string& stem() const { return stem_; }
-
-private:
-  const ConvergeOptions& o_;
-  const LoadedScene& loaded_;
-  const gpu::Context& context_;
-  std::unique_ptr<render::ObscuranceRenderer> obscurance_;
-  std::unique_ptr<render::Denoiser> denoiser_; // bound to obscurance_'s frame
-  std::unique_ptr<render::PathTracer> pathTracer_;
-  scene::Camera camera_;
-  std::uint32_t width_ = 0, height_ = 0;
-  std::string stem_;
-  mutable render::RenderStats statsCopy_;
-  std::map<std::string, std::map<std::string, io::Image>> otherReferences_; // model -> method -> image
-  io::Image farmReference_; // --pt-reference
-};
+using analysis::kObscuranceEmissionSamples;
+using analysis::kPathEmissionSamples;
 
 void runConverge(const ConvergeOptions& o) {
   checkBackground(o.background);
@@ -336,18 +56,18 @@ void runConverge(const ConvergeOptions& o) {
   buildTreeFor(loaded, context);
   fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
   warnIfUnlit(loaded);
-  Study study(o, loaded, context);
+  analysis::ConvergenceStudy study(o, loaded.scene, loaded.bvh, context);
 
-  const std::vector<Method> methods = studyMethods(o);
-  const Method& best = methods.front();
-  const Method& pathMethod = methods.back();
+  const std::vector<analysis::StudyMethod> methods = analysis::studyMethods(o);
+  const analysis::StudyMethod& best = methods.front();
+  const analysis::StudyMethod& pathMethod = methods.back();
   const io::Image obscuranceReference = study.reference(best);
   const io::Image ptReference = study.reference(pathMethod);
   // Secondary reflectors converge to an image of their own: their noise is measured against it.
   std::map<std::string, io::Image> reflectorReferences;
-  for (const Method& m : methods)
+  for (const analysis::StudyMethod& m : methods)
     if (m.secondaryReflectors > 0.0f) reflectorReferences[m.name] = study.reference(m);
-  auto noiseReference = [&](const Method& m) -> const io::Image& {
+  auto noiseReference = [&](const analysis::StudyMethod& m) -> const io::Image& {
     if (m.pathTrace) return ptReference;
     return m.secondaryReflectors > 0.0f ? reflectorReferences.at(m.name) : obscuranceReference;
   };
@@ -362,7 +82,7 @@ void runConverge(const ConvergeOptions& o) {
     analysis::Curve curve{.method = m.name, .points = {}};
     std::uint32_t maxSpp = m.pathTrace ? o.pathMaxSpp : o.obscuranceMaxSpp;
     for (std::uint32_t spp = 1; spp <= maxSpp; spp *= 2) {
-      Rendered r = study.render(m, spp, o.seed + spp);
+      analysis::StudyRender r = study.render(m, spp, o.seed + spp);
       analysis::CurvePoint p{.spp = spp, .raysPerPixel = r.rays, .gpuMs = r.gpuMs,
                            .noise = analysis::imageError(r.image, noiseReference(m)),
                            .total = analysis::imageError(r.image, ptReference)};
@@ -422,7 +142,7 @@ void runConverge(const ConvergeOptions& o) {
   const std::pair<const char*, analysis::Metric> metrics[] = {
       {"rmse", analysis::Metric::Rmse}, {"rmse_trimmed", analysis::Metric::RmseTrimmed}, {"mae", analysis::Metric::Mae}};
   for (std::size_t i = 0; i + 1 < methods.size(); ++i) {
-    const Method& m = methods[i];
+    const analysis::StudyMethod& m = methods[i];
     const analysis::CurvePoint* point = nullptr;
     for (const auto& p : curves[i].points)
       if (p.spp == m.budgetSpp) point = &p;
@@ -455,7 +175,7 @@ void runConverge(const ConvergeOptions& o) {
       if (p.spp == best.budgetSpp) point = &p;
     const double msPerPath = pt.points.back().gpuMs / pt.points.back().spp;
     const auto ptSpp = static_cast<std::uint32_t>(std::max(1.0, std::round(point->gpuMs / msPerPath)));
-    Rendered equalTime = study.render(pathMethod, ptSpp, o.seed + 104729);
+    analysis::StudyRender equalTime = study.render(pathMethod, ptSpp, o.seed + 104729);
     const fs::path obsPng = fs::path(o.outputDir) / (study.stem() + ".obscurance-budget.png");
     const fs::path ptPng = fs::path(o.outputDir) / (study.stem() + ".pathtrace-equal-time.png");
     io::writePng(obsPng.string(), atBudget.at(best.name), atBudget.at(best.name).channelIndex("combined.R"));

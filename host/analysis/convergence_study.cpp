@@ -1,0 +1,224 @@
+#include "analysis/convergence_study.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "farm/merge.h"
+#include "render/method.h"
+
+namespace obscura::analysis {
+
+namespace {
+
+// Each method with its best estimators, the paper's estimator for reproduction, and a real-time
+// budget (one primary sample with 1 + 1 rays per hit). Path tracing comes last.
+const std::vector<StudyMethod> kMethods = {
+    {"obscurance", false, render::LightSampling::Spatial, kPaperRays, kPaperSpp,
+     "spatial light sampling, 5+5 rays per hit, 8 spp (the paper's budget)"},
+    {"obscurance-paper", false, render::LightSampling::Area, kPaperRays, kPaperSpp,
+     "the paper's light sampling (by power, by area), 5+5 rays per hit, 8 spp"},
+    // The same 10 shading rays per hit, spent where modern-hall's noise is: its direct light
+    // holds 2/3 of the variance at 5 + 5, the obscurance 2 % (docs/BENCHMARKS.md).
+    {"obscurance-split", false, render::LightSampling::Spatial, 8, kPaperSpp,
+     "spatial light sampling, 8 shadow + 2 obscurance rays per hit, 8 spp", 0.0f, false, 2},
+    // What scaling a specular path vertex's rays by its throughput (the default) saves and costs.
+    {"obscurance-per-hit-vertices", false, render::LightSampling::Spatial, kPaperRays, kPaperSpp,
+     "as obscurance, 5+5 rays at every specular path vertex too (render --vertex-rays per-hit)", 0.0f, false, 0, 0,
+     false},
+    {"obscurance-realtime", false, render::LightSampling::Spatial, 1, 1, "spatial, 1+1 rays per hit, 1 spp"},
+    // The window's frames: the same, denoised (one frame alone, no history), error measured.
+    {"obscurance-denoised", false, render::LightSampling::Spatial, kPaperRays, 1,
+     "spatial, 5+5 rays per hit, denoised (a-trous on demodulated terms), 1 spp", 0.0f, true},
+    {"obscurance-realtime-denoised", false, render::LightSampling::Spatial, 1, 1,
+     "spatial, 1+1 rays per hit, denoised, 1 spp", 0.0f, true},
+    {"pathtrace", true, render::LightSampling::Spatial, 0, 1, "path tracing, NEE with spatial light sampling + MIS"},
+};
+
+} // namespace
+
+// The methods a study runs: kMethods, and with --secondary-reflectors the best obscurance method
+// with them too (before path tracing, which stays last).
+std::vector<StudyMethod> studyMethods(const StudySettings& o) {
+  std::vector<StudyMethod> methods = kMethods;
+  if (o.secondaryReflectors > 0.0f) {
+    StudyMethod m = methods.front();
+    m.name = "obscurance-reflectors";
+    m.what = fmt::format("as obscurance, with secondary reflectors marked at {:g} x mean direct irradiance",
+                         o.secondaryReflectors);
+    m.secondaryReflectors = o.secondaryReflectors;
+    methods.insert(methods.end() - 1, m);
+  }
+  if (o.emissionSamples > 1) { // what the emission rays change, in the same run
+    StudyMethod m = methods.front();
+    m.name = "obscurance-primary-emission";
+    m.what = "as obscurance, the seen emission from the primary rays alone (--emission-samples 1)";
+    m.emissionSamples = 1;
+    methods.insert(methods.begin() + 1, m);
+  }
+  return methods;
+}
+
+ConvergenceStudy::ConvergenceStudy(const StudySettings& o, const scene::Scene& studied, const bvh::Bvh& bvh,
+                                   const gpu::Context& context)
+    : o_(o), scene_(studied), bvh_(bvh), context_(context) {
+  camera_ = studied.cameras.empty() ? scene::defaultCamera(studied.bounds) : studied.cameras.front();
+  float aspect = camera_.aspectRatio > 0.0f ? camera_.aspectRatio : 1.0f;
+  width_ = o.width;
+  height_ = std::max(1u, static_cast<std::uint32_t>(std::lround(static_cast<float>(o.width) / aspect)));
+  stem_ = std::filesystem::path(o.scenePath).stem().string();
+  // Checked before anything is rendered: a wrong reference fails the study at once.
+  if (!o.pathReferenceFile.empty()) farmReference_ = farmReference();
+}
+
+StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, std::uint32_t seed) {
+  StudyRender r;
+  const render::RenderStats* stats = nullptr;
+  if (m.pathTrace) {
+    render::PathTraceSettings s{.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_,
+                                .lightSampling = m.lightSampling, .emissionSamples = o_.pathEmissionSamples};
+    if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, scene_, bvh_, s);
+    pathTracer_->configure(s);
+    pathTracer_->render();
+    r.image = pathTracer_->image();
+    statsCopy_ = pathTracer_->stats();
+  } else {
+    render::ObscuranceSettings s;
+    s.editableGeometry = false;
+    s.width = width_;
+    s.height = height_;
+    s.spp = spp;
+    s.emissionSamples = m.emissionSamples ? m.emissionSamples : o_.emissionSamples;
+    s.seed = seed;
+    s.camera = camera_;
+    s.shadowRays = m.raysPerHit;
+    s.obscuranceRays = m.obscuranceRays ? m.obscuranceRays : m.raysPerHit;
+    s.lightSampling = m.lightSampling;
+    s.ambient = render::AmbientModel::Seen; // the least biased I_a; Reached and Global composed beside it
+    s.dMax = o_.dMax;
+    s.secondaryReflectors = m.secondaryReflectors;
+    s.vertexRaysByThroughput = m.vertexRaysByThroughput;
+    if (!obscurance_)
+      obscurance_ = std::make_unique<render::ObscuranceRenderer>(context_, scene_, bvh_, s);
+    obscurance_->configure(s);
+    obscurance_->render();
+    r.image = obscurance_->image();
+    statsCopy_ = obscurance_->stats();
+    if (m.denoise) {
+      if (!denoiser_) denoiser_ = std::make_unique<render::Denoiser>(context_, *obscurance_);
+      denoiser_->reset(); // each render is a frame of its own
+      denoiser_->denoise(*obscurance_);
+      r.image = denoiser_->image();
+      r.gpuMs += denoiser_->lastGpuMs();
+    }
+  }
+  stats = &statsCopy_;
+  if (stats->truncatedTraversals) throw DeviceError("traversals were truncated; the study would be wrong");
+  for (const auto& [name, pass] : stats->passes) {
+    r.gpuMs += pass.gpuMs;
+    r.rays += static_cast<double>(pass.rays);
+  }
+  r.rays /= static_cast<double>(width_) * height_;
+  return r;
+}
+
+io::Image ConvergenceStudy::farmReference() const {
+  const std::string& file = o_.pathReferenceFile;
+  const io::Image image = io::readImage(file);
+  const std::string* text = image.attribute(farm::kMergedAttribute);
+  if (!text) throw InputError(fmt::format("{}: not a merged farm render (no {} attribute; 'obscura merge' writes it)",
+                                          file, farm::kMergedAttribute));
+  const nlohmann::json job = nlohmann::json::parse(*text, nullptr, false);
+  auto mismatch = [&](const std::string& what, const nlohmann::json& theirs, const nlohmann::json& ours) {
+    return InputError(fmt::format("{}: a reference of another image: its {} is {}, this study's {}", file, what,
+                                  theirs.dump(), ours.dump()));
+  };
+  if (!job.is_object() || !job.contains("method")) throw InputError(fmt::format("{}: its job description is malformed", file));
+  const std::string pathTrace = nameString(render::kMethodNames, render::Method::PathTrace);
+  if (job.at("method") != pathTrace) throw mismatch("method", job.at("method"), pathTrace);
+  if (job.at("scene") != farm::sceneHash(o_.scenePath)) throw mismatch("scene", job.at("scene"), o_.scenePath);
+  if (job.at("width") != width_ || job.at("height") != height_)
+    throw mismatch("size", {job.at("width"), job.at("height")}, {width_, height_});
+  if (job.at("camera") != -1) throw mismatch("camera", job.at("camera"), -1);
+  if (job.at("max_depth") != render::PathTraceSettings{}.maxDepth)
+    throw mismatch("max depth", job.at("max_depth"), render::PathTraceSettings{}.maxDepth);
+  if (job.at("background") != nlohmann::json(o_.background)) throw mismatch("background", job.at("background"), o_.background);
+  if (image.channelIndex("combined.R") < 0) throw InputError(fmt::format("{}: no combined channels", file));
+  fmt::print("reference pathtrace: the farm render {} ({} spp)\n", file, job.at("spp").dump());
+  return combinedOnly(image);
+}
+
+io::Image ConvergenceStudy::reference(const StudyMethod& m) {
+  if (m.pathTrace && !o_.pathReferenceFile.empty()) return farmReference_;
+  std::uint32_t spp = m.pathTrace ? (o_.pathReferenceSpp ? o_.pathReferenceSpp : o_.referenceFactor * o_.pathMaxSpp)
+                                  : o_.referenceFactor * o_.obscuranceMaxSpp;
+  std::filesystem::path exr = std::filesystem::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
+  std::filesystem::path txt = exr;
+  txt.replace_extension(".txt");
+  std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} "
+                                        "emission_samples={} light_sampling={}{}{}",
+                                        o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
+                                        m.pathTrace ? o_.pathEmissionSamples : o_.emissionSamples,
+                                        nameOf(render::kLightSamplingNames, m.lightSampling),
+                                        m.pathTrace ? "" : fmt::format(" ambient=seen+reached+global dmax={} secondary_reflectors={}",
+                                                                       o_.dMax, m.secondaryReflectors),
+                                        o_.background.empty() ? "" : fmt::format(" background={}", fmt::join(o_.background, ",")));
+  if (std::filesystem::exists(exr) && std::filesystem::exists(txt)) {
+    std::ifstream in(txt);
+    std::string first;
+    std::getline(in, first);
+    if (first == description &&
+        (m.pathTrace || (std::filesystem::exists(otherPath(exr, "global")) && std::filesystem::exists(otherPath(exr, "reached"))))) {
+      fmt::print("reference {}: cached ({})\n", m.name, exr.string());
+      if (!m.pathTrace)
+        for (const char* model : {"global", "reached"})
+          otherReferences_[model][m.name] = io::readImage(otherPath(exr, model).string());
+      return io::readImage(exr.string());
+    }
+  }
+  fmt::print("reference {}: rendering {} spp at {}x{}...\n", m.name, spp, width_, height_);
+  std::fflush(stdout);
+  StudyRender r = render(m, spp, o_.seed + 7919);
+  io::Image combined = combinedOnly(r.image);
+  io::writeExr(exr.string(), combined);
+  if (!m.pathTrace) {
+    // The same samples composed with the paper's whole-scene I_a and with the reached one
+    // (compose only, no ray).
+    for (auto [model, name] : {std::pair{render::AmbientModel::Global, "global"}, std::pair{render::AmbientModel::Reached, "reached"}}) {
+      obscurance_->setAmbientModel(model);
+      obscurance_->compose();
+      otherReferences_[name][m.name] = combinedOnly(obscurance_->image());
+      io::writeExr(otherPath(exr, name).string(), otherReferences_[name][m.name]);
+    }
+    obscurance_->setAmbientModel(render::AmbientModel::Seen);
+  }
+  std::ofstream(txt) << description << "\nmade by: " << o_.commandLine << "\ngpu_ms: " << r.gpuMs << "\n";
+  return combined;
+}
+
+io::Image ConvergenceStudy::combinedOnly(const io::Image& image) {
+  io::Image out;
+  out.width = image.width;
+  out.height = image.height;
+  out.channels = {"combined.R", "combined.G", "combined.B"};
+  int c = image.channelIndex("combined.R");
+  out.pixels.reserve(std::size_t(image.width) * image.height * 3);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      for (int k = 0; k < 3; ++k) out.pixels.push_back(image.at(x, y, c + k));
+  return out;
+}
+
+const io::Image& ConvergenceStudy::otherReference(const std::string& model, const std::string& name) const {
+  return otherReferences_.at(model).at(name);
+}
+
+std::filesystem::path ConvergenceStudy::otherPath(std::filesystem::path exr, const std::string& model) {
+  return exr.replace_extension(fmt::format(".{}-ia.exr", model));
+}
+
+} // namespace obscura::analysis

@@ -1,0 +1,131 @@
+// convergence_study.h — the renders of `obscura converge` [SPEC §4]: each method (obscurances with
+// several budgets and estimators, denoised or not, and path tracing) rendered at a sample count
+// with persistent renderers, and the converged references of each family, cached as EXR with a
+// .txt naming the settings that made them (convergence.h draws the figures from the curves).
+//
+// Every obscurance method estimates the same image (ray counts and light sampling change the
+// noise, not the expectation), so one converged obscurance render, made with the best
+// estimators, is the noise reference of all of them. The denoised methods (render/denoise/) are
+// measured the same way: one frame denoised alone, its GPU time counted.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bvh/bvh.h"
+#include "gpu/context.h"
+#include "io/image_io.h"
+#include "render/denoise/denoiser.h"
+#include "render/obscurance_renderer.h"
+#include "render/path_tracer.h"
+#include "scene/scene.h"
+
+namespace obscura::analysis {
+
+// The default emission rays per sample: the primary ray alone. They pay where bright emitters seen
+// directly set the error (the Cornell box: --emission-samples 16 --pt-emission-samples 4) and cost
+// more than they remove where the emitters are small on screen (modern-hall); docs/BENCHMARKS.md,
+// "Emission rays and the split of shading rays".
+inline constexpr std::uint32_t kObscuranceEmissionSamples = 1, kPathEmissionSamples = 1;
+
+// What a convergence study measures and how: `obscura converge`'s settings.
+struct StudySettings {
+  std::string scenePath;
+  std::string outputDir;
+  std::uint32_t width = 256; // per-pixel noise as a user sees it
+  std::uint32_t obscuranceMaxSpp = 16;
+  std::uint32_t pathMaxSpp = 256;
+  std::uint32_t referenceFactor = 64;   // a reference has this many times the largest curve's spp
+  std::uint32_t pathReferenceSpp = 0;   // 0: referenceFactor x pathMaxSpp
+  // A merged farm render (`obscura merge`'s EXR of --method pathtrace parts) to take as the path
+  // tracing reference instead of rendering it here: the longest render of a study, spread over a
+  // cluster (tools/farm/).
+  std::string pathReferenceFile;
+  std::uint32_t seed = 1;
+  float dMax = 0.0f; // 0: the renderer's default
+  float secondaryReflectors = 0.0f; // > 0: one more method, obscurances with secondary reflectors
+  std::vector<float> background;    // R,G,B of a sky (render --background); empty: none
+  // Camera rays per sample for the emission the camera sees (render --emission-samples), each
+  // method family with the count that serves it best (docs/BENCHMARKS.md).
+  std::uint32_t emissionSamples = kObscuranceEmissionSamples;
+  std::uint32_t pathEmissionSamples = kPathEmissionSamples;
+  std::string commandLine; // how the study was asked for: written beside each cached reference
+};
+
+// A method the study measures (its curve, its figures at its budget).
+struct StudyMethod {
+  std::string name;
+  bool pathTrace = false;
+  render::LightSampling lightSampling = render::LightSampling::Spatial;
+  std::uint32_t raysPerHit = 5;   // shadow (and obscurance, see below) rays per hit (obscurance methods)
+  std::uint32_t budgetSpp = 8;    // the budget its summary is read at
+  std::string what;
+  float secondaryReflectors = 0.0f; // their marking threshold, 0 = off
+  bool denoise = false;             // the frame denoised (render/denoise/), its GPU time counted
+  std::uint32_t obscuranceRays = 0; // obscurance rays per hit; 0: raysPerHit
+  std::uint32_t emissionSamples = 0; // camera rays per sample for the seen emission; 0: the study's
+  bool vertexRaysByThroughput = true; // specular path vertices: rays scaled by throughput, or N per hit
+};
+
+// The paper's budget [RTO §4.1]: 8 primary samples x (5 obscurance + 5 shadow rays) per hit.
+inline constexpr std::uint32_t kPaperSpp = 8, kPaperRays = 5;
+
+// The methods a study runs: every obscurance method with its budget, path tracing last; with
+// --secondary-reflectors the best obscurance method with them too, and with --emission-samples
+// K > 1 the best one without them.
+std::vector<StudyMethod> studyMethods(const StudySettings& settings);
+
+// One render of a method: its image, GPU time and rays per pixel.
+struct StudyRender {
+  io::Image image;
+  double gpuMs = 0.0;
+  double rays = 0.0;
+};
+
+class ConvergenceStudy {
+public:
+  // `settings.pathReferenceFile`, if any, is checked at once (a wrong reference fails the study
+  // before anything is rendered).
+  ConvergenceStudy(const StudySettings& settings, const scene::Scene& scene, const bvh::Bvh& bvh,
+                   const gpu::Context& context);
+
+  // Method `m` at `spp` samples with `seed`, with the study's persistent renderers: the scene is
+  // uploaded and the pipelines are made once per method family, not once per render.
+  StudyRender render(const StudyMethod& m, std::uint32_t spp, std::uint32_t seed);
+  // The converged image of a method, from the cache in the output folder when the same settings
+  // made it (the path tracing one from --pt-reference where given).
+  io::Image reference(const StudyMethod& m);
+  // Obscurance method `name`'s reference composed with the `model` I_a ("global": the paper's,
+  // "reached") instead of the Seen one (after reference() of it).
+  const io::Image& otherReference(const std::string& model, const std::string& name) const;
+
+  std::uint32_t width() const { return width_; }
+  std::uint32_t height() const { return height_; }
+  const std::string& stem() const { return stem_; }
+
+private:
+  // The path tracing reference from a merged farm render, checked to be of this study's image:
+  // the same scene (hash), camera, size, depth and sky.
+  io::Image farmReference() const;
+  static io::Image combinedOnly(const io::Image& image);
+  static std::filesystem::path otherPath(std::filesystem::path exr, const std::string& model);
+
+  const StudySettings& o_;
+  const scene::Scene& scene_;
+  const bvh::Bvh& bvh_;
+  const gpu::Context& context_;
+  std::unique_ptr<render::ObscuranceRenderer> obscurance_;
+  std::unique_ptr<render::Denoiser> denoiser_; // bound to obscurance_'s frame
+  std::unique_ptr<render::PathTracer> pathTracer_;
+  scene::Camera camera_;
+  std::uint32_t width_ = 0, height_ = 0;
+  std::string stem_;
+  mutable render::RenderStats statsCopy_;
+  std::map<std::string, std::map<std::string, io::Image>> otherReferences_; // model -> method -> image
+  io::Image farmReference_; // --pt-reference
+};
+
+} // namespace obscura::analysis
