@@ -26,10 +26,9 @@
 #include "bench/embree_baseline.h"
 #include "bench/embree_frame.h"
 #endif
-#include "bench/cpu_time.h"
-#include "bench/hit_agreement.h"
 #include "bench/lane_order.h"
 #include "bench/pass_bench.h"
+#include "bench/ray_set_measurement.h"
 #include "bench/ray_tracer.h"
 #include "render/passes/primary_pass.h"
 #include "app/render_options.h"
@@ -105,90 +104,6 @@ void applyMove(const BenchOptions& o, LoadedScene& loaded, const gpu::Context& c
   scene::moveObject(loaded.scene, object, d, glm::vec3(0.0f));
   if (o.refit) bvh::refit(loaded.bvh, render::triangleSoup(loaded.scene));
   else loaded.bvh = bvh::build(render::triangleSoup(loaded.scene), treeOptions(o, context));
-}
-
-struct SetResult {
-  double bestMs = 0.0, medianMs = 0.0;
-  double bestCpuMs = 0.0; // least process CPU time of one timed repeat
-  double hitFraction = 0.0;
-  double meanSteps = 0.0;
-  // lavapipe runs 8 invocations in lock-step: a group's loop runs as long as its busiest lane's
-  // (in trace.comp a lane's kTraceRaysPerLane rays together). Passes per ray as the groups run
-  // them; meanSteps / it = lane utilisation.
-  double meanGroupMaxSteps = 0.0;
-  std::size_t mismatches = 0;           // traversal errors (bench/hit_agreement.h)
-  std::size_t precisionDifferences = 0; // the other correct answer of a float-rounding-sensitive ray
-  std::vector<std::string> mismatchExamples; // the first few traversal errors, for the report
-};
-
-SetResult runSet(bench::RayTracer& tracer, const LoadedScene& loaded, const std::vector<gpu::GpuRay>& rays,
-                 bench::TraceMode mode, const BenchOptions& o, bool backToBack) {
-  SetResult r;
-  // Warm-up (pipeline JIT, caches) and hit statistics, then timed repeats.
-  auto first = tracer.trace(rays, mode, true);
-  std::size_t hits = 0;
-  double steps = 0;
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    if (first.hits[i].primitive != gpu::kInvalidIndex) ++hits;
-    steps += first.steps[i];
-  }
-  r.hitFraction = rays.empty() ? 0.0 : static_cast<double>(hits) / static_cast<double>(rays.size());
-  r.meanSteps = rays.empty() ? 0.0 : steps / static_cast<double>(rays.size());
-  // What lavapipe's 8-lane groups run: each lane traces its rays (the tracer's raysPerLane) in one
-  // refilling loop (trace.comp), so a group runs as many passes as its busiest lane's rays take.
-  constexpr std::size_t kLanes = 8;
-  const std::size_t kBlock = kLanes * tracer.shape().raysPerLane;
-  double groupPasses = 0.0;
-  for (std::size_t b = 0; b < rays.size(); b += kBlock) {
-    std::array<std::uint64_t, kLanes> lane{};
-    for (std::size_t i = b; i < std::min(rays.size(), b + kBlock); ++i) lane[(i - b) % kLanes] += first.steps[i];
-    groupPasses += static_cast<double>(*std::max_element(lane.begin(), lane.end()));
-  }
-  // Passes per ray as the groups run them: the mean per ray over the lane utilisation.
-  r.meanGroupMaxSteps = rays.empty() ? 0.0 : kLanes * groupPasses / static_cast<double>(rays.size());
-  std::vector<double> times, cpuMs;
-  if (backToBack) { // a GPU: the repeats in one submission, so that its clocks stay up between them
-    // Once untimed first (pipelines, caches). Not a cure: on an H200 the shadow set traced after
-    // Sponza's 1M-ray CPU check ran at a fifth of its rate in every run, all five repeats alike;
-    // warming up for 0.4 s of repeated traces made more sets do so (docs/BENCHMARKS.md,
-    // "Traversal per device"), so a set's figure is checked against the other runs of its kernel.
-    tracer.traceRepeated(rays, mode, static_cast<std::uint32_t>(o.repeats));
-    double c0 = bench::processCpuMs();
-    times = tracer.traceRepeated(rays, mode, static_cast<std::uint32_t>(o.repeats)).repeatGpuMs;
-    cpuMs.push_back((bench::processCpuMs() - c0) / o.repeats);
-  } else { // lavapipe: each repeat on its own, its process CPU time measured (the Embree ratio's)
-    for (int k = 0; k < o.repeats; ++k) {
-      double c0 = bench::processCpuMs();
-      times.push_back(tracer.trace(rays, mode).gpuMs);
-      cpuMs.push_back(bench::processCpuMs() - c0);
-    }
-  }
-  r.bestCpuMs = *std::min_element(cpuMs.begin(), cpuMs.end());
-  std::sort(times.begin(), times.end());
-  r.bestMs = times.front();
-  r.medianMs = times[times.size() / 2];
-  // Optional check of the first `verify` rays against the CPU reference traversal.
-  const bool shadowRays = mode == bench::TraceMode::Any;
-  const bvh::TriangleSoup soup = o.verify > 0 ? render::triangleSoup(loaded.scene) : bvh::TriangleSoup{};
-  for (std::size_t i = 0; i < std::min(o.verify, rays.size()); ++i) {
-    bvh::Ray ray{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
-    const bvh::Hit cpu = bvh::closestHit(loaded.bvh, ray);
-    const bool cpuOccluded = shadowRays && bvh::anyHit(loaded.bvh, ray);
-    const gpu::GpuHit& g = first.hits[i];
-    const bench::HitAgreement agreement =
-        shadowRays ? bench::anyHitAgreement(ray, cpuOccluded, cpu, g)
-                   : bench::closestHitAgreement(ray, cpu, g, &soup);
-    if (agreement == bench::HitAgreement::Different && ++r.mismatches <= 5) {
-      r.mismatchExamples.push_back(fmt::format(
-          "{} ray {}: origin ({}, {}, {}) direction ({}, {}, {}) t in ({}, {}); CPU closest t {} u {} v {} "
-          "triangle {}{}; GPU t {} u {} v {} triangle {}",
-          shadowRays ? "shadow" : "closest", i, ray.origin.x, ray.origin.y, ray.origin.z, ray.direction.x,
-          ray.direction.y, ray.direction.z, ray.tmin, ray.tmax, cpu.t, cpu.u, cpu.v, cpu.primitive,
-          shadowRays ? fmt::format(" (occluded: {})", cpuOccluded) : "", g.t, g.u, g.v, g.primitive));
-    }
-    if (agreement == bench::HitAgreement::WithinPrecision) ++r.precisionDifferences;
-  }
-  return r;
 }
 
 // The baseline's figures beside ours, and the ratios ours / baseline.
@@ -391,8 +306,11 @@ void runBench(const BenchOptions& o) {
     bench::saveRays(o.saveRays + ".shadow.bin", shadowRays);
   }
   const bool backToBack = context.info().type != "cpu";
-  SetResult closest = runSet(tracer, loaded, closestRays, bench::TraceMode::Closest, o, backToBack);
-  SetResult shadow = runSet(tracer, loaded, shadowRays, bench::TraceMode::Any, o, backToBack);
+  const bench::RaySetOptions setOptions{.repeats = o.repeats, .verify = o.verify, .backToBack = backToBack};
+  const bench::RaySetMeasurement closest =
+      bench::measureRaySet(tracer, loaded.scene, loaded.bvh, closestRays, bench::TraceMode::Closest, setOptions);
+  const bench::RaySetMeasurement shadow =
+      bench::measureRaySet(tracer, loaded.scene, loaded.bvh, shadowRays, bench::TraceMode::Any, setOptions);
   std::optional<Baseline> base = runBaseline(o, loaded, closestRays, shadowRays);
   const scene::Camera camera = chooseCamera(loaded.scene, -1);
   std::optional<PassesRun> passes;
@@ -487,7 +405,7 @@ void runBench(const BenchOptions& o) {
                  "rounding may: a grazed edge, a tie in t, a hit at the ray's end)\n",
                  o.verify, closest.mismatches + shadow.mismatches,
                  closest.precisionDifferences + shadow.precisionDifferences);
-    for (const SetResult* set : {&closest, &shadow})
+    for (const bench::RaySetMeasurement* set : {&closest, &shadow})
       for (const std::string& example : set->mismatchExamples) fmt::print("  mismatch: {}\n", example);
     if (base) {
       fmt::print("embree {} threads: build {:.3f} s\n", base->threads, base->buildSeconds);

@@ -11,8 +11,7 @@ namespace obscura::app {
 void addDeviceOptions(CLI::App& command, DeviceOptions& options) {
   command.add_option("--device", options.device, "Vulkan device: index or part of its name (see 'obscura info')");
   command.add_flag("--validate", options.validate, "enable the Khronos validation layer");
-  std::vector<std::string> names = namesOf(render::kTraversalNames);
-  names.insert(names.begin(), "auto");
+  const std::vector<std::string> names = render::traversalRequestNames();
   command.add_option("--traversal", options.traversal,
                      fmt::format("BVH layout and traversal loop: {} (default auto: wide on a CPU device such as "
                                  "lavapipe, binary-while-while on a GPU)",

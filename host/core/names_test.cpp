@@ -10,6 +10,7 @@
 #include "core/names.h"
 #include "io/json_fields.h"
 #include "recover/reflectance_recovery.h"
+#include "relight/light_edits.h"
 #include "render/method.h"
 #include "render/obscurance_renderer.h"
 #include "render/scene_data/bvh_layout.h"
@@ -47,9 +48,25 @@ TEST(NameTables, EveryEnumValueHasOneNameThatReadsBackAsIt) {
   expectTableCovers(kVertexRaysNames, {true, false});
   expectTableCovers(recover::kIndirectModelNames, {recover::IndirectModel::Constant, recover::IndirectModel::Obscurance,
                                                    recover::IndirectModel::Gather});
+  expectTableCovers(relight::kAddedLightTypeNames,
+                    {relight::AddedLightType::Point, relight::AddedLightType::Spot, relight::AddedLightType::Quad});
   // Recovery's subset keeps the full table's words.
   for (const auto& entry : recover::kRecoveryAmbientNames)
     EXPECT_EQ(nameOf(kAmbientModelNames, entry.value), entry.name);
+}
+
+TEST(NameTables, TraversalRequestsAreAutoThenTheTable) {
+  const std::vector<std::string> names = render::traversalRequestNames();
+  ASSERT_EQ(names.size(), render::kTraversalNames.size() + 1);
+  EXPECT_EQ(names.front(), "auto");
+  EXPECT_EQ(render::parseTraversal("auto"), std::nullopt);
+  for (std::size_t i = 1; i < names.size(); ++i) EXPECT_TRUE(render::parseTraversal(names[i]).has_value()) << names[i];
+  try {
+    render::parseTraversal("zigzag");
+    FAIL() << "an unknown traversal was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("auto, wide, binary, binary-while-while"), std::string::npos) << e.what();
+  }
 }
 
 TEST(NameTables, SentenceListsTheNamesInOrder) {

@@ -33,11 +33,11 @@ void requireLight(const std::vector<std::string>& names, const std::string& name
 
 scene::PunctualLight readAddedLight(const json& j, const io::JsonEntry& at) {
   if (!j.is_object()) at.fail("'add_light' must be an object");
-  const std::string type = text(j, "type", at);
+  const AddedLightType type = io::jsonNamed(j, "type", kAddedLightTypeNames, at);
+  if (type == AddedLightType::Quad) at.fail("an emissive quad is not a punctual light");
   scene::PunctualLight l;
   l.name = text(j, "name", at);
-  if (type != "point" && type != "spot") at.fail(fmt::format("light type '{}' (known: point, spot, quad)", type));
-  l.type = type == "point" ? scene::PunctualType::Point : scene::PunctualType::Spot;
+  l.type = type == AddedLightType::Point ? scene::PunctualType::Point : scene::PunctualType::Spot;
   l.position = vec3(j, "position", at);
   l.color = j.contains("color") ? vec3(j, "color", at) : glm::vec3(1.0f);
   l.intensity = number(j, "intensity", at);
@@ -99,7 +99,9 @@ Edit readEdit(const json& j, const io::JsonEntry& at) {
     }
   } else if (j.contains("add_light")) {
     const json& light = j.at("add_light");
-    if (light.is_object() && light.contains("type") && light.at("type") == "quad") {
+    const bool quad = light.is_object() && light.contains("type") && light.at("type").is_string() &&
+                      valueNamed(kAddedLightTypeNames, light.at("type").get<std::string>()) == AddedLightType::Quad;
+    if (quad) {
       e.kind = Edit::Kind::AddQuad;
       e.quad = addedQuad(light, at);
       e.name = e.quad.name;

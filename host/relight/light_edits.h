@@ -20,12 +20,18 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/names.h"
 #include "scene/scene.h"
 #include "scene/scene_edit.h"
 #include "io/json_fields.h"
 #include "session/edit.h"
 
 namespace obscura::relight {
+
+// What an 'add_light' entry's "type" makes: a punctual light, or an emissive quad (geometry too).
+enum class AddedLightType { Point, Spot, Quad };
+inline constexpr NameTable<AddedLightType, 3> kAddedLightTypeNames{
+    {{"point", AddedLightType::Point}, {"spot", AddedLightType::Spot}, {"quad", AddedLightType::Quad}}};
 
 using session::Edit;
 

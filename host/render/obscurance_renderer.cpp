@@ -56,7 +56,7 @@ std::uint32_t keptRaySamples(const gpu::Context& context, const ObscuranceSettin
 
 bool sceneHasGlossy(const scene::Scene& scene) {
   std::vector<bool> glossy;
-  for (const auto& m : scene.materials) glossy.push_back(isGlossy(m.metallic, m.roughness));
+  for (const auto& m : scene.materials) glossy.push_back(shading::isGlossy(m.metallic, m.roughness));
   for (std::uint32_t m : scene.triangleMaterial)
     if (glossy[m]) return true;
   return false;

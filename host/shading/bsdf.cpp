@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace obscura::render {
+namespace obscura::shading {
 
 // ---- Sampling (twins of shaders/lib/sampling.glsl; comments and citations there)
 
@@ -283,4 +283,4 @@ glm::vec3 meanAlbedo(glm::vec3 baseColor, float metallic, float roughness, int n
   return glm::vec3(sum / static_cast<double>(nOut));
 }
 
-} // namespace obscura::render
+} // namespace obscura::shading

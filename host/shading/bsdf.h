@@ -12,7 +12,7 @@
 
 #include <glm/glm.hpp>
 
-namespace obscura::render {
+namespace obscura::shading {
 
 inline constexpr float kPi = 3.14159265358979323846f;
 inline constexpr float kInvPi = 0.31830988618379067154f;
@@ -95,4 +95,4 @@ glm::vec3 directionalAlbedo(glm::vec3 baseColor, float metallic, float roughness
 // Exactly baseColor for a Lambertian material; accurate to ~5e-4 otherwise, ~2 ms.
 glm::vec3 meanAlbedo(glm::vec3 baseColor, float metallic, float roughness, int nOut = 32, int n = 32);
 
-} // namespace obscura::render
+} // namespace obscura::shading

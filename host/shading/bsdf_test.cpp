@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-namespace obscura::render {
+namespace obscura::shading {
 namespace {
 
 glm::vec3 directionAt(float cosTheta, float phi = 0.0f) {
@@ -204,4 +204,4 @@ TEST(Bsdf, MeanAlbedoIsFastAndDeterministic) {
 }
 
 } // namespace
-} // namespace obscura::render
+} // namespace obscura::shading

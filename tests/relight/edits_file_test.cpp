@@ -60,6 +60,8 @@ TEST_F(EditsFile, BadEntriesAreRefusedNamingTheEntry) {
   expectRefused(json::array({{{"add_light", {{"type", "point"}, {"name", "b"}}}}}), "position");
   expectRefused(json::array({{{"remove_light", "b"}}}), "no light named 'b'");
   expectRefused(json::array({{{"teleport", "x"}}}), "unknown edit");
+  expectRefused(json::array({{{"add_light", {{"type", "laser"}, {"name", "b"}, {"position", {0, 1, 0}}, {"intensity", 1}}}}}),
+                "'type' is point, spot or quad");
   expectRefused(json::object({{"light", kLamp}}), "list");
   expectRefused(json::array({{{"add_light", {{"type", "quad"}, {"name", "q"}, {"corner", {0, 0, 0}},
                                              {"edge1", {1, 0, 0}}, {"edge2", {2, 0, 0}}, {"emission", {1, 1, 1}}}}}}),

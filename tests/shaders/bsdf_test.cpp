@@ -45,7 +45,7 @@ public:
 glm::vec3 randomDirection(std::mt19937& rng, bool upper) {
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   float z = upper ? u(rng) : 2.0f * u(rng) - 1.0f;
-  float phi = 2.0f * render::kPi * u(rng);
+  float phi = 2.0f * shading::kPi * u(rng);
   float s = std::sqrt(std::max(0.0f, 1.0f - z * z));
   return {s * std::cos(phi), s * std::sin(phi), z};
 }
@@ -87,12 +87,12 @@ TEST_F(BsdfShader, MatchesCpuTwin) {
     const auto& g = gpu[i].r;
     glm::vec3 color(c.material), wo(c.wo), wi(c.wi), u3(c.u);
     float metallic = c.material.w, roughness = c.wo.w;
-    expectClose(glm::vec3(g[0]), render::evalBsdf(color, metallic, roughness, wo, wi), kTol, 1.0f, "evalBsdf", i);
-    expectClose(g[0].w, render::bsdfPdf(color, metallic, roughness, wo, wi), kTol, 1.0f, "bsdfPdf", i);
+    expectClose(glm::vec3(g[0]), shading::evalBsdf(color, metallic, roughness, wo, wi), kTol, 1.0f, "evalBsdf", i);
+    expectClose(g[0].w, shading::bsdfPdf(color, metallic, roughness, wo, wi), kTol, 1.0f, "bsdfPdf", i);
     glm::vec3 cpuWi;
     float cpuPdf = 0.0f;
     bool cpuDelta = false;
-    glm::vec3 cpuWeight = render::sampleBsdf(color, metallic, roughness, wo, u3, cpuWi, cpuPdf, cpuDelta);
+    glm::vec3 cpuWeight = shading::sampleBsdf(color, metallic, roughness, wo, u3, cpuWi, cpuPdf, cpuDelta);
     ASSERT_EQ(g[2].w != 0.0f, cpuDelta) << i;
     ASSERT_EQ(g[1].w > 0.0f, cpuPdf > 0.0f) << i;
     // Sampled directions agree to 1e-4; their pdfs are compared at the GPU's direction, because
@@ -102,26 +102,26 @@ TEST_F(BsdfShader, MatchesCpuTwin) {
       glm::vec3 gpuWi(g[2]);
       expectClose(gpuWi, cpuWi, kTol, 1.0f, "sampleBsdf wi", i);
       expectClose(glm::vec3(g[1]), cpuWeight, kTol, 1.0f, "sampleBsdf weight", i);
-      float cpuPdfThere = cpuDelta ? cpuPdf : render::bsdfPdf(color, metallic, roughness, wo, gpuWi);
+      float cpuPdfThere = cpuDelta ? cpuPdf : shading::bsdfPdf(color, metallic, roughness, wo, gpuWi);
       expectClose(g[1].w, cpuPdfThere, kTol, 1.0f, "sampleBsdf pdf", i);
-      expectClose(glm::vec3(g[3]), render::evalBsdf(color, metallic, roughness, wo, gpuWi), kTol, 1.0f,
+      expectClose(glm::vec3(g[3]), shading::evalBsdf(color, metallic, roughness, wo, gpuWi), kTol, 1.0f,
                   "evalBsdf at the sample", i);
     }
     expectClose(glm::vec3(g[7]), cpuWeight, kTol, 1.0f, "sampleBsdf (7 arguments) weight", i);
-    float alpha = render::ggxAlpha(roughness);
-    expectClose(g[4].x, render::ggxD(wi.z, alpha), kTol, 1.0f, "ggxD", i);
-    expectClose(g[8].x, render::ggxD(wo + wi, alpha), kTol, 1.0f, "ggxD (vector)", i);
-    expectClose(g[4].y, render::smithG1(wo.z, alpha), kTol, 1.0f, "smithG1", i);
-    expectClose(g[4].z, render::smithG2(wo.z, wi.z, alpha), kTol, 1.0f, "smithG2", i);
-    expectClose(g[4].w, render::ggxReflectionPdf(wo, wi, alpha), kTol, 1.0f, "ggxReflectionPdf", i);
+    float alpha = shading::ggxAlpha(roughness);
+    expectClose(g[4].x, shading::ggxD(wi.z, alpha), kTol, 1.0f, "ggxD", i);
+    expectClose(g[8].x, shading::ggxD(wo + wi, alpha), kTol, 1.0f, "ggxD (vector)", i);
+    expectClose(g[4].y, shading::smithG1(wo.z, alpha), kTol, 1.0f, "smithG1", i);
+    expectClose(g[4].z, shading::smithG2(wo.z, wi.z, alpha), kTol, 1.0f, "smithG2", i);
+    expectClose(g[4].w, shading::ggxReflectionPdf(wo, wi, alpha), kTol, 1.0f, "ggxReflectionPdf", i);
     if (wo.z > 0.0f) {
-      glm::vec3 h = render::sampleGgxVisibleNormal(wo, alpha, glm::vec2(u3.y, u3.z)), gpuH(g[5]);
+      glm::vec3 h = shading::sampleGgxVisibleNormal(wo, alpha, glm::vec2(u3.y, u3.z)), gpuH(g[5]);
       expectClose(gpuH, h, kTol, 1.0f, "sampleGgxVisibleNormal", i);
-      expectClose(g[5].w, render::ggxVisibleNormalPdf(wo, gpuH, alpha), kTol, 1.0f, "ggxVisibleNormalPdf", i);
+      expectClose(g[5].w, shading::ggxVisibleNormalPdf(wo, gpuH, alpha), kTol, 1.0f, "ggxVisibleNormalPdf", i);
     }
-    EXPECT_EQ(g[6].x != 0.0f, render::isGlossy(metallic, roughness)) << i;
-    EXPECT_EQ(g[6].y != 0.0f, render::isMirror(roughness)) << i;
-    expectClose(g[6].z, render::specularProbability(color, metallic, wo.z), kTol, 1.0f, "specularProbability", i);
+    EXPECT_EQ(g[6].x != 0.0f, shading::isGlossy(metallic, roughness)) << i;
+    EXPECT_EQ(g[6].y != 0.0f, shading::isMirror(roughness)) << i;
+    expectClose(g[6].z, shading::specularProbability(color, metallic, wo.z), kTol, 1.0f, "specularProbability", i);
     EXPECT_EQ(g[6].w, alpha) << i;
     if (HasFailure()) return;
   }
@@ -146,10 +146,10 @@ TEST_F(BsdfShader, SampleWeightIsEvalCosOverPdf) {
     EXPECT_GT(wi.z, 0.0f) << i;
     if (g[2].w != 0.0f) { // delta
       ++deltas;
-      EXPECT_TRUE(render::isMirror(c.wo.w)) << i;
+      EXPECT_TRUE(shading::isMirror(c.wo.w)) << i;
       EXPECT_NEAR(glm::length(wi - glm::vec3(-wo.x, -wo.y, wo.z)), 0.0f, 1e-6f) << i;
-      glm::vec3 f0 = glm::mix(glm::vec3(render::kDielectricF0), glm::vec3(c.material), c.material.w);
-      expectClose(weight, render::fresnelSchlick(f0, wo.z) / pdf, 1e-5f, 1e-3f, "mirror weight", i);
+      glm::vec3 f0 = glm::mix(glm::vec3(shading::kDielectricF0), glm::vec3(c.material), c.material.w);
+      expectClose(weight, shading::fresnelSchlick(f0, wo.z) / pdf, 1e-5f, 1e-3f, "mirror weight", i);
       continue;
     }
     ++checked;
@@ -166,7 +166,7 @@ TEST_F(BsdfShader, SampleWeightIsEvalCosOverPdf) {
 // horizon, expected N (1 - integral of bsdfPdf).
 ChiSquare glossyChiSquare(BsdfShader& test, glm::vec3 color, float metallic, float roughness, double& lost,
                           double& expectedLost) {
-  const float theta = 50.0f * render::kPi / 180.0f;
+  const float theta = 50.0f * shading::kPi / 180.0f;
   const glm::vec3 wo(std::sin(theta), 0.0f, std::cos(theta));
   const std::size_t caseCount = 1'000'000 / kOutPerCase;
   std::vector<BsdfCase> cases(caseCount, BsdfCase{glm::vec4(color, metallic), glm::vec4(wo, roughness), {}, {},
@@ -198,7 +198,7 @@ ChiSquare glossyChiSquare(BsdfShader& test, glm::vec3 color, float metallic, flo
           double z = (iz + (a + 0.5) / kSub) / kZ, phi = 2.0 * M_PI * (ip + (b + 0.5) / kSub) / kPhi;
           double s = std::sqrt(std::max(0.0, 1.0 - z * z));
           glm::vec3 wi(float(s * std::cos(phi)), float(s * std::sin(phi)), float(z));
-          sum += render::bsdfPdf(color, metallic, roughness, wo, wi);
+          sum += shading::bsdfPdf(color, metallic, roughness, wo, wi);
         }
       double p = sum / (kSub * kSub) * (1.0 / kZ) * (2.0 * M_PI / kPhi); // dw = dz dphi
       expected[iz * kPhi + ip] = n * p;
@@ -239,7 +239,7 @@ TEST_F(BsdfShader, MirrorDeltaFrequencyIsItsProbability) {
   double deltas = 0.0, n = double(cases.size() * kOutPerCase);
   for (const auto& res : gpu)
     for (const auto& s : res.r) deltas += s.w < 0.0f;
-  double p = render::specularProbability(color, 0.0f, wo.z);
+  double p = shading::specularProbability(color, 0.0f, wo.z);
   EXPECT_NEAR(deltas / n, p, 5.0 * std::sqrt(p * (1.0 - p) / n));
 }
 

@@ -82,16 +82,16 @@ TEST_F(SamplingShader, SystematicGridFactorisations) {
     std::uint32_t best = 1; // the largest divisor <= sqrt(n), by brute force
     for (std::uint32_t d = 1; d * d <= n; ++d)
       if (n % d == 0) best = d;
-    glm::uvec2 cpu = render::systematicGrid(n);
+    glm::uvec2 cpu = shading::systematicGrid(n);
     EXPECT_EQ(cpu, glm::uvec2(n / best, best)) << "n = " << n;
     EXPECT_EQ(glm::uvec2(gpu[n - 1].v[0]), cpu) << "n = " << n;
   }
-  EXPECT_EQ(render::systematicGrid(5), glm::uvec2(5, 1));
-  EXPECT_EQ(render::systematicGrid(4), glm::uvec2(2, 2));
-  EXPECT_EQ(render::systematicGrid(40), glm::uvec2(8, 5)); // the paper's 40 rays per pixel
-  EXPECT_EQ(render::systematicGrid(1), glm::uvec2(1, 1));
-  EXPECT_EQ(render::systematicGrid(97), glm::uvec2(97, 1));
-  EXPECT_EQ(render::systematicGrid(0), glm::uvec2(0, 0));
+  EXPECT_EQ(shading::systematicGrid(5), glm::uvec2(5, 1));
+  EXPECT_EQ(shading::systematicGrid(4), glm::uvec2(2, 2));
+  EXPECT_EQ(shading::systematicGrid(40), glm::uvec2(8, 5)); // the paper's 40 rays per pixel
+  EXPECT_EQ(shading::systematicGrid(1), glm::uvec2(1, 1));
+  EXPECT_EQ(shading::systematicGrid(97), glm::uvec2(97, 1));
+  EXPECT_EQ(shading::systematicGrid(0), glm::uvec2(0, 0));
 }
 
 // 10^6 random cosine samples (u from rng.glsl) against cos(theta) / pi.
@@ -124,7 +124,7 @@ TEST_F(SamplingShader, SystematicChiSquare) {
 // one ray. The tolerance (1e-4 of a cell) only absorbs float rounding at the cell borders.
 TEST_F(SamplingShader, SystematicPutsOneRayInEachCell) {
   for (std::uint32_t n : {1u, 4u, 5u, 7u, 16u, 40u, 64u}) {
-    glm::uvec2 grid = render::systematicGrid(n);
+    glm::uvec2 grid = shading::systematicGrid(n);
     auto results = runMode(kModeSystematic, n, 2000);
     std::size_t hits = 0, outside = 0;
     for (const auto& res : results) {
@@ -208,7 +208,7 @@ TEST_F(SamplingShader, UniformTriangleChiSquare) {
     }
   EXPECT_LT(maxOffPlane, 1e-5);
   EXPECT_GT(minBary, -1e-6);
-  EXPECT_NEAR(render::triangleArea(v0, v1, v2), area, 1e-5 * area);
+  EXPECT_NEAR(shading::triangleArea(v0, v1, v2), area, 1e-5 * area);
   std::vector<double> expected(observed.size(), double(count) / observed.size());
   ChiSquare chi = chiSquareTest(observed, expected);
   EXPECT_TRUE(chi.passed()) << "chi2 = " << chi.value << ", dof " << chi.dof << ", threshold " << chi.threshold;
@@ -268,7 +268,7 @@ TEST_F(SamplingShader, SphericalTriangleChiSquare) {
     std::printf("[ chi2     ] spherical triangle, %s (%.4g sr): %.1f (dof %d, threshold %.1f at p = 1e-4)\n", c.name,
                 total, chi.value, chi.dof, chi.threshold);
   }
-  EXPECT_NEAR(render::sphericalTriangleArea({1, 0, 0}, {0, 1, 0}, {0, 0, 1}), kPi / 2.0, 1e-6);
+  EXPECT_NEAR(shading::sphericalTriangleArea({1, 0, 0}, {0, 1, 0}, {0, 0, 1}), kPi / 2.0, 1e-6);
 }
 
 // GPU == CPU twin for Arvo's warp on random triangles around the origin.
@@ -280,7 +280,7 @@ TEST_F(SamplingShader, SphericalTriangleWarpMatchesCpu) {
   while (cases.size() < 4000) {
     glm::vec3 v[3];
     for (auto& x : v) x = glm::normalize(glm::vec3(normal(rng), normal(rng), normal(rng)));
-    float area = render::sphericalTriangleArea(v[0], v[1], v[2]);
+    float area = shading::sphericalTriangleArea(v[0], v[1], v[2]);
     if (area < 3e-4f || area > 6.22f) continue; // the range lights.glsl samples this way
     cases.push_back({{kModeSpherical, 1u, 0u, 0u}, glm::vec4(v[0], uni(rng)), glm::vec4(v[1], uni(rng)), glm::vec4(v[2], 0)});
   }
@@ -288,8 +288,8 @@ TEST_F(SamplingShader, SphericalTriangleWarpMatchesCpu) {
   std::vector<double> differences;
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const auto& c = cases[i];
-    glm::vec3 w = render::sampleSphericalTriangle({c.a.w, c.b.w}, glm::vec3(c.a), glm::vec3(c.b), glm::vec3(c.c));
-    EXPECT_NEAR(gpu[i].v[0].w, render::sphericalTriangleArea(glm::vec3(c.a), glm::vec3(c.b), glm::vec3(c.c)),
+    glm::vec3 w = shading::sampleSphericalTriangle({c.a.w, c.b.w}, glm::vec3(c.a), glm::vec3(c.b), glm::vec3(c.c));
+    EXPECT_NEAR(gpu[i].v[0].w, shading::sphericalTriangleArea(glm::vec3(c.a), glm::vec3(c.b), glm::vec3(c.c)),
                 5e-5f * gpu[i].v[0].w + 1e-6f) << i; // lavapipe's atan: ~2e-5 relative
     differences.push_back(glm::length(glm::vec3(gpu[i].v[0]) - w));
   }
@@ -319,32 +319,32 @@ TEST_F(SamplingShader, WarpsInvertAndMatchCpu) {
                       : glm::normalize(glm::vec3(uni(rng) - 0.5f, uni(rng) - 0.5f, uni(rng) - 0.5f) + glm::vec3(1e-6f));
     glm::vec4 a(uni(rng), uni(rng), uni(rng), uni(rng));
     if (i == 0) a = glm::vec4(0.0f, 0.0f, 0.999f, 0.999f);
-    if (i == 1) a = glm::vec4(render::kOneMinusEpsilon, render::kOneMinusEpsilon, 0.0f, 0.0f);
+    if (i == 1) a = glm::vec4(shading::kOneMinusEpsilon, shading::kOneMinusEpsilon, 0.0f, 0.0f);
     std::uint32_t sysN = 1 + i % 40;
     cases.push_back({{kModeWarps, sysN, 0u, std::uint32_t(i) % sysN}, a, glm::vec4(n, 0),
-                     glm::vec4(render::sampleCosineHemisphere({uni(rng), uni(rng)}), 0)});
+                     glm::vec4(shading::sampleCosineHemisphere({uni(rng), uni(rng)}), 0)});
   }
   auto gpu = run(cases);
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const auto& c = cases[i];
     const auto& g = gpu[i].v;
     glm::vec2 u(c.a.x, c.a.y);
-    glm::vec3 w = render::sampleCosineHemisphere(u);
+    glm::vec3 w = shading::sampleCosineHemisphere(u);
     ASSERT_NEAR(glm::length(glm::vec3(g[0]) - w), 0.0f, 2e-6f) << i;
-    ASSERT_NEAR(g[0].w, render::cosineHemispherePdf(w.z), 2e-6f) << i;
+    ASSERT_NEAR(g[0].w, shading::cosineHemispherePdf(w.z), 2e-6f) << i;
     EXPECT_NEAR(glm::length(w), 1.0f, 1e-6f);
     // Round trip, on both sides; u.x is periodic, and undefined at the pole.
-    for (glm::vec2 back : {render::invertCosineHemisphereSample(w), glm::vec2(g[1])}) {
-      EXPECT_NEAR(back.y, std::min(u.y, render::kOneMinusEpsilon), 2e-6f) << i;
+    for (glm::vec2 back : {shading::invertCosineHemisphereSample(w), glm::vec2(g[1])}) {
+      EXPECT_NEAR(back.y, std::min(u.y, shading::kOneMinusEpsilon), 2e-6f) << i;
       float du = std::abs(back.x - u.x);
       if (u.y > 1e-6f) {
         EXPECT_LT(std::min(du, 1.0f - du), 2e-5f) << i << " u = " << u.x << ", " << u.y;
       }
     }
-    glm::vec3 sys = render::sampleSystematic(c.mode.w, render::systematicGrid(c.mode.y), glm::vec2(c.a.z, c.a.w));
+    glm::vec3 sys = shading::sampleSystematic(c.mode.w, shading::systematicGrid(c.mode.y), glm::vec2(c.a.z, c.a.w));
     ASSERT_NEAR(glm::length(glm::vec3(g[2]) - sys), 0.0f, 2e-6f) << i;
     glm::vec3 n(c.b), t, b;
-    render::orthonormalBasis(n, t, b);
+    shading::orthonormalBasis(n, t, b);
     ASSERT_NEAR(glm::length(glm::vec3(g[3]) - t), 0.0f, 1e-6f) << i;
     ASSERT_NEAR(glm::length(glm::vec3(g[4]) - b), 0.0f, 1e-6f) << i;
     EXPECT_NEAR(glm::length(t), 1.0f, 1e-5f);
@@ -353,14 +353,14 @@ TEST_F(SamplingShader, WarpsInvertAndMatchCpu) {
     EXPECT_NEAR(glm::dot(t, n), 0.0f, 1e-5f);
     EXPECT_NEAR(glm::dot(b, n), 0.0f, 1e-5f);
     EXPECT_NEAR(glm::length(glm::cross(t, b) - n), 0.0f, 1e-5f) << i; // right-handed
-    glm::vec3 world = render::toWorld(glm::vec3(c.c), t, b, n);
+    glm::vec3 world = shading::toWorld(glm::vec3(c.c), t, b, n);
     EXPECT_NEAR(glm::dot(world, n), c.c.z, 1e-5f); // local z is the normal
     ASSERT_NEAR(glm::length(glm::vec3(g[5]) - world), 0.0f, 2e-6f) << i;
     if (HasFailure()) return;
   }
   // The extremes: u = 0 is the pole, u.y -> 1 the horizon (cos > 0 still).
-  EXPECT_EQ(render::sampleCosineHemisphere({0, 0}), glm::vec3(0, 0, 1));
-  EXPECT_GT(render::sampleCosineHemisphere({0.3f, 1.0f}).z, 0.0f);
+  EXPECT_EQ(shading::sampleCosineHemisphere({0, 0}), glm::vec3(0, 0, 1));
+  EXPECT_GT(shading::sampleCosineHemisphere({0.3f, 1.0f}).z, 0.0f);
 }
 
 } // namespace

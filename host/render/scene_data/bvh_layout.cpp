@@ -30,7 +30,13 @@ std::optional<Traversal> parseTraversal(std::string_view name) {
   if (name.empty() || name == "auto") return std::nullopt;
   if (const auto traversal = valueNamed(kTraversalNames, name)) return traversal;
   throw std::invalid_argument(
-      fmt::format("unknown traversal '{}' (expected one of: auto, {})", name, fmt::join(namesOf(kTraversalNames), ", ")));
+      fmt::format("unknown traversal '{}' (expected one of: {})", name, fmt::join(traversalRequestNames(), ", ")));
+}
+
+std::vector<std::string> traversalRequestNames() {
+  std::vector<std::string> names = namesOf(kTraversalNames);
+  names.insert(names.begin(), "auto");
+  return names;
 }
 
 std::string traversalName(Traversal traversal) { return std::string(nameOf(kTraversalNames, traversal)); }

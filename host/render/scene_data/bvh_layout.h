@@ -42,6 +42,8 @@ inline constexpr NameTable<Traversal, 3> kTraversalNames{{{"wide", Traversal::Wi
 // A name of kTraversalNames; "auto" (or empty) is nullopt: the device's. Throws
 // std::invalid_argument naming the accepted values otherwise.
 std::optional<Traversal> parseTraversal(std::string_view name);
+// The words --traversal takes: "auto" (the device's choice), then kTraversalNames' names.
+std::vector<std::string> traversalRequestNames();
 std::string traversalName(Traversal traversal);
 
 std::uint32_t bvhLayoutOf(Traversal traversal); // gpu::kBvhLayoutWide or kBvhLayoutBinary

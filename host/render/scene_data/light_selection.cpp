@@ -103,7 +103,7 @@ LightPick selectLightFromTree(const std::vector<gpu::GpuLightNode>& tree, float 
     pick.light = tree[1u + header.z + std::min(static_cast<std::uint32_t>(scaled), unbounded - 1u)].refs.x;
     return pick;
   }
-  float v = std::min(scaled - float(unbounded), kOneMinusEpsilon);
+  float v = std::min(scaled - float(unbounded), shading::kOneMinusEpsilon);
   float probability = 1.0f / shares;
   std::uint32_t row = header.x;
   for (std::uint32_t depth = 0; depth < gpu::kLightTreeMaxDepth; ++depth) {
@@ -113,7 +113,7 @@ LightPick selectLightFromTree(const std::vector<gpu::GpuLightNode>& tree, float 
     const bool second = !(v < q.x);
     probability *= second ? q.y : q.x;
     if (!(probability > 0.0f)) return pick;
-    v = std::min(second ? (v - q.x) / q.y : v / q.x, kOneMinusEpsilon);
+    v = std::min(second ? (v - q.x) / q.y : v / q.x, shading::kOneMinusEpsilon);
     row = second ? refs.y : refs.x;
   }
   pick.probability = probability;

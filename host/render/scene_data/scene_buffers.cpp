@@ -100,7 +100,7 @@ std::vector<gpu::TriangleShading> shadingData(const scene::Scene& scene, const s
 } // namespace
 
 glm::vec3 materialMeanAlbedo(const scene::Material& m) {
-  return meanAlbedo(glm::vec3(m.baseColor), m.metallic, m.roughness);
+  return shading::meanAlbedo(glm::vec3(m.baseColor), m.metallic, m.roughness);
 }
 
 namespace {
@@ -111,7 +111,7 @@ std::vector<gpu::GpuMaterial> materialData(const scene::Scene& scene) {
     out.push_back({.baseColor = m.baseColor,
                    .emission = glm::vec4(m.emission, m.doubleSided ? 1.0f : 0.0f),
                    .params = glm::vec4(m.metallic, m.roughness, m.alphaCutoff,
-                                       isGlossy(m.metallic, m.roughness) ? 1.0f : 0.0f),
+                                       shading::isGlossy(m.metallic, m.roughness) ? 1.0f : 0.0f),
                    .textures = glm::ivec4(m.baseColorTexture, m.metallicRoughnessTexture, m.emissiveTexture, -1),
                    .meanAlbedo = glm::vec4(materialMeanAlbedo(m), 0.0f)});
   return out;
