@@ -3,15 +3,23 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <optional>
+#include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include "app/command_line.h"
 
 #include "gpu_test.h"
 
 namespace obscura::test {
 namespace fs = std::filesystem;
 
-RunResult runObscura(const std::string& args, const std::string& prefix) {
+namespace {
+
+RunResult runInShell(const std::string& args, const std::string& prefix) {
   const std::string command = prefix + std::string(OBSCURA_BINARY_PATH) + " " + args + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   RunResult r{-1, ""};
@@ -20,6 +28,60 @@ RunResult runObscura(const std::string& args, const std::string& prefix) {
   while (std::fgets(buffer.data(), buffer.size(), pipe)) r.output += buffer.data();
   const int status = pclose(pipe);
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// Words separated by blanks, and nothing a shell would read otherwise (quotes, variables,
+// redirections, globs): only such a command line means the same in-process.
+std::optional<std::vector<std::string>> plainWords(const std::string& args) {
+  if (args.find_first_of("'\"\\$`|;&<>*?(){}[]~#\n") != std::string::npos) return std::nullopt;
+  std::vector<std::string> words;
+  std::istringstream in(args);
+  for (std::string word; in >> word;) words.push_back(word);
+  return words;
+}
+
+// Runs `obscura words` through app::runCommandLine with this process's stdout and stderr sent
+// to one file (as the shell's 2>&1 does), then read back.
+RunResult runInProcess(const std::vector<std::string>& words) {
+  std::vector<const char*> argv{"obscura"};
+  for (const std::string& w : words) argv.push_back(w.c_str());
+  std::FILE* capture = std::tmpfile();
+  if (!capture) return {-1, "tmpfile failed"};
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const int savedOut = ::dup(1), savedErr = ::dup(2);
+  ::dup2(::fileno(capture), 1);
+  ::dup2(::fileno(capture), 2);
+  RunResult r{-1, ""};
+  r.exitCode = app::runCommandLine(static_cast<int>(argv.size()), argv.data());
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(stdout);
+  std::fflush(stderr);
+  ::dup2(savedOut, 1);
+  ::dup2(savedErr, 2);
+  ::close(savedOut);
+  ::close(savedErr);
+  std::rewind(capture);
+  std::array<char, 4096> buffer;
+  for (std::size_t n; (n = std::fread(buffer.data(), 1, buffer.size(), capture)) > 0;) r.output.append(buffer.data(), n);
+  std::fclose(capture);
+  return r;
+}
+
+} // namespace
+
+RunResult runObscura(const std::string& args, const std::string& prefix) {
+  const char* subprocess = std::getenv("OBSCURA_CLI_SUBPROCESS");
+  const bool inShell = !prefix.empty() || (subprocess && std::string(subprocess) == "1");
+  auto words = inShell ? std::nullopt : plainWords(args);
+  // The window keeps GLFW's global state for its process: `view` runs as its own process, as a
+  // user starts it.
+  if (words && !words->empty() && words->front() == "view") words.reset();
+  RunResult r = words ? runInProcess(*words) : runInShell(args, prefix);
   EXPECT_EQ(r.output.find("obscura: validation:"), std::string::npos) << r.output;
   return r;
 }

@@ -1,0 +1,50 @@
+#include "app/command_line.h"
+
+#include <cstdio>
+#include <new>
+
+#include <fmt/core.h>
+
+#include "app/commands.h"
+#include "core/error.h"
+
+namespace obscura::app {
+
+int runCommandLine(int argc, const char* const* argv) {
+  CLI::App app{"obscura: ray-traced obscurances and interactive relighting (Vulkan compute)"};
+  app.require_subcommand(1);
+  addRenderCommand(app);
+  addInfoCommand(app);
+  addBenchRaysCommand(app);
+  addConvergeCommand(app);
+  addRelightCommand(app);
+  addCompareCommand(app);
+  addViewCommand(app);
+  addRecoverCommand(app);
+  addRemodelCommand(app);
+  addMergeCommand(app);
+  // Errors in input are caught here once: nothing else ever ends the program.
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const InputError& e) {
+    fmt::print(stderr, "obscura: error: {}\n", e.what());
+    return 2;
+  } catch (const DeviceError& e) {
+    fmt::print(stderr, "obscura: device error: {}\n", e.what());
+    return 3;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "obscura: out of host memory (a smaller --width/--height or scene needs less)\n");
+    return 3;
+  } catch (const vk::SystemError& e) {
+    fmt::print(stderr, "obscura: Vulkan error: {}\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "obscura: internal error: {}\n", e.what());
+    return 4;
+  }
+  return 0;
+}
+
+} // namespace obscura::app
