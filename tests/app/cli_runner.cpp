@@ -1,6 +1,8 @@
 #include "app/cli_runner.h"
 
 #include <algorithm>
+#include <cctype>
+#include <utility>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -72,16 +74,56 @@ RunResult runInProcess(const std::vector<std::string>& words) {
   return r;
 }
 
+// A prefix of environment assignments alone (NAME=value ...), as name and value pairs.
+std::optional<std::vector<std::pair<std::string, std::string>>> assignments(const std::string& prefix) {
+  const auto words = plainWords(prefix);
+  if (!words) return std::nullopt;
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const std::string& w : *words) {
+    const std::size_t eq = w.find('=');
+    if (eq == 0 || eq == std::string::npos ||
+        !std::all_of(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(eq), [](char c) { return std::isupper(c) || c == '_'; }))
+      return std::nullopt;
+    out.emplace_back(w.substr(0, eq), w.substr(eq + 1));
+  }
+  return out;
+}
+
+// Sets the variables for this process while it lives, then puts back what was there.
+class ScopedEnvironment {
+public:
+  explicit ScopedEnvironment(const std::vector<std::pair<std::string, std::string>>& vars) {
+    for (const auto& [name, value] : vars) {
+      const char* old = std::getenv(name.c_str());
+      saved_.emplace_back(name, old ? std::optional<std::string>(old) : std::nullopt);
+      ::setenv(name.c_str(), value.c_str(), 1);
+    }
+  }
+  ~ScopedEnvironment() {
+    for (auto it = saved_.rbegin(); it != saved_.rend(); ++it) {
+      if (it->second) ::setenv(it->first.c_str(), it->second->c_str(), 1);
+      else ::unsetenv(it->first.c_str());
+    }
+  }
+
+private:
+  std::vector<std::pair<std::string, std::optional<std::string>>> saved_;
+};
+
 } // namespace
 
 RunResult runObscura(const std::string& args, const std::string& prefix) {
   const char* subprocess = std::getenv("OBSCURA_CLI_SUBPROCESS");
-  const bool inShell = !prefix.empty() || (subprocess && std::string(subprocess) == "1");
-  auto words = inShell ? std::nullopt : plainWords(args);
-  // The window keeps GLFW's global state for its process: `view` runs as its own process, as a
-  // user starts it.
-  if (words && !words->empty() && words->front() == "view") words.reset();
-  RunResult r = words ? runInProcess(*words) : runInShell(args, prefix);
+  const auto env = assignments(prefix);
+  const bool inShell = !env || (subprocess && std::string(subprocess) == "1");
+  const auto words = inShell ? std::nullopt : plainWords(args);
+  RunResult r;
+  if (words) {
+    const ScopedEnvironment scoped(*env);
+    r = runInProcess(*words);
+  } else {
+    r = runInShell(args, prefix);
+  }
   EXPECT_EQ(r.output.find("obscura: validation:"), std::string::npos) << r.output;
   return r;
 }
