@@ -32,8 +32,8 @@ GeometryRetrace::Result GeometryRetrace::retrace(const Frame& frame, const Edit&
   // Probing replays the rays the frame traced, so not after addEmitter: its new light changed how
   // lights are chosen, and the replayed rays would not be those traced.
   const bool probe = edit.probe && !edit.everyPixel && edit.tracedLight == gpu::kInvalidIndex && frame.samples > 0;
-  // Ray origins leave their surfaces by a few hundred ulps of their coordinates (lib/ray.glsl):
-  // a changed box grown by 1e-3 of the scene's size and reach covers them.
+  // Each changed box grown by frame.changedBoxPadding: ray origins leave their surfaces by a few
+  // hundred ulps of their coordinates (lib/ray.glsl).
   for (std::uint32_t b = 0; b < bands; ++b)
     dirty_.prepare(b, layout, frame.camera, edit.changed, frame.changedBoxPadding, frame.dMax, frame.lights,
                    edit.everyPixel, edit.tracedLight, probe);

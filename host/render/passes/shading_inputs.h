@@ -1,5 +1,7 @@
 // shading_inputs.h — what the shading passes (shadow, obscurance, specular) bind: the scene,
-// the lights, and one band of the frame (shaders/lib/shading_bindings.glsl, bindings 0..17).
+// the lights, and one band of the frame (shaders/lib/shading_bindings.glsl, bindings 0..17); and
+// what one of their dispatches does (ShadeSample, ShadeDispatch), packed into ShadePush in one
+// place (packShadePush).
 #pragma once
 #include <span>
 
