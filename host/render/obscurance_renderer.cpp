@@ -126,7 +126,7 @@ void ObscuranceRenderer::markReflectors() {
 }
 
 void ObscuranceRenderer::retraceAll() {
-  const std::uint32_t samples = samples_;
+  const std::uint32_t samples = progress().samples;
   const double wall = wallSeconds_;
   reset();
   wallSeconds_ = wall;
@@ -174,17 +174,9 @@ void ObscuranceRenderer::configure(const ObscuranceSettings& settings) {
   reset();
 }
 
-void ObscuranceRenderer::markResolveStale(std::uint32_t fromLight, bool ambient) {
-  resolveFrom_ = std::min(resolveFrom_, fromLight);
-  resolveAmbient_ = resolveAmbient_ || ambient;
-}
-
 void ObscuranceRenderer::reset() {
-  markResolveStale(0, true);
+  progress().restart();
   geometry_.keptRaysRenderedAnew();
-  samples_ = 0;
-  gbufferSample_ = kNoSample;
-  primaryRays_ = 0;
   wallSeconds_ = 0.0;
   frame_.resetStatus();
   timestamps_ = gpu::Timestamps(*context_);
@@ -276,23 +268,24 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
   const auto start = Clock::now();
   const double wallBefore = wallSeconds_;
   const FrameLayout& layout = frame_.layout();
-  const std::uint32_t end = samples_ + samples;
-  markResolveStale(0, true);
-  while (samples_ < end) {
-    const std::uint32_t last = std::min(end, samples_ + kSamplesPerSubmission);
+  FrameProgress& done = frame_.progress();
+  const std::uint32_t end = done.samples + samples;
+  done.markResolveStale(0, true);
+  while (done.samples < end) {
+    const std::uint32_t last = std::min(end, done.samples + kSamplesPerSubmission);
     stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
       timestamps_.reset(cmd);
-      for (std::uint32_t s = samples_; s < last; ++s) {
-        if (s > samples_) gpu::computeBarrier(cmd);
+      for (std::uint32_t s = done.samples; s < last; ++s) {
+        if (s > done.samples) gpu::computeBarrier(cmd);
         recordSample(cmd, s, SampleMode::Render);
       }
     });
     timestamps_.collect();
-    primaryRays_ += layout.pixels() * (last - samples_) * cameraRaysPerSample();
-    samples_ = last;
-    gbufferSample_ = last - 1;
+    done.primaryRays += layout.pixels() * (last - done.samples) * cameraRaysPerSample();
+    done.samples = last;
+    done.gbufferSample = last - 1;
     wallSeconds_ = wallBefore + secondsSince(start);
-    if (progress) progress(samples_ - (end - samples), samples, secondsSince(start));
+    if (progress) progress(done.samples - (end - samples), samples, secondsSince(start));
   }
 }
 
@@ -436,21 +429,22 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
   // The sky lights every pixel from every direction: any edit may change any pixel.
   // So do secondary reflectors: what the edit lights or shades anew is marked anew.
   const bool all = everyPixel || backgroundLight(lights_) < lights_.size() || reflectorsOn();
-  const bool keptAll = samples_ <= frame_.contents().keptRaySamples && keptRays(0, true);
+  const bool keptAll = progress().samples <= frame_.contents().keptRaySamples && keptRays(0, true);
   const GeometryRetrace::Result r = geometry_.retrace(
       {.stream = stream_, .timestamps = timestamps_, .recorder = *this, .buffers = frame_, .camera = primaryCamera(),
-       .lights = lightCount, .samples = samples_, .gbufferSample = gbufferSample_, .dMax = dMax_,
+       .lights = lightCount, .samples = progress().samples, .gbufferSample = progress().gbufferSample, .dMax = dMax_,
        .changedBoxPadding = changedBoxPadding(scene_->bounds), .specular = runSpecular_},
       {.changed = changed, .everyPixel = all, .tracedLight = tracedLight,
        .probe = GeometryRetrace::probing(settings_.dirtyTest, runSpecular_, keptAll)});
-  primaryRays_ += r.pixels * samples_ * cameraRaysPerSample();
+  progress().primaryRays += r.pixels * progress().samples * cameraRaysPerSample();
   // The retraced pixels' (and the probed candidates') G-buffer now holds the last sample; the
   // others' still hold theirs.
-  if ((r.probed || r.pixels > 0) && gbufferSample_ + 1 != samples_) gbufferSample_ = kNoSample;
+  if ((r.probed || r.pixels > 0) && progress().gbufferSample + 1 != progress().samples) progress().gbufferSample = FrameProgress::kNoSample;
   // Only the listed pixels changed: where the rest is resolved, the next light mix resolves them
   // alone (the lists stay until the next edit, so a second edit before it resolves everything).
-  if (resolveFrom_ >= lightCount && !resolveAmbient_ && !resolveDirty_) resolveDirty_ = r.pixels > 0;
-  else markResolveStale(0, true);
+  FrameProgress& p = progress();
+  if (p.resolveFrom >= lightCount && !p.resolveAmbient && !p.resolveDirty) p.resolveDirty = r.pixels > 0;
+  else p.markResolveStale(0, true);
   return r.pixels;
 }
 
@@ -502,15 +496,15 @@ void ObscuranceRenderer::composeDisplay(float exposureStops) {
   const FrameLayout& layout = frame_.layout();
   const glm::vec3 ia = ambientIntensity();
   const auto lightCount = static_cast<std::uint32_t>(lights_.size());
-  const bool resolve = resolveFrom_ < lightCount || resolveAmbient_;
-  const bool resolveDirty = !resolve && resolveDirty_;
+  const bool resolve = progress().resolveFrom < lightCount || progress().resolveAmbient;
+  const bool resolveDirty = !resolve && progress().resolveDirty;
   const std::uint32_t slots = frame_.lightCapacity();
   stream_.submit([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
     if (resolve || resolveDirty) {
       recordBands(cmd, "resolve", [&](std::uint32_t b) {
-        resolve_.record(cmd, b, layout, lightCount, slots, runSpecular_, resolveDirty ? 0u : resolveFrom_,
-                        resolveDirty || resolveAmbient_, resolveDirty);
+        resolve_.record(cmd, b, layout, lightCount, slots, runSpecular_, resolveDirty ? 0u : progress().resolveFrom,
+                        resolveDirty || progress().resolveAmbient, resolveDirty);
       });
       gpu::computeBarrier(cmd);
     }
@@ -518,9 +512,7 @@ void ObscuranceRenderer::composeDisplay(float exposureStops) {
                 [&](std::uint32_t b) { lightMix_.record(cmd, b, layout, lightCount, slots, ia, exposureStops); });
   });
   timestamps_.collect();
-  resolveFrom_ = lightCount;
-  resolveAmbient_ = false;
-  resolveDirty_ = false;
+  progress().resolved(lightCount);
   wallSeconds_ += secondsSince(start);
 }
 
@@ -658,7 +650,7 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
     throw InputError(fmt::format("add light '{}': a light of that name exists", light.name));
   const std::size_t index = lights_.size();
   frame_.addLightSlot(stream_, static_cast<std::uint32_t>(index));
-  markResolveStale(static_cast<std::uint32_t>(index), false);
+  progress().markResolveStale(static_cast<std::uint32_t>(index), false);
   appendPunctual(lights_, light, scene_->bounds);
   updateSelection(lights_);
   emissions_.push_back(lights_.emission.back());
@@ -695,9 +687,9 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
   // The sample whose G-buffer the frame holds goes first and needs no primary pass (at one sample
   // per pixel, none at all); the others follow in order.
   std::vector<std::uint32_t> order;
-  if (gbufferSample_ < samples_) order.push_back(gbufferSample_);
-  for (std::uint32_t s = 0; s < samples_; ++s)
-    if (s != gbufferSample_) order.push_back(s);
+  if (progress().gbufferSample < progress().samples) order.push_back(progress().gbufferSample);
+  for (std::uint32_t s = 0; s < progress().samples; ++s)
+    if (s != progress().gbufferSample) order.push_back(s);
   std::uint64_t primaryPixels = 0;
   for (std::size_t first = 0; first < order.size(); first += kSamplesPerSubmission) {
     const std::size_t last = std::min(order.size(), first + kSamplesPerSubmission);
@@ -706,7 +698,7 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
       for (std::size_t k = first; k < last; ++k) {
         const std::uint32_t s = order[k];
         if (k > first) gpu::computeBarrier(cmd);
-        if (s != gbufferSample_) {
+        if (s != progress().gbufferSample) {
           const PrimaryPass::Dispatch gbuffer{.sample = settings_.firstSample + s, .firstSample = settings_.firstSample,
                                               .seed = settings_.seed, .lights = lightCount, .gbufferOnly = true};
           recordBands(cmd, "primary", [&](std::uint32_t b) { primary_.record(cmd, b, frame_, camera, gbuffer); });
@@ -723,8 +715,8 @@ void ObscuranceRenderer::traceAddedLight(std::uint32_t light) {
     });
     timestamps_.collect();
   }
-  primaryRays_ += primaryPixels;
-  if (!order.empty()) gbufferSample_ = order.back();
+  progress().primaryRays += primaryPixels;
+  if (!order.empty()) progress().gbufferSample = order.back();
   wallSeconds_ = wallBefore + secondsSince(start);
 }
 
@@ -742,7 +734,7 @@ std::uint64_t ObscuranceRenderer::addEmitter(const scene::Scene& edited, const b
   const auto start = Clock::now();
   const double wallBefore = wallSeconds_;
   frame_.addLightSlot(stream_, static_cast<std::uint32_t>(index));
-  markResolveStale(static_cast<std::uint32_t>(index), true);
+  progress().markResolveStale(static_cast<std::uint32_t>(index), true);
   const LightSet fresh = buildLightSet(edited);
   lights_.emitters = fresh.emitters; // the new group's triangles come last: the others keep their places
   auto insertAt = [&](auto& v, const auto& value) { v.insert(v.begin() + static_cast<std::ptrdiff_t>(index), value); };
@@ -783,7 +775,7 @@ void ObscuranceRenderer::removeLight(std::size_t index) {
     return;
   }
   frame_.removeLightSlot(stream_, static_cast<std::uint32_t>(index));
-  markResolveStale(static_cast<std::uint32_t>(index), false);
+  progress().markResolveStale(static_cast<std::uint32_t>(index), false);
   removePunctual(lights_, index);
   if (reach_.measured()) ambient_.reach.erase(ambient_.reach.begin() + static_cast<std::ptrdiff_t>(index));
   emissions_.erase(emissions_.begin() + static_cast<std::ptrdiff_t>(index));
@@ -804,7 +796,7 @@ RenderStats ObscuranceRenderer::stats() const {
     if (!timestamps_.totalsMs().contains(name)) return;
     st.passes[name] = {.gpuMs = timestamps_.totalsMs().at(name), .rays = rays};
   };
-  pass("primary", primaryRays_);
+  pass("primary", progress().primaryRays);
   pass("shadow", status[gpu::kStatusShadowRays]);
   pass("obscurance", status[gpu::kStatusObscuranceRays]);
   pass("specular", status[gpu::kStatusSpecularRays]);

@@ -239,7 +239,7 @@ public:
   const AmbientTerm& ambient() const { return ambient_; }
   glm::vec3 ambientIntensity() const { return ambient_.intensity(emissions_); }
   float dMax() const { return dMax_; }
-  std::uint32_t samples() const { return samples_; }
+  std::uint32_t samples() const { return frame_.progress().samples; }
   // The samples each pixel's sums hold, row by row (compose divides by them): samples() everywhere
   // once a frame or an edit's retrace is done.
   std::vector<std::uint32_t> sampleCounts() const;
@@ -342,13 +342,9 @@ private:
   gpu::Buffer emissionBuffer_;
 
   // Frame lifetime.
-  ObscuranceFrame frame_;
-  std::uint32_t samples_ = 0;
-  std::uint64_t primaryRays_ = 0;
-  // The sample whose primary hits the G-buffer holds at every pixel (kNoSample: none, or mixed),
-  // so that an added light's rays start from it without a primary pass.
-  static constexpr std::uint32_t kNoSample = ~0u;
-  std::uint32_t gbufferSample_ = kNoSample;
+  ObscuranceFrame frame_; // its buffers and progress (samples, the G-buffer's sample, what is resolved)
+  FrameProgress& progress() { return frame_.progress(); }
+  const FrameProgress& progress() const { return frame_.progress(); }
 
   // Passes. Those that trace (primary to specular) are specialised for the scene
   // (sceneKernels_: the compact traversal stack its BVH needs, the texture kinds its materials
@@ -371,13 +367,6 @@ private:
                     bool tracePrimary = true) override;
   // Camera rays a summing primary pass traces per pixel and sample: its own, and the emission rays.
   std::uint64_t cameraRaysPerSample() const;
-  // The resolved transport is current for lights before resolveFrom_ (and the ambient unless
-  // resolveAmbient_); a new sample makes all of it stale, an added light only itself.
-  std::uint32_t resolveFrom_ = 0;
-  bool resolveAmbient_ = true;
-  // A geometry edit's retrace left only the pixels of the dirty lists stale (the rest is current).
-  bool resolveDirty_ = false;
-  void markResolveStale(std::uint32_t fromLight, bool ambient);
 
   gpu::CommandStream stream_;
   gpu::Timestamps timestamps_;

@@ -18,6 +18,7 @@
 #include "gpu/command_stream.h"
 #include "gpu/context.h"
 #include "render/frame/frame_layout.h"
+#include "render/frame/frame_progress.h"
 #include "render/status_counters.h"
 #include "shared/host_device.h"
 
@@ -123,6 +124,10 @@ public:
   void removeLightSlot(gpu::CommandStream& stream, std::uint32_t index);
   std::uint32_t lightCapacity() const { return maxLights_; }
 
+  // How far the sums have come (samples, the G-buffer's sample, what is resolved).
+  FrameProgress& progress() { return progress_; }
+  const FrameProgress& progress() const { return progress_; }
+
   const gpu::Context* context_;
   FrameLayout layout_;
   std::uint32_t lights_ = 0;
@@ -130,6 +135,7 @@ public:
   FrameContents contents_;
   std::vector<Band> bands_;
   StatusCounters status_;
+  FrameProgress progress_;
 };
 
 } // namespace obscura::render
