@@ -315,7 +315,6 @@ void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::u
     // A probe's candidates' camera rays miss the changed boxes, so they find what the frame's did:
     // their G-buffer is made again, and nothing is summed.
     primary.gbufferOnly = probe;
-    if (probe) primary.aovs = true;
     const gpu::GpuCamera camera = primaryCamera();
     recordBands(cmd, label("primary"), [&](std::uint32_t b) { primary_.record(cmd, b, frame_, camera, primary); });
     gpu::computeBarrier(cmd);

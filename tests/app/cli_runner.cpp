@@ -82,7 +82,7 @@ std::optional<std::vector<std::pair<std::string, std::string>>> assignments(cons
   for (const std::string& w : *words) {
     const std::size_t eq = w.find('=');
     if (eq == 0 || eq == std::string::npos ||
-        !std::all_of(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(eq), [](char c) { return std::isupper(c) || c == '_'; }))
+        !std::all_of(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(eq), [](unsigned char c) { return std::isupper(c) || c == '_'; }))
       return std::nullopt;
     out.emplace_back(w.substr(0, eq), w.substr(eq + 1));
   }

@@ -74,7 +74,8 @@ void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band,
   // The emission rays go with a dispatch that accumulates.
   const std::uint32_t emissionSamples = dispatch.gbufferOnly || dispatch.emissionSamples <= 1u ? 0u : dispatch.emissionSamples;
   const std::uint32_t flags = (dispatch.gbufferOnly ? gpu::kPrimaryFlagGBufferOnly : 0u) |
-                              (dispatch.aovs ? 0u : gpu::kPrimaryFlagNoAovs) |
+                              // (a dispatch that sums nothing keeps no AOVs either way)
+                              (dispatch.aovs || dispatch.gbufferOnly ? 0u : gpu::kPrimaryFlagNoAovs) |
                               (dispatch.dirtyOnly ? gpu::kPrimaryFlagDirtyOnly : 0u) |
                               (emissionSamples << gpu::kPrimaryEmissionSamplesShift);
   // The camera sees the whole image (a tile's rows are rows of it).
