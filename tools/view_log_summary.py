@@ -15,8 +15,9 @@ segment is what it applied, from its "actions" (first match wins):
 next to nothing, so "all" alone would flatter the loop.
 
 For each: frames, frames/s at the median frame, the median and the 95th-percentile frame wall ms
-(the 5th percentile of frames/s: the slow frames a person notices), and the median GPU ms
-(frame_gpu_ms: the renderer's passes and the denoiser, by timestamps). Frame 0 (kernels and
+(the 5th percentile of frames/s: the slow frames a person notices), the median GPU ms
+(frame_gpu_ms: the renderer's passes and the denoiser, by timestamps) and the median host CPU ms
+of the frame's edits (edit_cpu_ms; 0 in logs older than it). Frame 0 (kernels and
 buffers warming up) is left out unless --keep-first.
 
 Usage: tools/view_log_summary.py LOG [--keep-first] [--json]
@@ -69,6 +70,7 @@ def summary(frames):
         "wall_ms_median": median,
         "wall_ms_95th_percentile": slow,
         "gpu_ms_median": statistics.median(f.get("frame_gpu_ms", 0.0) for f in frames),
+        "edit_cpu_ms_median": statistics.median(f.get("edit_cpu_ms", 0.0) for f in frames),
     }
 
 
@@ -100,11 +102,12 @@ def main():
         return
     print(f"{args.log}: frames/s from each frame's wall_ms" + ("" if args.keep_first else " (frame 0 left out)"))
     print("| segment | frames | frames/s (median) | frames/s (5th pct) | frames/s (mean) | wall ms median "
-          "| wall ms 95th pct | GPU ms median |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+          "| wall ms 95th pct | GPU ms median | edit CPU ms median |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, r in rows.items():
         print(f"| {name} | {r['frames']} | {r['fps_median']:.1f} | {r['fps_5th_percentile']:.1f} | {r['fps_mean']:.1f} | "
-              f"{r['wall_ms_median']:.2f} | {r['wall_ms_95th_percentile']:.2f} | {r['gpu_ms_median']:.2f} |")
+              f"{r['wall_ms_median']:.2f} | {r['wall_ms_95th_percentile']:.2f} | {r['gpu_ms_median']:.2f} | "
+              f"{r['edit_cpu_ms_median']:.2f} |")
 
 
 if __name__ == "__main__":

@@ -29,7 +29,7 @@
 #include "bench/lane_order.h"
 #include "bench/pass_bench.h"
 #include "bench/ray_set_measurement.h"
-#include "bench/ray_tracer.h"
+#include "render/ray_tracer.h"
 #include "render/passes/primary_pass.h"
 #include "app/render_options.h"
 
@@ -70,7 +70,7 @@ glm::uvec2 parseSize(const std::string& text, const char* option) {
 
 // --trace-shape WxR: trace.comp's workgroup size W (a multiple of 8, lavapipe's SIMD width) and
 // rays per invocation R (1 to kTraceRaysPerLane), for trying other shapes on a new device.
-bench::TraceShape parseTraceShape(const std::string& text, const gpu::Context& context) {
+render::TraceShape parseTraceShape(const std::string& text, const gpu::Context& context) {
   unsigned w = 0, r = 0;
   char tail = 0;
   if (std::sscanf(text.c_str(), "%ux%u%c", &w, &r, &tail) != 2 || w == 0 || w % 8 != 0 || w > 1024 || r == 0 ||
@@ -288,17 +288,17 @@ void runBench(const BenchOptions& o) {
   render::SceneBuffers buffers(context, loaded.scene, loaded.bvh);
   for (const std::string& note : buffers.notes()) fmt::print(stderr, "note: {}\n", note);
   if (!o.json) fmt::print("traversal: {}\n", render::traversalName(buffers.traversal()));
-  std::optional<bench::TraceShape> shape;
+  std::optional<render::TraceShape> shape;
   if (!o.traceShape.empty()) shape = parseTraceShape(o.traceShape, context);
   if (o.bvhItems == "storage" || o.cullOnPop) {
-    if (!shape) shape = bench::TraceShape::forDevice(context, buffers.traversal());
+    if (!shape) shape = render::TraceShape::forDevice(context, buffers.traversal());
     shape->bvhItemsFromStorage = o.bvhItems == "storage";
     shape->binaryCullOnPop = o.cullOnPop;
   }
   if (o.stackRegisters && !bvh::compactStackHolds(*o.stackRegisters, buffers.compactStackVectors()))
     throw InputError(fmt::format("--stack-registers {}: this BVH (depth {}) needs {} (or 0, the general kernel)",
                                  *o.stackRegisters, loaded.bvh.stats.maxDepth, buffers.compactStackVectors()));
-  bench::RayTracer tracer(context, buffers, shape, o.stackRegisters);
+  render::RayTracer tracer(context, buffers, shape, o.stackRegisters);
   auto closestRays = bench::closestBenchRays(loaded.scene.bounds, o.rays, o.seed);
   auto shadowRays = bench::shadowBenchRays(loaded.scene.bounds, o.rays, o.seed + 1);
   if (!o.saveRays.empty()) {
@@ -308,9 +308,9 @@ void runBench(const BenchOptions& o) {
   const bool backToBack = context.info().type != "cpu";
   const bench::RaySetOptions setOptions{.repeats = o.repeats, .verify = o.verify, .backToBack = backToBack};
   const bench::RaySetMeasurement closest =
-      bench::measureRaySet(tracer, loaded.scene, loaded.bvh, closestRays, bench::TraceMode::Closest, setOptions);
+      bench::measureRaySet(tracer, loaded.scene, loaded.bvh, closestRays, render::TraceMode::Closest, setOptions);
   const bench::RaySetMeasurement shadow =
-      bench::measureRaySet(tracer, loaded.scene, loaded.bvh, shadowRays, bench::TraceMode::Any, setOptions);
+      bench::measureRaySet(tracer, loaded.scene, loaded.bvh, shadowRays, render::TraceMode::Any, setOptions);
   std::optional<Baseline> base = runBaseline(o, loaded, closestRays, shadowRays);
   const scene::Camera camera = chooseCamera(loaded.scene, -1);
   std::optional<PassesRun> passes;

@@ -21,11 +21,11 @@ gpu::GpuRay makeRay(glm::vec3 origin, glm::vec3 direction, float tmax) {
   return {glm::vec4(origin, 0.0f), glm::vec4(direction, tmax)};
 }
 
-LaneOrderFigures measure(RayTracer& tracer, const std::string& name, const OrderedRays& ordered,
-                         TraceMode mode, int repeats) {
+LaneOrderFigures measure(render::RayTracer& tracer, const std::string& name, const OrderedRays& ordered,
+                         render::TraceMode mode, int repeats) {
   LaneOrderFigures f;
   f.name = name;
-  const TraceResult first = tracer.trace(ordered.rays, mode, true);
+  const render::TraceResult first = tracer.trace(ordered.rays, mode, true);
   double steps = 0.0, groupMax = 0.0;
   std::size_t groups = 0;
   for (std::size_t g = 0; g < ordered.rays.size(); g += kLanes) {
@@ -82,7 +82,7 @@ std::uint32_t spreadBits10(std::uint32_t v) {
 
 } // namespace
 
-std::vector<LaneOrderFigures> measureLaneOrders(RayTracer& tracer, const scene::Scene& scene,
+std::vector<LaneOrderFigures> measureLaneOrders(render::RayTracer& tracer, const scene::Scene& scene,
                                                 const ObscuranceFrameWork& work, int repeats) {
   std::vector<LaneOrderFigures> out;
   const glm::vec3 eye(work.camera.origin);
@@ -92,14 +92,14 @@ std::vector<LaneOrderFigures> measureLaneOrders(RayTracer& tracer, const scene::
     camera.rays.push_back(makeRay(eye, cameraRayDirection(work, p, 0), std::numeric_limits<float>::infinity()));
     camera.real.push_back(true);
   }
-  const TraceResult hits = tracer.trace(camera.rays, TraceMode::Closest);
-  out.push_back(measure(tracer, "camera rays, rows of 8 (the passes' order)", camera, TraceMode::Closest, repeats));
+  const render::TraceResult hits = tracer.trace(camera.rays, render::TraceMode::Closest);
+  out.push_back(measure(tracer, "camera rays, rows of 8 (the passes' order)", camera, render::TraceMode::Closest, repeats));
   OrderedRays cameraTiles;
   for (glm::uvec2 p : pixelOrder(work, true)) {
     cameraTiles.rays.push_back(camera.rays[std::size_t(p.y) * work.width + p.x]);
     cameraTiles.real.push_back(true);
   }
-  out.push_back(measure(tracer, "camera rays, 4x2 tiles", cameraTiles, TraceMode::Closest, repeats));
+  out.push_back(measure(tracer, "camera rays, 4x2 tiles", cameraTiles, render::TraceMode::Closest, repeats));
 
   // Each pixel's obscurance rays (none where the camera ray missed).
   const std::uint32_t n = work.obscuranceRays;
@@ -131,8 +131,8 @@ std::vector<LaneOrderFigures> measureLaneOrders(RayTracer& tracer, const scene::
     return o;
   };
   out.push_back(measure(tracer, "obscurance rays, rows of 8 (the pass's order)", passOrder(pixelOrder(work, false)),
-                        TraceMode::Closest, repeats));
-  out.push_back(measure(tracer, "obscurance rays, 4x2 tiles", passOrder(pixelOrder(work, true)), TraceMode::Closest,
+                        render::TraceMode::Closest, repeats));
+  out.push_back(measure(tracer, "obscurance rays, 4x2 tiles", passOrder(pixelOrder(work, true)), render::TraceMode::Closest,
                         repeats));
   // Sorted: origin cell (Morton code of a 1024^3 grid over the box) and direction octant.
   std::vector<std::pair<std::uint64_t, gpu::GpuRay>> keyed;
@@ -154,7 +154,7 @@ std::vector<LaneOrderFigures> measureLaneOrders(RayTracer& tracer, const scene::
       sorted.rays.push_back(ray);
       sorted.real.push_back(true);
     }
-    out.push_back(measure(tracer, name, sorted, TraceMode::Closest, repeats));
+    out.push_back(measure(tracer, name, sorted, render::TraceMode::Closest, repeats));
   };
   sortedBy("obscurance rays, sorted by origin cell, then octant", [](std::uint64_t k) { return k; });
   sortedBy("obscurance rays, sorted by octant, then origin cell",

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "bench/frame_rays.h"
-#include "bench/ray_tracer.h"
+#include "render/ray_tracer.h"
 #include "scene/scene.h"
 
 namespace obscura::bench {
@@ -31,7 +31,7 @@ struct LaneOrderFigures {
 // by 4 x 2 tiles; obscurance rays as the obscurance pass traces them (ray i of 8 neighbouring
 // pixels of a row, i = 0 .. N_obs - 1), by 4 x 2 tiles, and sorted over the frame by origin cell
 // (a 1024^3 grid over the scene's box, Morton order) and direction octant (either first).
-std::vector<LaneOrderFigures> measureLaneOrders(RayTracer& tracer, const scene::Scene& scene,
+std::vector<LaneOrderFigures> measureLaneOrders(render::RayTracer& tracer, const scene::Scene& scene,
                                                 const ObscuranceFrameWork& work, int repeats);
 
 } // namespace obscura::bench

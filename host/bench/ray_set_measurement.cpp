@@ -11,8 +11,8 @@
 
 namespace obscura::bench {
 
-RaySetMeasurement measureRaySet(RayTracer& tracer, const scene::Scene& scene, const bvh::Bvh& bvh,
-                                const std::vector<gpu::GpuRay>& rays, TraceMode mode, const RaySetOptions& o) {
+RaySetMeasurement measureRaySet(render::RayTracer& tracer, const scene::Scene& scene, const bvh::Bvh& bvh,
+                                const std::vector<gpu::GpuRay>& rays, render::TraceMode mode, const RaySetOptions& o) {
   RaySetMeasurement r;
   // Warm-up (pipeline JIT, caches) and hit statistics, then timed repeats.
   auto first = tracer.trace(rays, mode, true);
@@ -58,7 +58,7 @@ RaySetMeasurement measureRaySet(RayTracer& tracer, const scene::Scene& scene, co
   r.bestMs = times.front();
   r.medianMs = times[times.size() / 2];
   // Optional check of the first `verify` rays against the CPU reference traversal.
-  const bool shadowRays = mode == TraceMode::Any;
+  const bool shadowRays = mode == render::TraceMode::Any;
   const bvh::TriangleSoup soup = o.verify > 0 ? render::triangleSoup(scene) : bvh::TriangleSoup{};
   for (std::size_t i = 0; i < std::min(o.verify, rays.size()); ++i) {
     bvh::Ray ray{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};

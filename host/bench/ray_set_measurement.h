@@ -1,5 +1,5 @@
 // ray_set_measurement.h — the measurement behind `obscura bench-rays`: one set of rays traced by
-// a RayTracer, warmed up, then timed over repeats (back to back in one submission on a GPU, whose
+// a render::RayTracer, warmed up, then timed over repeats (back to back in one submission on a GPU, whose
 // clocks would drop between submissions; one by one with the process CPU time on lavapipe, which
 // the Embree ratio reads), with the statistics that explain a rate and the check that makes it
 // honest (the hits against the CPU traversal).
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/ray_tracer.h"
+#include "render/ray_tracer.h"
 #include "bvh/bvh.h"
 #include "scene/scene.h"
 
@@ -37,7 +37,7 @@ struct RaySetOptions {
   bool backToBack = false;  // the repeats in one submission (a GPU)
 };
 
-RaySetMeasurement measureRaySet(RayTracer& tracer, const scene::Scene& scene, const bvh::Bvh& bvh,
-                                const std::vector<gpu::GpuRay>& rays, TraceMode mode, const RaySetOptions& options);
+RaySetMeasurement measureRaySet(render::RayTracer& tracer, const scene::Scene& scene, const bvh::Bvh& bvh,
+                                const std::vector<gpu::GpuRay>& rays, render::TraceMode mode, const RaySetOptions& options);
 
 } // namespace obscura::bench

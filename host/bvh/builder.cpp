@@ -30,6 +30,7 @@
 #include "bvh/bvh.h"
 #include "bvh/wide_collapse.h"
 #include "bvh/wide_node.h"
+#include "core/host_cpu_time.h"
 
 namespace obscura::bvh {
 namespace {
@@ -170,7 +171,10 @@ private:
     for (unsigned i = 1; i < chunks; ++i) {
       const std::uint32_t b = static_cast<std::uint32_t>(std::uint64_t{n} * i / chunks);
       const std::uint32_t e = static_cast<std::uint32_t>(std::uint64_t{n} * (i + 1) / chunks);
-      futures.push_back(std::async(std::launch::async, [&body, i, b, e] { body(i, b, e); }));
+      futures.push_back(std::async(std::launch::async, [&body, i, b, e] {
+        const HelperThreadCpu counted; // an edit's host work (core/host_cpu_time.h)
+        body(i, b, e);
+      }));
     }
     body(0u, 0u, static_cast<std::uint32_t>(std::uint64_t{n} / chunks));
     for (auto& f : futures) f.get();
@@ -318,6 +322,7 @@ private:
                        rightCount >= kParallelSubtreeMin;
     if (spawn) {
       auto right = std::async(std::launch::async, [&, rightSlot, rightBegin, rightCount, rightExtra, depth, taskDepth] {
+        const HelperThreadCpu counted;
         buildRange(rightSlot, rightBegin, rightCount, rightExtra, depth + 1, rightBox, rightCentroids, taskDepth + 1);
       });
       buildRange(leftSlot, begin, leftCount, leftExtra, depth + 1, leftBox, leftCentroids, taskDepth + 1);

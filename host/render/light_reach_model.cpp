@@ -5,6 +5,7 @@
 #include <chrono>
 #include <thread>
 
+#include "core/host_cpu_time.h"
 #include "render/scene_data/scene_buffers.h"
 
 namespace obscura::render {
@@ -31,15 +32,27 @@ void LightReachModel::measure(const scene::Scene& scene, const bvh::Bvh& bvh, co
 void LightReachModel::start(const scene::Scene& scene, const bvh::Bvh& bvh, const Inputs& inputs,
                             const AmbientTerm& ambient, const std::vector<scene::Bounds>* changed) {
   wait();
+  if (rays_) { // the device's rays: now, between the renderer's submissions
+    ready_ = measurementOf(scene, bvh, inputs.lights, inputs.seen, ambient.reach, changed);
+    return;
+  }
   pending_ = std::async(std::launch::async, [this, &scene, &bvh, &lights = inputs.lights, seen = inputs.seen,
                                              &previous = ambient.reach, changed] {
+    const HelperThreadCpu counted; // the edit's host work (core/host_cpu_time.h)
     return measurementOf(scene, bvh, lights, seen, previous, changed);
   });
 }
 
 void LightReachModel::startLight(const LightSet& lights, std::size_t light) {
   wait();
+  if (rays_) {
+    const auto start = Clock::now();
+    readyLight_ = reached_->measure(*rays_, lights, light);
+    last_ = {readyLight_->rays.traced, msSince(start)};
+    return;
+  }
   pendingLight_ = std::async(std::launch::async, [this, &lights, light] {
+    const HelperThreadCpu counted;
     const auto start = Clock::now();
     LightReach reach = reached_->measure(lights, light);
     last_ = {reach.rays.traced, msSince(start)};
@@ -48,11 +61,22 @@ void LightReachModel::startLight(const LightSet& lights, std::size_t light) {
 }
 
 void LightReachModel::finish(const Inputs& inputs, AmbientTerm& ambient) {
-  if (pending_.valid()) apply(pending_.get(), inputs, ambient);
-  if (pendingLight_.valid()) {
-    ambient.reach.push_back(pendingLight_.get());
+  if (pending_.valid()) ready_ = pending_.get();
+  if (pendingLight_.valid()) readyLight_ = pendingLight_.get();
+  if (ready_) {
+    apply(std::move(*ready_), inputs, ambient);
+    ready_.reset();
+  }
+  if (readyLight_) {
+    ambient.reach.push_back(std::move(*readyLight_));
+    readyLight_.reset();
     updateAmbientWeights(ambient, inputs.lights, inputs.colourBleeding);
   }
+}
+
+void LightReachModel::setSeenView(const SeenView& view) {
+  if (rays_) reached_->setSeenView(*rays_, view);
+  else reached_->setSeenView(view);
 }
 
 void LightReachModel::wait() {
@@ -63,20 +87,24 @@ void LightReachModel::wait() {
 LightReachModel::Measurement LightReachModel::measurementOf(const scene::Scene& scene, const bvh::Bvh& bvh,
                                                             const LightSet& lights, const std::optional<SeenView>& seen,
                                                             const std::vector<LightReach>& previous,
-                                                            const std::vector<scene::Bounds>* changed) const {
+                                                            const std::vector<scene::Bounds>* changed) {
   const auto start = Clock::now();
   Measurement m;
-  // Every triangle's mean reflectance: a move or a removal keeps them (averaging modern-hall's
-  // textures takes ~0.25 s); an insert brings its own.
+  // Every triangle's mean reflectance: a move or a removal keeps them; an insert brings its own
+  // (with the textures' means kept: averaging modern-hall's takes ~0.25 s).
   if (!changed || reflectance_.size() != scene.triangles.size()) {
     std::vector<glm::vec3> meanAlbedo;
     for (const auto& material : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(material));
-    m.reflectance = triangleReflectances(scene, meanAlbedo);
+    textureMeans_ = textureMeanColours(scene, std::move(textureMeans_));
+    m.reflectance = triangleReflectances(scene, meanAlbedo, textureMeans_);
   } else {
     m.reflectance = reflectance_;
   }
-  m.reached = std::make_unique<ReachedSurfaces>(scene, bvh, m.reflectance);
-  if (seen) m.reached->setSeenView(*seen);
+  m.reached = std::make_unique<ReachedSurfaces>(scene, bvh, m.reflectance, /*copyBvh=*/rays_ == nullptr);
+  if (seen) {
+    if (rays_) m.reached->setSeenView(*rays_, *seen);
+    else m.reached->setSeenView(*seen);
+  }
   std::vector<scene::Bounds> padded;
   if (changed && reached_) {
     const float pad = changedBoxPadding(scene.bounds);
@@ -108,11 +136,17 @@ void LightReachModel::measureAll(const Inputs& inputs, AmbientTerm& ambient) {
 std::vector<LightReach> LightReachModel::reachOfEveryLight(const ReachedSurfaces& reached, const LightSet& lights,
                                                            const ReachedSurfaces* before,
                                                            const std::vector<LightReach>& previous,
-                                                           const std::vector<scene::Bounds>& changed) {
+                                                           const std::vector<scene::Bounds>& changed) const {
   const bool incremental = before && previous.size() == lights.size();
+  std::vector<LightReach> reach(lights.size());
+  if (rays_) { // the device's: a light at a time, each a few submissions
+    for (std::size_t s = 0; s < lights.size(); ++s)
+      reach[s] = incremental ? reached.remeasure(*rays_, *before, previous[s], lights, s, changed)
+                             : reached.measure(*rays_, lights, s);
+    return reach;
+  }
   // Lights spread over the cores (measure is const and draws its own numbers): the CPU rays of
   // modern-hall's 13 lights take ~0.3 s on one core when measured whole.
-  std::vector<LightReach> reach(lights.size());
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
     for (std::size_t s = next++; s < lights.size(); s = next++)
@@ -121,7 +155,10 @@ std::vector<LightReach> LightReachModel::reachOfEveryLight(const ReachedSurfaces
   std::vector<std::future<void>> workers;
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   for (unsigned w = 1; w < std::min<std::size_t>(cores, lights.size()); ++w)
-    workers.push_back(std::async(std::launch::async, worker));
+    workers.push_back(std::async(std::launch::async, [&worker] {
+      const HelperThreadCpu counted; // the caller's thread counts its own
+      worker();
+    }));
   worker();
   for (auto& w : workers) w.get();
   return reach;

@@ -3,9 +3,13 @@
 // reflectors: measured when a renderer is made, re-measured after an edit (only the rays a move
 // can change), a new light measured alone.
 //
-// One of ObscuranceRenderer's jobs, kept apart: it owns the measured surfaces and the measurement
-// that runs on threads of its own beside an edit's GPU work; the renderer owns the lights and the
-// AmbientTerm it fills (compose reads I_a from it).
+// One of ObscuranceRenderer's jobs, kept apart: it owns the measured surfaces and the measurement;
+// the renderer owns the lights and the AmbientTerm it fills (compose reads I_a from it).
+//
+// Where the rays run (useRays): on the device, through the renderer's traversal (GpuRayBatch),
+// a stage of a light's rays per submission, on the renderer's thread, so start() measures at
+// once; without one, on the CPU's BVH, on threads of its own beside an edit's GPU work (finish()
+// waits for them).
 #pragma once
 #include <cstdint>
 #include <future>
@@ -16,6 +20,7 @@
 #include "bvh/bvh.h"
 #include "render/scene_data/ambient.h"
 #include "render/scene_data/light_set.h"
+#include "render/scene_data/ray_batch.h"
 #include "render/scene_data/reached_surfaces.h"
 #include "scene/scene.h"
 
@@ -42,6 +47,13 @@ public:
   LightReachModel& operator=(LightReachModel&&) = default;
   // Waits for a measurement still running: it reads the renderer's lights.
   ~LightReachModel() { wait(); }
+
+  // The rays through `rays` from now on (the renderer's GpuRayBatch, which must outlive this or be
+  // replaced first); nullptr: the CPU's BVH.
+  void useRays(RayBatch* rays) {
+    wait();
+    rays_ = rays;
+  }
 
   // Whether anything was measured (the renderer was made with Reached or Seen, or reflectors).
   bool measured() const { return reached_ != nullptr; }
@@ -77,7 +89,7 @@ public:
   // Every light again with the surfaces as they are (the Seen fit after a new view).
   void measureAll(const Inputs& inputs, AmbientTerm& ambient);
   // The view the Seen fit measures from (fitted by the next measurement).
-  void setSeenView(const SeenView& view) { reached_->setSeenView(view); }
+  void setSeenView(const SeenView& view);
 
 private:
   struct Measurement {
@@ -88,20 +100,25 @@ private:
   };
   Measurement measurementOf(const scene::Scene& scene, const bvh::Bvh& bvh, const LightSet& lights,
                             const std::optional<SeenView>& seen, const std::vector<LightReach>& previous,
-                            const std::vector<scene::Bounds>* changed) const;
+                            const std::vector<scene::Bounds>* changed);
   void apply(Measurement measurement, const Inputs& inputs, AmbientTerm& ambient);
   // Every light's reach with `reached`; with `before` (the reach of the scene before an edit, and
   // `previous` its per-light results), re-tracing only the rays `changed` (padded) can change.
-  static std::vector<LightReach> reachOfEveryLight(const ReachedSurfaces& reached, const LightSet& lights,
-                                                   const ReachedSurfaces* before, const std::vector<LightReach>& previous,
-                                                   const std::vector<scene::Bounds>& changed);
+  std::vector<LightReach> reachOfEveryLight(const ReachedSurfaces& reached, const LightSet& lights,
+                                            const ReachedSurfaces* before, const std::vector<LightReach>& previous,
+                                            const std::vector<scene::Bounds>& changed) const;
   void wait();
 
+  RayBatch* rays_ = nullptr;                // the device's rays, or none: the CPU's
   std::vector<glm::vec3> reflectance_;      // mean reflectance per triangle of the measured scene
+  std::vector<glm::vec3> textureMeans_;     // mean colour per texture (an edit only appends textures)
   std::unique_ptr<ReachedSurfaces> reached_;
   Update last_;
+  // A measurement started: on threads (CPU rays), or done already (the device's).
   std::future<Measurement> pending_;
   std::future<LightReach> pendingLight_;
+  std::optional<Measurement> ready_;
+  std::optional<LightReach> readyLight_;
 };
 
 // How far beyond a changed box the rays' offset origins may start: 1e-3 of the scene's size and

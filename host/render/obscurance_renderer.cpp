@@ -86,12 +86,20 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
   if (settings.ambient != AmbientModel::Global) ambient_.model = settings.ambient;
   defaultDMax_ = defaultDMax(scene, bvh, settings.camera); // first: the Seen fit needs dmax
-  if (settings.ambient != AmbientModel::Global || settings.secondaryReflectors > 0.0f)
+  if (settings.ambient != AmbientModel::Global || settings.secondaryReflectors > 0.0f) {
+    useReachRays();
     reach_.measure(scene, bvh, reachInputs(), ambient_);
+  }
   emissions_ = lights_.emission;
   configure(settings);
   if (reflectorsOn()) markReflectors();
   uploadLights();
+}
+
+void ObscuranceRenderer::useReachRays() {
+  reach_.useRays(nullptr);
+  reachRays_ = std::make_unique<GpuRayBatch>(*context_, sceneBuffers_);
+  reach_.useRays(reachRays_.get());
 }
 
 gpu::GpuCamera ObscuranceRenderer::primaryCamera() const {
@@ -226,9 +234,18 @@ void ObscuranceRenderer::bindAll() {
 }
 
 void ObscuranceRenderer::prepareForEdits() const {
-  shadow_.compileEditKernels(frame_.contents().keptRaySamples > 0);
+  const bool kept = frame_.contents().keptRaySamples > 0;
+  shadow_.compileEditKernels(kept);
   obscurance_.compileEditKernels(false);
-  specularPass_.compileEditKernels(frame_.contents().keptRaySamples > 0);
+  specularPass_.compileEditKernels(kept);
+  // An edit that rebuilds the BVH (an emissive quad, an insert) leaves the kept rays naming other
+  // triangles: its added light and probes take the variants without them. A GPU's driver compiles
+  // those now rather than inside the edit (tens of ms of host work each); lavapipe, whose JIT
+  // would cost every session of the test suite seconds, compiles them when an edit first needs them.
+  if (kept && context_->info().type != "cpu") {
+    shadow_.compileEditKernels(false);
+    specularPass_.compileEditKernels(false);
+  }
 }
 
 bool ObscuranceRenderer::keptRays(std::uint32_t sample, bool replaying) const {
@@ -388,34 +405,46 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
     updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   }
   // Same materials and textures (a move or a removal): only the BVH and the triangles' shading
-  // data are uploaded again; an insert brings surfaces of its own and uploads the scene anew.
-  const bool sameSurfaces = edited.materials.size() == scene_->materials.size() &&
-                            edited.textures.size() == scene_->textures.size();
+  // data are uploaded again; an edit that added materials (a quad) uploads the material table too;
+  // one that brought textures (an insert) uploads the scene anew.
+  const bool sameTextures = edited.textures.size() == scene_->textures.size();
+  const bool sameSurfaces = edited.materials.size() == scene_->materials.size() && sameTextures;
   scene_ = &edited;
   geometry_.useBvh(bvh); // a rebuilt BVH lays the triangles out anew: the kept lobe hits name other triangles
 
-  // Moved occluders change what every light reaches: where the emitters and surfaces stayed, only
-  // the rays that meet the changed boxes are traced again.
-  if (reach_.measured()) {
-    const std::vector<scene::Bounds>* boxes = emittersMoved || !sameSurfaces ? nullptr : changed;
-    if (reflectorsOn()) {
-      reach_.measure(edited, bvh, reachInputs(), ambient_, boxes); // markReflectors below needs it
-    } else {
-      // Compose needs it, the passes do not: measured on threads of their own beside the GPU work
-      // of the edit, and applied when that is done (finishReach). The edit's callers keep `edited`,
-      // `bvh` and `changed` alive until then.
-      reach_.start(edited, bvh, reachInputs(), ambient_, boxes);
-    }
-  }
+  // An edit that added materials but no texture keeps the textures on the device too.
   bool rebind = true;
-  if (sameSurfaces) rebind = sceneBuffers_.updateGeometry(edited, bvh);
-  else sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
+  if (sameSurfaces) {
+    rebind = sceneBuffers_.updateGeometry(edited, bvh);
+  } else if (sameTextures) {
+    rebind = sceneBuffers_.updateGeometry(edited, bvh);
+    rebind = sceneBuffers_.updateMaterials(edited) || rebind;
+  } else {
+    sceneBuffers_ = SceneBuffers(*context_, edited, bvh);
+  }
   // Compact-stack kernels could overflow their stack on a deeper BVH (and would miss hits
   // unnoticed), and kernels without a kind of texture lookup would not see new textures: the
   // passes are made again for what the edited scene needs.
   if (!sceneKernels_.holds(sceneBuffers_.specialisation())) {
     makeTracingPasses(sceneBuffers_.specialisation());
+    if (reachRays_) useReachRays();
     rebind = true;
+  } else if (reachRays_ && rebind) {
+    reachRays_->rebind();
+  }
+  // Moved occluders change what every light reaches: where the emitters and surfaces stayed, only
+  // the rays that meet the changed boxes are traced again (on the device, through the buffers
+  // just updated).
+  if (reach_.measured()) {
+    const std::vector<scene::Bounds>* boxes = emittersMoved || !sameSurfaces ? nullptr : changed;
+    if (reflectorsOn()) {
+      reach_.measure(edited, bvh, reachInputs(), ambient_, boxes); // markReflectors below needs it
+    } else {
+      // Compose needs it, the passes do not: applied when the edit's GPU work is done
+      // (finishReach); with CPU rays measured on threads of their own beside it, and then the
+      // edit's callers keep `edited`, `bvh` and `changed` alive until then.
+      reach_.start(edited, bvh, reachInputs(), ambient_, boxes);
+    }
   }
   if (reflectorsOn()) markReflectors();
   if (rebind || emittersMoved) uploadLights();
@@ -654,8 +683,9 @@ std::size_t ObscuranceRenderer::addLight(const scene::PunctualLight& light) {
   updateSelection(lights_);
   emissions_.push_back(lights_.emission.back());
   uploadLights();
-  // What the new light reaches (CPU rays, for I_a) is measured on a thread of its own while its
-  // rays are traced: compose needs it, the passes do not (lights_ stays as it is meanwhile).
+  // What the new light reaches (for I_a): its own rays on the device, before its light rays; with
+  // CPU rays on a thread of its own while they are traced. Compose needs it, the passes do not
+  // (lights_ stays as it is meanwhile).
   const auto reachIn = [&] {
     if (reach_.measured()) finishReach();
     else updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);

@@ -32,6 +32,7 @@
 #include "render/aovs.h"
 #include "render/frame/obscurance_frame.h"
 #include "render/geometry_retrace.h"
+#include "render/gpu_ray_batch.h"
 #include "render/light_reach_model.h"
 #include "render/passes/compose_pass.h"
 #include "render/passes/light_mix_pass.h"
@@ -260,7 +261,7 @@ public:
   bool specular() const { return runSpecular_; }
   // Per-pass GPU ms and rays since the last reset, wall time, memory, truncations, notes.
   RenderStats stats() const;
-  // The last measurement of what the lights reach (the Reached ambient model, CPU rays): rays
+  // The last measurement of what the lights reach (the Reached ambient model, on the device): rays
   // traced and wall ms; after a move, only the rays it could change.
   using ReachUpdate = LightReachModel::Update;
   ReachUpdate lastReachUpdate() const { return reach_.lastUpdate(); }
@@ -371,8 +372,11 @@ private:
   gpu::CommandStream stream_;
   gpu::Timestamps timestamps_;
   double wallSeconds_ = 0.0;
-  // What each light reaches (CPU rays, for I_a and the reflectors). Last: its destructor waits for
-  // a measurement still running beside an edit, which reads the members above.
+  // What each light reaches (for I_a and the reflectors), its rays traced on the device through
+  // reachRays_ (the scene's buffers and traversal). Last: its destructor waits for a measurement
+  // still running beside an edit (CPU rays), which reads the members above.
+  std::unique_ptr<GpuRayBatch> reachRays_;
+  void useReachRays(); // made (again) for the scene's buffers and kernels
   LightReachModel reach_;
 };
 

@@ -12,12 +12,14 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/shared_bytes.h"
+
 namespace obscura::scene {
 
 struct Texture {
   std::string name;            // file name or "image[N]" for embedded data, for messages
   int width = 0, height = 0;
-  std::vector<std::uint8_t> rgba8; // width * height * 4 bytes, rows top to bottom
+  SharedBytes rgba8;           // width * height * 4 bytes, rows top to bottom (shared by copies)
   bool srgb = false;           // true for base colour and emissive textures (glTF says so)
 };
 

@@ -28,6 +28,7 @@ nlohmann::json EditReport::json() const {
                          {"rays", rays},
                          {"gpu_ms", gpuMs},
                          {"host_ms", hostMs()},
+                         {"cpu_ms", cpuMs},
                          {"total_ms", totalMs}};
   if (bvh) line["bvh"] = {{"kind", bvh->refit ? "refit" : "rebuild"}, {"ms", bvh->ms}};
   if (reach) line["reach"] = {{"rays", reach->rays}, {"ms", reach->ms}};

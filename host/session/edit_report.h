@@ -28,11 +28,15 @@ struct EditReport {
   // Host work: the wall time not spent in the GPU passes above (BVH update, the reach's CPU
   // rays not hidden behind GPU work, bookkeeping, submission and waits).
   double hostMs() const;
+  // Host CPU time of the edit on every thread it used (core/host_cpu_time.h), whether or not it
+  // overlapped GPU work: what an edit on a GPU waits for. lavapipe's own threads (the device's
+  // work there) are not in it.
+  double cpuMs = 0.0;
 
   // Adds the per-pass rays and GPU ms between two of a renderer's counters.
   void addPasses(const render::RenderStats& before, const render::RenderStats& after);
   // One line of edits.jsonl: kind, name, pixels_retraced, rays, gpu_ms, bvh, reach, host_ms,
-  // total_ms.
+  // cpu_ms, total_ms.
   nlohmann::json json() const;
 };
 

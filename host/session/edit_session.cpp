@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "core/host_cpu_time.h"
 #include "render/scene_data/light_set.h"
 
 namespace obscura::session {
@@ -47,6 +48,7 @@ void EditSession::addLight(const scene::PunctualLight& light, bool added) {
 EditReport EditSession::apply(const Edit& e, const std::string& where) {
   using Kind = Edit::Kind;
   const auto start = Clock::now();
+  const HostCpuClock cpu;
   const render::RenderStats before = renderer_->stats();
   EditReport report;
   report.kind = e.kindName();
@@ -111,15 +113,18 @@ EditReport EditSession::apply(const Edit& e, const std::string& where) {
   if (report.bvh || e.kind == Kind::AddLight || e.kind == Kind::MoveLight) report.reach = renderer_->lastReachUpdate();
   report.addPasses(before, renderer_->stats());
   report.totalMs = msSince(start);
+  report.cpuMs = cpu.ms();
   return report;
 }
 
 void EditSession::composeDisplay(EditReport& report, float exposureStops) {
   const auto start = Clock::now();
+  const HostCpuClock cpu;
   const render::RenderStats before = renderer_->stats();
   renderer_->composeDisplay(exposureStops);
   report.addPasses(before, renderer_->stats());
   report.totalMs += msSince(start);
+  report.cpuMs += cpu.ms();
 }
 
 } // namespace obscura::session

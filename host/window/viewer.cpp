@@ -34,6 +34,7 @@ struct Viewer::FrameRecord {
   std::size_t frame = 0;
   bool restarted = false, preview = false, presented = false;
   std::uint64_t retraced = 0;
+  double editCpuMs = 0.0;      // host CPU time of this frame's edits (EditReport::cpuMs)
   std::uint64_t rays = 0;      // traced this frame: edits, samples
   double gpuMs = 0.0;          // the renderer's GPU time this frame (its passes' timestamps)
   double renderMs = 0.0;       // wall time of the edits, the samples and the compose
@@ -104,6 +105,7 @@ void Viewer::applyEdit(session::Edit edit, FrameRecord& record) {
   }
   if (edit.kind == EditKind::Insert) throw InputError("insert: not in the window (relight --edits inserts objects)");
   const session::EditReport report = session_->apply(edit, edit.kindName());
+  record.editCpuMs += report.cpuMs;
   forgetHistory_ = true; // the image itself changed
   needsCompose_ = true;
   if (edit.changesGeometry()) {
@@ -349,6 +351,7 @@ void Viewer::writeLog(const FrameRecord& r) {
                          {"preview", r.preview},
                          {"presented", r.presented},
                          {"pixels_retraced", r.retraced},
+                         {"edit_cpu_ms", r.editCpuMs},
                          {"rays", r.rays},
                          {"gpu_ms", r.gpuMs},
                          {"render_ms", r.renderMs},

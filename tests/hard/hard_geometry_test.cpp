@@ -19,7 +19,7 @@
 #include "bvh/bvh.h"
 #include "gpu_test.h"
 #include "render/test_scenes.h"
-#include "bench/ray_tracer.h"
+#include "render/ray_tracer.h"
 #include "render/scene_data/scene_buffers.h"
 #include "scene/gltf_loader.h"
 
@@ -104,8 +104,8 @@ protected:
     Traced out;
     out.tree = bvh::build(render::triangleSoup(s), options);
     render::SceneBuffers buffers(context(), s, out.tree);
-    bench::RayTracer tracer(context(), buffers);
-    out.hits = tracer.trace(rays, bench::TraceMode::Closest).hits;
+    render::RayTracer tracer(context(), buffers);
+    out.hits = tracer.trace(rays, render::TraceMode::Closest).hits;
     out.truncatedStatus = buffers.truncatedTraversals();
     return out;
   }

@@ -19,7 +19,7 @@
 #include "render/test_scenes.h"
 #include "loop_limit_test.spv.h"
 #include "bench/bench_rays.h"
-#include "bench/ray_tracer.h"
+#include "render/ray_tracer.h"
 #include "core/error.h"
 #include "render/scene_data/bvh_layout.h"
 #include "render/scene_data/scene_buffers.h"
@@ -73,7 +73,7 @@ void expectAgreement(const Comparison& c, const char* what) {
 class GpuTraversal : public GpuTest {
 protected:
   Comparison traceAndCompare(const scene::Scene& scene, std::size_t count, std::uint64_t seed,
-                             std::optional<bench::TraceShape> shape = {}, const bvh::BuildOptions& options = {},
+                             std::optional<render::TraceShape> shape = {}, const bvh::BuildOptions& options = {},
                              std::optional<render::Traversal> traversal = {}) {
     bvh::TriangleSoup soup = render::triangleSoup(scene);
     bvh::Bvh tree = bvh::build(soup, options);
@@ -82,9 +82,9 @@ protected:
     }
     render::SceneBuffers buffers(context(), scene, tree, traversal);
     EXPECT_EQ(buffers.traversal(), traversal.value_or(render::Traversal::Wide)); // lavapipe's own: wide
-    bench::RayTracer tracer(context(), buffers, shape);
+    render::RayTracer tracer(context(), buffers, shape);
     auto rays = bench::closestBenchRays(scene.bounds, count, seed);
-    auto result = tracer.trace(rays, bench::TraceMode::Closest);
+    auto result = tracer.trace(rays, render::TraceMode::Closest);
     EXPECT_EQ(buffers.truncatedTraversals(), 0u);
     return compare(result.hits, bruteForce(soup, rays));
   }
@@ -144,9 +144,9 @@ TEST_F(GpuTraversal, ModernHallMatchesBruteForce) {
 // force, like the lavapipe shape above.
 TEST_F(GpuTraversal, GpuAndOneRayPerInvocationShapesMatchBruteForce) {
   scene::Scene soup = soupScene(randomSoup(3000, 1));
-  expectAgreement(traceAndCompare(soup, 100000, 1, bench::TraceShape::forGpu()), "random soup, GPU shape");
-  expectAgreement(traceAndCompare(soup, 100000, 1, bench::TraceShape{128, 1}), "random soup, one ray per invocation");
-  bench::TraceShape fromStorage = bench::TraceShape::forGpu();
+  expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape::forGpu()), "random soup, GPU shape");
+  expectAgreement(traceAndCompare(soup, 100000, 1, render::TraceShape{128, 1}), "random soup, one ray per invocation");
+  render::TraceShape fromStorage = render::TraceShape::forGpu();
   fromStorage.bvhItemsFromStorage = true;
   expectAgreement(traceAndCompare(soup, 100000, 1, fromStorage), "random soup, GPU shape, BVH from an SSBO");
 }
@@ -166,7 +166,7 @@ TEST_F(GpuTraversal, BinaryLayoutMatchesBruteForceAndCpuAnyHit) {
                   "random soup, binary-while-while");
   expectAgreement(traceAndCompare(cornell, 100000, 11, {}, {}, render::Traversal::BinaryWhileWhile),
                   "cornell-box, binary-while-while");
-  bench::TraceShape culling = bench::TraceShape::forBinary();
+  render::TraceShape culling = render::TraceShape::forBinary();
   culling.binaryCullOnPop = true;
   expectAgreement(traceAndCompare(soup, 100000, 4, culling, splits, render::Traversal::BinaryWhileWhile),
                   "cull on pop, binary-while-while");
@@ -175,10 +175,10 @@ TEST_F(GpuTraversal, BinaryLayoutMatchesBruteForceAndCpuAnyHit) {
 
     const bvh::Bvh tree = bvh::build(render::triangleSoup(cornell));
     render::SceneBuffers buffers(context(), cornell, tree, traversal);
-    bench::RayTracer tracer(context(), buffers);
+    render::RayTracer tracer(context(), buffers);
     EXPECT_EQ(tracer.shape().raysPerLane, 1u);
     const auto rays = bench::shadowBenchRays(cornell.bounds, 100000, 5);
-    const auto result = tracer.trace(rays, bench::TraceMode::Any);
+    const auto result = tracer.trace(rays, render::TraceMode::Any);
     std::size_t disagreements = 0, occluded = 0;
     for (std::size_t i = 0; i < rays.size(); ++i) {
       const bvh::Ray r{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
@@ -196,7 +196,7 @@ TEST_F(GpuTraversal, BinaryLayoutMatchesBruteForceAndCpuAnyHit) {
 // (traverseBinaryStream), in lavapipe's shape and a GPU's.
 TEST_F(GpuTraversal, BinaryRefillingShapesMatchBruteForce) {
   const scene::Scene soup = soupScene(randomSoup(3000, 1));
-  for (const bench::TraceShape shape : {bench::TraceShape::forCpu(), bench::TraceShape::forGpu()})
+  for (const render::TraceShape shape : {render::TraceShape::forCpu(), render::TraceShape::forGpu()})
     expectAgreement(traceAndCompare(soup, 100000, 3, shape, {}, render::Traversal::Binary),
                     ("random soup, binary, " + std::to_string(shape.raysPerLane) + " rays per invocation").c_str());
 }
@@ -207,10 +207,10 @@ TEST_F(GpuTraversal, RepeatedTraceTimesEachRepeatAndKeepsTheHits) {
   scene::Scene soup = soupScene(randomSoup(500, 3));
   bvh::Bvh tree = bvh::build(render::triangleSoup(soup));
   render::SceneBuffers buffers(context(), soup, tree);
-  bench::RayTracer tracer(context(), buffers);
+  render::RayTracer tracer(context(), buffers);
   auto rays = bench::closestBenchRays(soup.bounds, 5000, 3);
-  auto once = tracer.trace(rays, bench::TraceMode::Closest);
-  auto repeated = tracer.traceRepeated(rays, bench::TraceMode::Closest, 3);
+  auto once = tracer.trace(rays, render::TraceMode::Closest);
+  auto repeated = tracer.traceRepeated(rays, render::TraceMode::Closest, 3);
   ASSERT_EQ(repeated.repeatGpuMs.size(), 3u);
   for (double ms : repeated.repeatGpuMs) EXPECT_GT(ms, 0.0);
   ASSERT_EQ(repeated.hits.size(), once.hits.size());
@@ -225,9 +225,9 @@ TEST_F(GpuTraversal, ShadowRaysMatchCpuAnyHit) {
   bvh::TriangleSoup soup = render::triangleSoup(s);
   bvh::Bvh tree = bvh::build(soup);
   render::SceneBuffers buffers(context(), s, tree);
-  bench::RayTracer tracer(context(), buffers);
+  render::RayTracer tracer(context(), buffers);
   auto rays = bench::shadowBenchRays(s.bounds, 100000, 5);
-  auto result = tracer.trace(rays, bench::TraceMode::Any);
+  auto result = tracer.trace(rays, render::TraceMode::Any);
   std::size_t disagreements = 0, occluded = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     bvh::Ray r{glm::vec3(rays[i].origin), glm::vec3(rays[i].direction), rays[i].origin.w, rays[i].direction.w};
@@ -261,9 +261,9 @@ TEST_F(GpuTraversal, LongTraversalIsReportedNotTruncatedSilently) {
       scene::Scene s = stackedMisses(n);
       bvh::Bvh tree = bvh::build(render::triangleSoup(s));
       render::SceneBuffers buffers(context(), s, tree, traversal);
-      bench::RayTracer tracer(context(), buffers);
+      render::RayTracer tracer(context(), buffers);
       std::vector<gpu::GpuRay> rays(8, gpu::GpuRay{glm::vec4(0, 0, -1, 0), glm::vec4(0, 0, 1, INFINITY)});
-      auto result = tracer.trace(rays, bench::TraceMode::Closest, true);
+      auto result = tracer.trace(rays, render::TraceMode::Closest, true);
       const std::string what = render::traversalName(traversal) + ", " + std::to_string(n) + " triangles";
       if (n == 20000) {
         // Every triangle is tested: at least n passes, and still a clean miss.
@@ -318,9 +318,9 @@ std::vector<gpu::GpuRay> combRays() {
 
 // The comb's closest hits match the brute force (the spine's last triangle), its any hits end at
 // that triangle's plane; returns each ray's loop passes.
-std::vector<std::uint32_t> expectCombHits(bench::RayTracer& tracer, const Comb& c, std::uint32_t levels) {
+std::vector<std::uint32_t> expectCombHits(render::RayTracer& tracer, const Comb& c, std::uint32_t levels) {
   std::vector<gpu::GpuRay> rays = combRays();
-  auto result = tracer.trace(rays, bench::TraceMode::Closest, true);
+  auto result = tracer.trace(rays, render::TraceMode::Closest, true);
   auto cpu = bruteForce(c.soup, rays);
   for (std::size_t i = 0; i < rays.size(); ++i) {
     EXPECT_EQ(result.hits[i].primitive, cpu[i].primitive) << i;
@@ -329,9 +329,9 @@ std::vector<std::uint32_t> expectCombHits(bench::RayTracer& tracer, const Comb& 
   EXPECT_EQ(result.hits[0].primitive, levels);
   // Any hit: not occluded short of the last triangle's plane, occluded beyond it.
   for (auto& r : rays) r.direction.w = static_cast<float>(levels) + 4.0f; // the hit is at t = levels + 4.5
-  auto blocked = tracer.trace(rays, bench::TraceMode::Any);
+  auto blocked = tracer.trace(rays, render::TraceMode::Any);
   for (auto& r : rays) r.direction.w = INFINITY;
-  auto open = tracer.trace(rays, bench::TraceMode::Any);
+  auto open = tracer.trace(rays, render::TraceMode::Any);
   for (std::size_t i = 0; i < rays.size(); ++i) {
     EXPECT_EQ(blocked.hits[i].primitive, gpu::kInvalidIndex) << i;
     EXPECT_EQ(open.hits[i].primitive, levels) << i;
@@ -346,7 +346,7 @@ TEST_F(GpuTraversal, DeepStackMatchesBruteForce) {
   scene::Scene s = soupScene(c.soup);
   render::SceneBuffers buffers(context(), s, c.tree);
   ASSERT_EQ(buffers.compactStackVectors(), 0u);
-  bench::RayTracer tracer(context(), buffers);
+  render::RayTracer tracer(context(), buffers);
   const std::vector<std::uint32_t> steps = expectCombHits(tracer, c, levels);
   // Every node is visited: the spine and the ribs (the overflow restarts from the root).
   for (std::size_t i = 0; i < steps.size(); ++i) EXPECT_GE(steps[i], 2 * levels) << i;
@@ -367,8 +367,8 @@ TEST_F(GpuTraversal, CompactStackHoldsTheDeepestBvhItAccepts) {
     scene::Scene s = soupScene(c.soup);
     render::SceneBuffers buffers(context(), s, c.tree);
     ASSERT_EQ(buffers.compactStackVectors(), v);
-    for (const bench::TraceShape shape : {bench::TraceShape::forCpu(), bench::TraceShape{128, 1}}) {
-      bench::RayTracer tracer(context(), buffers, shape, v);
+    for (const render::TraceShape shape : {render::TraceShape::forCpu(), render::TraceShape{128, 1}}) {
+      render::RayTracer tracer(context(), buffers, shape, v);
       // The ribs' triangles miss the rays, so a rib dropped from the stack would not change the
       // hits: every one of the 2 levels + 1 nodes must be visited, one per pass at most.
       for (const std::uint32_t steps : expectCombHits(tracer, c, levels)) EXPECT_GE(steps, 2 * levels + 1) << v;
@@ -379,7 +379,7 @@ TEST_F(GpuTraversal, CompactStackHoldsTheDeepestBvhItAccepts) {
     scene::Scene deeperScene = soupScene(deeper.soup);
     render::SceneBuffers deeperBuffers(context(), deeperScene, deeper.tree);
     EXPECT_EQ(deeperBuffers.compactStackVectors(), v < gpu::kBvhCompactStackVectors ? v + 1 : 0u);
-    EXPECT_THROW(bench::RayTracer(context(), deeperBuffers, {}, v), std::logic_error);
+    EXPECT_THROW(render::RayTracer(context(), deeperBuffers, {}, v), std::logic_error);
   }
   static_assert(4 * gpu::kBvhCompactStackVectors + 2 == gpu::kBvhCompactStackMaxDepth);
 }
@@ -393,7 +393,7 @@ TEST_F(GpuTraversal, BinaryLayoutHoldsDeepStacksAndRefusesTreesDeeperThanItsStac
   scene::Scene s = soupScene(c.soup);
   for (const render::Traversal traversal : {render::Traversal::Binary, render::Traversal::BinaryWhileWhile}) {
     render::SceneBuffers buffers(context(), s, c.tree, traversal);
-    bench::RayTracer tracer(context(), buffers);
+    render::RayTracer tracer(context(), buffers);
     expectCombHits(tracer, c, levels);
     EXPECT_EQ(buffers.truncatedTraversals(), 0u);
   }

@@ -122,9 +122,14 @@ TEST_F(EditSessionTest, ReportsSayWhatEachEditTracedAndHowTheBvhFollowed) {
   EXPECT_FALSE(shown.gpuMs.empty()) << "the compose pass's GPU time";
 
   const auto line = move.json();
-  for (const char* key : {"kind", "name", "pixels_retraced", "rays", "gpu_ms", "bvh", "reach", "host_ms", "total_ms"})
+  for (const char* key : {"kind", "name", "pixels_retraced", "rays", "gpu_ms", "bvh", "reach", "host_ms", "cpu_ms", "total_ms"})
     EXPECT_TRUE(line.contains(key)) << key;
   EXPECT_GE(line["host_ms"].get<double>(), 0.0);
+  EXPECT_EQ(line["cpu_ms"].get<double>(), move.cpuMs);
+  // The host's CPU time, on every thread: a quad's rebuild and every light's reach are far more
+  // of it than a scale's bookkeeping.
+  EXPECT_GT(scale.cpuMs, 0.0);
+  EXPECT_GT(quad.cpuMs, 2.0 * scale.cpuMs);
 }
 
 TEST_F(EditSessionTest, ARefusedEditLeavesTheSessionAsItWas) {

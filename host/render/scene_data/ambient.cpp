@@ -1,5 +1,6 @@
 #include "render/scene_data/ambient.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -33,9 +34,18 @@ glm::vec3 AmbientTerm::globalIntensity(const std::vector<glm::vec3>& emission) c
   return weighted(globalWeight, emission);
 }
 
+std::vector<glm::vec3> textureMeanColours(const scene::Scene& scene, std::vector<glm::vec3> known) {
+  known.resize(std::min(known.size(), scene.textures.size()));
+  for (std::size_t t = known.size(); t < scene.textures.size(); ++t) known.push_back(meanTextureColour(scene.textures[t]));
+  return known;
+}
+
 std::vector<glm::vec3> triangleReflectances(const scene::Scene& scene, const std::vector<glm::vec3>& meanAlbedo) {
-  std::vector<glm::vec3> textureMean(scene.textures.size());
-  for (std::size_t t = 0; t < scene.textures.size(); ++t) textureMean[t] = meanTextureColour(scene.textures[t]);
+  return triangleReflectances(scene, meanAlbedo, textureMeanColours(scene));
+}
+
+std::vector<glm::vec3> triangleReflectances(const scene::Scene& scene, const std::vector<glm::vec3>& meanAlbedo,
+                                            const std::vector<glm::vec3>& textureMean) {
   std::vector<glm::vec3> material(scene.materials.size());
   for (std::size_t m = 0; m < scene.materials.size(); ++m) {
     material[m] = meanAlbedo[m];

@@ -25,7 +25,11 @@ struct GridHit {
 };
 
 // The camera ray through (gx, gy) of a grid x grid over the image (cell (x, y) spans
-// [x, x + 1) x [y, y + 1), y down) and its first hit; none for a miss or a degenerate triangle.
+// [x, x + 1) x [y, y + 1), y down).
+bvh::Ray gridRay(const GridCamera& camera, float gx, float gy, int grid);
+// What `ray` found, as a GridHit; none for a miss or a degenerate triangle.
+std::optional<GridHit> gridHit(const scene::Scene& scene, const bvh::Ray& ray, const bvh::Hit& hit);
+// gridRay's first hit in `bvh`.
 std::optional<GridHit> firstHitThroughGrid(const scene::Scene& scene, const bvh::Bvh& bvh, const GridCamera& camera,
                                            float gx, float gy, int grid);
 

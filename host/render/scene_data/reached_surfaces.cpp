@@ -14,7 +14,7 @@
 namespace obscura::render {
 
 // The streams of a light's measurement: one per ray (or per surface sample, whose tries share it).
-enum class Stream : std::uint32_t { LightRay = 1, Bounce = 2, Sample = 3, Seen = 4 };
+enum class Stream : std::uint32_t { LightRay = 1, Bounce = 2, Sample = 3, Seen = 4, SeenGrid = 5 };
 
 // A counter-based generator (splitmix64, Steele, Lea & Flood 2014) for one stream: cheap to start
 // at any (light, stream, index), so that every ray has numbers of its own.
@@ -181,8 +181,10 @@ float obscuranceRho(float d, float dMax, std::uint32_t kind, float tau) {
   return std::sqrt(x);
 }
 
-ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<glm::vec3>& reflectance)
-    : scene_(&scene), bvh_(bvh), reflectance_(reflectance), bounds_(scene.bounds),
+ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<glm::vec3>& reflectance,
+                                 bool copyBvh)
+    : scene_(&scene), bvhCopy_(copyBvh ? std::optional<bvh::Bvh>(bvh) : std::nullopt),
+      callersBvh_(&bvh), reflectance_(reflectance), bounds_(scene.bounds),
       offset_(1e-5f * largestExtent(scene.bounds)) {
   std::vector<double> cdf;
   cdf.reserve(scene.triangles.size());
@@ -221,26 +223,45 @@ struct ReachedSurfaces::Replay {
   }
 };
 
-LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) const {
-  return trace(lights, light, nullptr);
+LightReach ReachedSurfaces::measure(RayBatch& rays, const LightSet& lights, std::size_t light) const {
+  return trace(rays, lights, light, nullptr);
 }
 
-LightReach ReachedSurfaces::remeasure(const ReachedSurfaces& before, const LightReach& previous, const LightSet& lights,
-                                      std::size_t light, const std::vector<scene::Bounds>& changed) const {
-  if (previous.rays.landingT.size() != kLightRays) return measure(lights, light); // never measured
+LightReach ReachedSurfaces::measure(const LightSet& lights, std::size_t light) const {
+  CpuRayBatch cpu(bvh());
+  return measure(cpu, lights, light);
+}
+
+LightReach ReachedSurfaces::remeasure(RayBatch& batch, const ReachedSurfaces& before, const LightReach& previous,
+                                      const LightSet& lights, std::size_t light,
+                                      const std::vector<scene::Bounds>& changed) const {
+  if (previous.rays.landingT.size() != kLightRays) return measure(batch, lights, light); // never measured
   // Ray origins leave their surfaces by a share of the scene's size: a move that changed it moved
   // every ray.
-  if (before.offset_ != offset_) return measure(lights, light);
+  if (before.offset_ != offset_) return measure(batch, lights, light);
   // The sky's and the sun's points are placed by the scene's bounds: a move that changed them
   // moved every one of those light points.
   const std::uint32_t type = lights.lights[light].info.x;
   const bool placedByBounds = type == gpu::kLightBackground || type == gpu::kLightDirectional;
-  if (placedByBounds && (before.bounds_.lo != bounds_.lo || before.bounds_.hi != bounds_.hi)) return measure(lights, light);
+  if (placedByBounds && (before.bounds_.lo != bounds_.lo || before.bounds_.hi != bounds_.hi))
+    return measure(batch, lights, light);
   const Replay replay{before, previous.rays, changed, before.samples_.size() == samples_.size()};
-  return trace(lights, light, &replay);
+  return trace(batch, lights, light, &replay);
 }
 
-LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, const Replay* replay) const {
+LightReach ReachedSurfaces::remeasure(const ReachedSurfaces& before, const LightReach& previous, const LightSet& lights,
+                                      std::size_t light, const std::vector<scene::Bounds>& changed) const {
+  CpuRayBatch cpu(bvh());
+  return remeasure(cpu, before, previous, lights, light, changed);
+}
+
+// The rays are traced a stage at a time (RayBatch): the light rays, their bounces, the surface
+// samples' tries at the light, the tries at the landings of those still unseen, the Seen fit's
+// shadow rays. Every ray draws from a stream of its own, so tracing a stage's rays together draws
+// the numbers a ray-by-ray loop would: a sample's tries are all drawn (its stream goes on in
+// order), and the first seen decides, as when the loop stopped there. Tries after the first seen
+// are traced but not kept (tryBlockedAt stays NaN there, as before).
+LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::size_t light, const Replay* replay) const {
   LightReach reach;
   if (samples_.empty() || !(lights.power[light] > 0.0)) return reach;
   const std::uint32_t seed = lightSeed(lights.names[light]);
@@ -249,6 +270,15 @@ LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, con
   auto offsetToward = [&](glm::vec3 p, glm::vec3 n, glm::vec3 towards) {
     const float o = offsetAt(p, offset_);
     return p + (glm::dot(n, towards - p) >= 0.0f ? o : -o) * n;
+  };
+  // The rays of one stage: `ray[i]` belongs to `owner[i]`.
+  struct Stage {
+    std::vector<bvh::Ray> ray;
+    std::vector<std::uint32_t> owner;
+    void add(std::uint32_t who, const bvh::Ray& r) {
+      ray.push_back(r);
+      owner.push_back(who);
+    }
   };
 
   // 1. Where the light lands: first hits of rays leaving it (the position and the lit side's
@@ -262,33 +292,50 @@ LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, con
   std::vector<Landing> landingOf(kLightRays); // by light ray; valid where landingT is finite
   rays.landingT.assign(kLightRays, std::numeric_limits<float>::quiet_NaN());
   rays.landingPrimitive.assign(kLightRays, gpu::kInvalidIndex);
-  std::map<std::uint32_t, std::uint32_t> landedOn; // triangle -> rays
+  std::vector<bvh::Ray> lightRay(kLightRays);
+  std::vector<std::uint8_t> retraced(kLightRays, 0);
   std::uint32_t emitted = 0, landed = 0;
-  for (std::uint32_t i = 0; i < kLightRays; ++i) {
-    StreamRng rng(seed, Stream::LightRay, i);
-    LightPoint p = samplePoint(lights, light, rng, scene.bounds);
-    glm::vec3 d;
-    if (!emitDirection(lights, light, p, rng, d)) continue;
-    bvh::Ray ray{.origin = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, p.position + d),
-                 .direction = d};
-    ++emitted;
-    float t = replay ? replay->rays.landingT[i] : 0.0f;
-    std::uint32_t primitive = replay ? replay->rays.landingPrimitive[i] : gpu::kInvalidIndex;
-    const bool retrace = !replay || std::isnan(t) || replay->meets(ray.origin, d, t);
-    if (retrace) {
-      bvh::Hit hit = bvh::closestHit(bvh_, ray);
-      ++rays.traced;
-      t = hit.hit() ? hit.t : std::numeric_limits<float>::infinity();
-      primitive = hit.hit() ? hit.primitive : gpu::kInvalidIndex;
+  {
+    Stage stage;
+    for (std::uint32_t i = 0; i < kLightRays; ++i) {
+      StreamRng rng(seed, Stream::LightRay, i);
+      LightPoint p = samplePoint(lights, light, rng, scene.bounds);
+      glm::vec3 d;
+      if (!emitDirection(lights, light, p, rng, d)) continue;
+      const bvh::Ray ray{.origin = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, p.position + d),
+                         .direction = d};
+      lightRay[i] = ray;
+      ++emitted;
+      const float t = replay ? replay->rays.landingT[i] : 0.0f;
+      if (!replay || std::isnan(t) || replay->meets(ray.origin, d, t)) {
+        stage.add(i, ray);
+        retraced[i] = 1;
+        rays.landingT[i] = kInfinity; // until traced
+        continue;
+      }
+      rays.landingT[i] = t;
+      rays.landingPrimitive[i] = replay->rays.landingPrimitive[i];
     }
-    rays.landingT[i] = t;
-    rays.landingPrimitive[i] = primitive;
+    const std::vector<bvh::Hit> hits = batch.closest(stage.ray);
+    rays.traced += stage.ray.size();
+    for (std::size_t k = 0; k < hits.size(); ++k) {
+      const std::uint32_t i = stage.owner[k];
+      rays.landingT[i] = hits[k].hit() ? hits[k].t : kInfinity;
+      rays.landingPrimitive[i] = hits[k].hit() ? hits[k].primitive : gpu::kInvalidIndex;
+    }
+  }
+  std::map<std::uint32_t, std::uint32_t> landedOn; // triangle -> rays
+  for (std::uint32_t i = 0; i < kLightRays; ++i) {
+    const float t = rays.landingT[i];
     if (!std::isfinite(t)) continue;
+    const std::uint32_t primitive = rays.landingPrimitive[i];
+    const glm::vec3 d = lightRay[i].direction;
     const glm::uvec3 tri = scene.triangles[primitive];
     glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
     glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
     if (glm::dot(n, d) > 0.0f) n = -n; // the side the light arrives on
-    landingOf[i] = {ray.origin + t * d, n, reflectance_[primitive], ray.origin, d, retrace && replay};
+    landingOf[i] = {lightRay[i].origin + t * d, n, reflectance_[primitive], lightRay[i].origin, d,
+                    retraced[i] != 0 && replay != nullptr};
     ++landed;
     ++landedOn[primitive];
   }
@@ -299,90 +346,136 @@ LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, con
   // crosses the scene's box already), and after one diffuse reflection where the light lands.
   const bool directional = lights.lights[light].info.x == gpu::kLightDirectional;
   reach.escapeDirect = directional || emitted == 0 ? 0.0 : 1.0 - static_cast<double>(landed) / emitted;
-  std::size_t escapedBounce = 0;
   rays.bounceBlockedAt.assign(kLightRays, kInfinity);
-  for (std::uint32_t i = 0; i < kLightRays; ++i) {
-    if (!std::isfinite(rays.landingT[i])) continue;
-    const Landing& h = landingOf[i];
-    StreamRng rng(seed, Stream::Bounce, i);
-    glm::vec3 d = cosineDirection(h.normal, rng.next(), rng.next());
-    bvh::Ray ray{.origin = h.position + offsetAt(h.position, offset_) * h.normal, .direction = d};
-    // Blocked at t before: still blocked unless the segment up to there meets a changed box; left
-    // the scene: still does unless the whole ray meets one.
-    float blockedAt = replay ? replay->rays.bounceBlockedAt[i] : kInfinity;
-    if (!replay || h.moved || replay->meets(ray.origin, d, blockedAt)) {
-      blockedAt = kInfinity;
-      bvh::anyHit(bvh_, ray, &blockedAt);
-      ++rays.traced;
+  {
+    Stage stage;
+    for (std::uint32_t i = 0; i < kLightRays; ++i) {
+      if (!std::isfinite(rays.landingT[i])) continue;
+      const Landing& h = landingOf[i];
+      StreamRng rng(seed, Stream::Bounce, i);
+      glm::vec3 d = cosineDirection(h.normal, rng.next(), rng.next());
+      bvh::Ray ray{.origin = h.position + offsetAt(h.position, offset_) * h.normal, .direction = d};
+      // Blocked at t before: still blocked unless the segment up to there meets a changed box; left
+      // the scene: still does unless the whole ray meets one.
+      const float blockedAt = replay ? replay->rays.bounceBlockedAt[i] : kInfinity;
+      if (!replay || h.moved || replay->meets(ray.origin, d, blockedAt)) stage.add(i, ray);
+      else rays.bounceBlockedAt[i] = blockedAt;
     }
-    rays.bounceBlockedAt[i] = blockedAt;
-    escapedBounce += std::isinf(blockedAt) ? 1 : 0;
+    const std::vector<float> blocked = batch.blockedAt(stage.ray);
+    rays.traced += stage.ray.size();
+    for (std::size_t k = 0; k < blocked.size(); ++k) rays.bounceBlockedAt[stage.owner[k]] = blocked[k];
   }
+  std::size_t escapedBounce = 0;
+  for (std::uint32_t i = 0; i < kLightRays; ++i)
+    if (std::isfinite(rays.landingT[i]) && std::isinf(rays.bounceBlockedAt[i])) ++escapedBounce;
   reach.escapeBounce = landed == 0 ? 0.0 : static_cast<double>(escapedBounce) / static_cast<double>(landed);
 
   // 2. Surface samples that see the light or a landing point: up to kVisibilityTries points of the
   // light, then as many landing points (a light ray picked at random; none when it did not land),
-  // stopping at the first seen. Before an edit, try k of sample j was unseen for k < its first seen
+  // the first seen deciding. Before an edit, try k of sample j was unseen for k < its first seen
   // try, seen at it, and not traced after it.
   const gpu::GpuLight& l = lights.lights[light];
-  std::size_t reached = 0;
-  glm::dvec3 reflectance(0.0);
   rays.firstSeenTry.assign(samples_.size(), kNotSeen);
   rays.tryBlockedAt.assign(samples_.size() * kTries, kNaN);
-  for (std::size_t j = 0; j < samples_.size(); ++j) {
-    const SurfacePoint& s = samples_[j];
-    const bool sameSample = replay && replay->samplesComparable && replay->before.samples_[j] == s;
-    const std::uint8_t firstBefore = sameSample ? replay->rays.firstSeenTry[j] : kNotSeen;
-    // Try k, the segment from -> to: seen before and its whole segment clear of the changed boxes,
-    // or blocked at t before and its segment up to t clear of them, it finds the same now.
-    auto seenFrom = [&](std::uint32_t k, glm::vec3 from, glm::vec3 to, bool targetMoved) {
-      float& blockedAt = rays.tryBlockedAt[j * kTries + k];
-      if (sameSample && !targetMoved) {
-        const float before = replay->rays.tryBlockedAt[j * kTries + k];
-        if (k == firstBefore && !replay->meets(from, to - from, 1.0f)) return true;
-        if (!std::isnan(before) && !replay->meets(from, to - from, before)) {
-          blockedAt = before;
-          return false;
+  // A try's outcome: known from before the edit, or found by its ray.
+  enum class Outcome : std::uint8_t { Skipped, Seen, Blocked, Traced };
+  struct Try {
+    Outcome outcome = Outcome::Skipped;
+    float blockedAt = kNaN; // Blocked: where
+    std::uint32_t ray = 0;  // Traced: its index in the stage
+  };
+  std::vector<Try> tries(samples_.size() * kTries);
+  std::vector<StreamRng> sampleRng;
+  sampleRng.reserve(samples_.size());
+  auto sameSample = [&](std::size_t j) { return replay && replay->samplesComparable && replay->before.samples_[j] == samples_[j]; };
+  // Try k of sample j, the segment from -> to: seen before and its whole segment clear of the
+  // changed boxes, or blocked at t before and its segment up to t clear of them, it finds the
+  // same now; otherwise its ray goes into the stage.
+  // decided[j]: a try of sample j is known seen, so its later tries cannot matter (not planned).
+  std::vector<std::uint8_t> decided(samples_.size(), 0);
+  auto plan = [&](Stage& stage, std::size_t j, std::uint32_t k, glm::vec3 from, glm::vec3 to, bool targetMoved) {
+    Try& tr = tries[j * kTries + k];
+    if (decided[j]) return;
+    if (sameSample(j) && !targetMoved) {
+      const float before = replay->rays.tryBlockedAt[j * kTries + k];
+      if (k == replay->rays.firstSeenTry[j] && !replay->meets(from, to - from, 1.0f)) {
+        tr.outcome = Outcome::Seen;
+        decided[j] = 1;
+        return;
+      }
+      if (!std::isnan(before) && !replay->meets(from, to - from, before)) {
+        tr = {Outcome::Blocked, before};
+        return;
+      }
+    }
+    tr = {Outcome::Traced, kNaN, static_cast<std::uint32_t>(stage.ray.size())};
+    stage.add(static_cast<std::uint32_t>(j), {.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f});
+  };
+  // Walks tries [first, last) of sample j in order with their stage's results: the first seen
+  // decides; the blocked ones before it keep where they were blocked.
+  auto decide = [&](std::size_t j, std::uint32_t first, std::uint32_t last, const std::vector<float>& blocked) {
+    for (std::uint32_t k = first; k < last; ++k) {
+      const Try& tr = tries[j * kTries + k];
+      float at = tr.blockedAt;
+      if (tr.outcome == Outcome::Skipped) continue;
+      if (tr.outcome == Outcome::Traced) at = blocked[tr.ray];
+      if (tr.outcome == Outcome::Seen || std::isinf(at)) {
+        rays.firstSeenTry[j] = static_cast<std::uint8_t>(k);
+        return true;
+      }
+      rays.tryBlockedAt[j * kTries + k] = at;
+    }
+    return false;
+  };
+  {
+    Stage stage; // the tries at points of the light
+    for (std::size_t j = 0; j < samples_.size(); ++j) {
+      const SurfacePoint& s = samples_[j];
+      StreamRng& rng = sampleRng.emplace_back(seed, Stream::Sample, static_cast<std::uint32_t>(j));
+      for (std::uint32_t k = 0; k < kVisibilityTries; ++k) {
+        LightPoint p = samplePoint(lights, light, rng, scene.bounds);
+        if (p.directional) {
+          glm::vec3 to = s.position - 4.0f * largestExtent(scene.bounds) * p.direction;
+          plan(stage, j, k, offsetToward(s.position, s.normal, to), to, false);
+          continue;
         }
+        if (p.normal != glm::vec3(0.0f) && !p.twoSided && glm::dot(p.normal, s.position - p.position) <= 0.0f) continue;
+        if (l.info.x == gpu::kLightSpot && glm::dot(glm::normalize(s.position - p.position), glm::vec3(l.direction)) < l.params.w)
+          continue;
+        glm::vec3 target = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, s.position);
+        plan(stage, j, k, offsetToward(s.position, s.normal, target), target, false);
       }
-      bvh::Ray ray{.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f};
-      ++rays.traced;
-      float t = kNaN;
-      if (!bvh::anyHit(bvh_, ray, &t)) return true;
-      blockedAt = t;
-      return false;
-    };
-    StreamRng rng(seed, Stream::Sample, static_cast<std::uint32_t>(j));
-    bool seen = false;
-    std::uint32_t k = 0;
-    for (; k < kVisibilityTries && !seen; ++k) {
-      LightPoint p = samplePoint(lights, light, rng, scene.bounds);
-      if (p.directional) {
-        glm::vec3 to = s.position - 4.0f * largestExtent(scene.bounds) * p.direction;
-        seen = seenFrom(k, offsetToward(s.position, s.normal, to), to, false);
-        continue;
+    }
+    const std::vector<float> blocked = batch.blockedAt(stage.ray);
+    rays.traced += stage.ray.size();
+    for (std::size_t j = 0; j < samples_.size(); ++j) decide(j, 0, kVisibilityTries, blocked);
+  }
+  if (landed > 0) {
+    Stage stage; // the tries at landing points, for the samples the light itself did not see
+    for (std::size_t j = 0; j < samples_.size(); ++j) {
+      if (rays.firstSeenTry[j] != kNotSeen) continue;
+      const SurfacePoint& s = samples_[j];
+      for (std::uint32_t landingTry = 0; landingTry < kVisibilityTries; ++landingTry) {
+        const std::uint32_t k = kVisibilityTries + landingTry;
+        const std::uint32_t i = sampleRng[j].below(kLightRays);
+        if (!std::isfinite(rays.landingT[i])) continue; // that light ray left the scene
+        const Landing& h = landingOf[i];
+        if (glm::dot(h.normal, s.position - h.position) <= 0.0f) continue; // behind the lit side
+        glm::vec3 target = h.position + offsetAt(h.position, offset_) * h.normal;
+        plan(stage, j, k, offsetToward(s.position, s.normal, target), target, h.moved);
       }
-      if (p.normal != glm::vec3(0.0f) && !p.twoSided && glm::dot(p.normal, s.position - p.position) <= 0.0f) continue;
-      if (l.info.x == gpu::kLightSpot && glm::dot(glm::normalize(s.position - p.position), glm::vec3(l.direction)) < l.params.w)
-        continue;
-      glm::vec3 target = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, s.position);
-      seen = seenFrom(k, offsetToward(s.position, s.normal, target), target, false);
     }
-    for (std::uint32_t tries = 0; tries < kVisibilityTries && !seen && landed > 0; ++tries) {
-      const std::uint32_t k2 = kVisibilityTries + tries;
-      const std::uint32_t i = rng.below(kLightRays);
-      if (!std::isfinite(rays.landingT[i])) continue; // that light ray left the scene
-      const Landing& h = landingOf[i];
-      if (glm::dot(h.normal, s.position - h.position) <= 0.0f) continue; // behind the lit side
-      glm::vec3 target = h.position + offsetAt(h.position, offset_) * h.normal;
-      seen = seenFrom(k2, offsetToward(s.position, s.normal, target), target, h.moved);
-      if (seen) k = k2 + 1;
-    }
-    if (seen) {
-      rays.firstSeenTry[j] = static_cast<std::uint8_t>(k - 1);
-      ++reached;
-      reflectance += glm::dvec3(s.reflectance);
-    }
+    const std::vector<float> blocked = batch.blockedAt(stage.ray);
+    rays.traced += stage.ray.size();
+    for (std::size_t j = 0; j < samples_.size(); ++j)
+      if (rays.firstSeenTry[j] == kNotSeen) decide(j, kVisibilityTries, kTries, blocked);
+  }
+  std::size_t reached = 0;
+  glm::dvec3 reflectance(0.0);
+  for (std::size_t j = 0; j < samples_.size(); ++j) {
+    if (rays.firstSeenTry[j] == kNotSeen) continue;
+    ++reached;
+    reflectance += glm::dvec3(samples_[j].reflectance);
   }
   if (reached == 0) return reach;
   reach.fraction = static_cast<double>(reached) / static_cast<double>(samples_.size());
@@ -401,16 +494,11 @@ LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, con
   for (std::uint32_t i = 0; i < kLightRays; ++i)
     if (std::isfinite(rays.landingT[i])) landings.push_back(landingOf[i]);
   StreamRng rng(seed, Stream::Seen, 0);
-  auto visible = [&](glm::vec3 from, glm::vec3 to) {
-    bvh::Ray ray{.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f};
-    ++rays.traced;
-    return !bvh::anyHit(bvh_, ray);
-  };
   if (!seen_.empty() && !landings.empty() && glm::length(seenModel_) > 0.0) {
     std::vector<Photon> photons;
     const std::uint32_t type = lights.lights[light].info.x;
     if (type == gpu::kLightDirectional || type == gpu::kLightBackground) {
-      photons = beamPhotons(lights, light, rng);
+      photons = beamPhotons(batch, lights, light, rng, rays.traced);
       // The first landings keep the beams outside the seen box's shadow (the strata beamPhotons drew apart).
       const double perRay = type == gpu::kLightDirectional
                                 ? std::numbers::pi * sceneRadius() * sceneRadius() / emitted // irradiance 1 x the disk's share
@@ -425,9 +513,16 @@ LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, con
       const double rc2 = reach.area / (std::numbers::pi * static_cast<double>(landings.size()));
       for (const Landing& h : landings) photons.push_back({h.position, h.normal, h.reflectance, flux, rc2});
     }
-    glm::dvec3 target(0.0);
-    for (const SurfacePoint& p : seen_) {
-      glm::dvec3 sum(0.0);
+    // Every point's photon draws first (they do not depend on what the rays find), then their
+    // shadow rays at once, then the sums in the same order.
+    struct Gather {
+      std::uint32_t point;
+      glm::dvec3 contribution; // if visible
+    };
+    std::vector<Gather> gathers;
+    Stage stage;
+    for (std::uint32_t point = 0; point < seen_.size(); ++point) {
+      const SurfacePoint& p = seen_[point];
       for (std::uint32_t k = 0; k < kSeenLandingsPerPoint && !photons.empty(); ++k) {
         const Photon& h = photons[rng.below(static_cast<std::uint32_t>(photons.size()))];
         glm::vec3 d = h.position - p.position;
@@ -438,12 +533,21 @@ LightReach ReachedSurfaces::trace(const LightSet& lights, std::size_t light, con
         if (cosP <= 0.0f || cosL <= 0.0f) continue;
         glm::vec3 from = p.position + offsetAt(p.position, offset_) * p.normal;
         glm::vec3 to = h.position + offsetAt(h.position, offset_) * h.normal;
-        if (!visible(from, to)) continue;
-        sum += h.flux * glm::dvec3(h.reflectance) * static_cast<double>(cosP * cosL) / std::max(static_cast<double>(r2), h.rc2);
+        stage.add(point, {.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f});
+        gathers.push_back({point, h.flux * glm::dvec3(h.reflectance) * static_cast<double>(cosP * cosL) /
+                                   std::max(static_cast<double>(r2), h.rc2)});
       }
+    }
+    const std::vector<float> blocked = batch.blockedAt(stage.ray);
+    rays.traced += stage.ray.size();
+    std::vector<glm::dvec3> sum(seen_.size(), glm::dvec3(0.0));
+    for (std::size_t g = 0; g < gathers.size(); ++g)
+      if (std::isinf(blocked[g])) sum[gathers[g].point] += gathers[g].contribution;
+    glm::dvec3 target(0.0);
+    for (std::uint32_t point = 0; point < seen_.size(); ++point) {
       // Photons drawn uniformly: the sum over all of them is photons / K times this one.
-      const glm::dvec3 e1 = sum * (static_cast<double>(photons.size()) / kSeenLandingsPerPoint) / std::numbers::pi;
-      target += glm::dvec3(p.reflectance) * e1 / std::numbers::pi;
+      const glm::dvec3 e1 = sum[point] * (static_cast<double>(photons.size()) / kSeenLandingsPerPoint) / std::numbers::pi;
+      target += glm::dvec3(seen_[point].reflectance) * e1 / std::numbers::pi;
     }
     for (int c = 0; c < 3; ++c) reach.seenFirstBounce[c] = seenModel_[c] > 0.0 ? static_cast<float>(target[c] / seenModel_[c]) : 0.0f;
     reach.seenBounce = seenBounce_;
@@ -494,78 +598,109 @@ bool ReachedSurfaces::beamCrossesSeenBox(glm::vec3 from, glm::vec3 direction) co
 // the first landings, so the beams that cross the seen box (grown by dmax) are drawn apart:
 // kSeenBeamRays uniform over the box's projection, each carrying irradiance x projected area / N;
 // measure() keeps the first landings outside that stratum. Landings only (misses carry nothing).
-std::vector<ReachedSurfaces::Photon> ReachedSurfaces::beamPhotons(const LightSet& lights, std::size_t light, StreamRng& rng) const {
+std::vector<ReachedSurfaces::Photon> ReachedSurfaces::beamPhotons(RayBatch& batch, const LightSet& lights, std::size_t light,
+                                                                   StreamRng& rng, std::uint64_t& traced) const {
   auto uni = [](StreamRng& r) { return r.next(); };
   const scene::Bounds& bounds = scene_->bounds;
   const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
   const float radius = sceneRadius();
   const bool sky = lights.lights[light].info.x == gpu::kLightBackground;
-  std::vector<Photon> out;
+  std::vector<bvh::Ray> beams;
+  std::vector<float> shares; // each beam's cross-section
   for (std::uint32_t i = 0; i < kSeenBeamRays; ++i) {
     const glm::vec3 direction = sky ? sphereDirection(uni(rng), uni(rng)) : glm::normalize(glm::vec3(lights.lights[light].direction));
     const BeamRect r = seenBoxAcross(direction);
     if (!(r.area() > 0.0f)) continue;
     glm::vec2 uv(r.lo.x + uni(rng) * (r.hi.x - r.lo.x), r.lo.y + uni(rng) * (r.hi.y - r.lo.y));
     if (glm::dot(uv, uv) > radius * radius) continue; // outside the disk: no light there
-    bvh::Ray ray{.origin = centre - 2.0f * radius * direction + uv.x * r.t + uv.y * r.b, .direction = direction};
-    bvh::Hit hit = bvh::closestHit(bvh_, ray);
+    beams.push_back({.origin = centre - 2.0f * radius * direction + uv.x * r.t + uv.y * r.b, .direction = direction});
+    shares.push_back(r.area());
+  }
+  const std::vector<bvh::Hit> hits = batch.closest(beams);
+  traced += beams.size();
+  std::vector<Photon> out;
+  for (std::size_t i = 0; i < beams.size(); ++i) {
+    const bvh::Hit& hit = hits[i];
     if (!hit.hit()) continue;
+    const glm::vec3 direction = beams[i].direction;
     const glm::uvec3 tri = scene_->triangles[hit.primitive];
     glm::vec3 a = scene_->positions[tri.x], b = scene_->positions[tri.y], c = scene_->positions[tri.z];
     glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
     if (glm::dot(n, direction) > 0.0f) n = -n;
-    const double share = static_cast<double>(r.area()) / kSeenBeamRays; // cross-section per ray
+    const double share = static_cast<double>(shares[i]) / kSeenBeamRays; // cross-section per ray
     const double flux = (sky ? 4.0 * std::numbers::pi : 1.0) * share;
-    out.push_back({ray.origin + hit.t * direction, n, reflectance_[hit.primitive], glm::dvec3(flux), share / std::numbers::pi});
+    out.push_back({beams[i].origin + hit.t * direction, n, reflectance_[hit.primitive], glm::dvec3(flux), share / std::numbers::pi});
   }
   return out;
 }
 
 void ReachedSurfaces::setSeenView(const SeenView& view) {
+  CpuRayBatch cpu(bvh());
+  setSeenView(cpu, view);
+}
+
+// The camera's points (a jittered grid), then at each W_c (or W) as obscurance.glsl estimates it
+// (cosine rays of length dmax) and what comes back at all (any distance: the later bounces' q).
+// Each cell draws from a stream of its own, so that a stage's rays are traced together.
+void ReachedSurfaces::setSeenView(RayBatch& batch, const SeenView& view) {
   seen_.clear();
   seenModel_ = glm::dvec3(0.0);
   seenLo_ = glm::vec3(std::numeric_limits<float>::max());
   seenHi_ = glm::vec3(-std::numeric_limits<float>::max());
   const scene::Scene& scene = *scene_;
   const GridCamera camera{view.position, view.forward, view.up, view.yfov, view.aspect};
-  glm::dvec3 bounce(0.0);
-  std::size_t bounceRays = 0;
-  std::mt19937 rng(0x5ee9u);
-  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
-  for (std::uint32_t y = 0; y < kSeenGrid; ++y)
-    for (std::uint32_t x = 0; x < kSeenGrid; ++x) {
-      // A jittered grid over the image.
-      const float gx = static_cast<float>(x) + uni(rng);
-      const float gy = static_cast<float>(y) + uni(rng);
-      const auto hit = firstHitThroughGrid(scene, bvh_, camera, gx, gy, static_cast<int>(kSeenGrid));
-      if (!hit) continue;
-      const glm::vec3 n = hit->normal;
-      const SurfacePoint p{hit->position, n, reflectance_[hit->primitive]};
-      // W_c (or W) at P as obscurance.glsl estimates it: cosine rays of length dmax.
-      glm::dvec3 w(0.0);
-      for (std::uint32_t k = 0; k < kSeenObscuranceRays; ++k) {
-        // What comes back at all (any distance): the later bounces' q.
-        bvh::Hit any = bvh::closestHit(bvh_, {.origin = p.position + offsetAt(p.position, offset_) * n,
-                                              .direction = cosineDirection(n, uni(rng), uni(rng))});
-        if (any.hit()) bounce += glm::dvec3(reflectance_[any.primitive]);
-        ++bounceRays;
-        glm::vec3 dir = cosineDirection(n, uni(rng), uni(rng));
-        bvh::Hit q = bvh::closestHit(bvh_, {.origin = p.position + offsetAt(p.position, offset_) * n, .direction = dir,
-                                            .tmin = 0.0f, .tmax = view.dMax});
-        glm::vec3 r = view.colourBleeding ? view.averageReflectance : glm::vec3(1.0f);
-        float rho = 1.0f;
-        if (q.hit()) {
-          rho = obscuranceRho(q.t, view.dMax, view.rho, view.tau);
-          r = view.colourBleeding ? reflectance_[q.primitive] : glm::vec3(1.0f);
-        }
-        w += glm::dvec3(r) * static_cast<double>(rho);
-      }
-      seenModel_ += glm::dvec3(p.reflectance) * w / static_cast<double>(kSeenObscuranceRays);
-      seen_.push_back(p);
-      seenLo_ = glm::min(seenLo_, p.position - glm::vec3(view.dMax));
-      seenHi_ = glm::max(seenHi_, p.position + glm::vec3(view.dMax));
+  constexpr std::uint32_t kSeenSeed = 0x5ee9u;
+  constexpr std::uint32_t kCells = kSeenGrid * kSeenGrid;
+  std::vector<bvh::Ray> cameraRays;
+  std::vector<StreamRng> cellRng;
+  cellRng.reserve(kCells);
+  for (std::uint32_t cell = 0; cell < kCells; ++cell) {
+    StreamRng& rng = cellRng.emplace_back(kSeenSeed, Stream::SeenGrid, cell);
+    const float gx = static_cast<float>(cell % kSeenGrid) + rng.next();
+    const float gy = static_cast<float>(cell / kSeenGrid) + rng.next();
+    cameraRays.push_back(gridRay(camera, gx, gy, static_cast<int>(kSeenGrid)));
+  }
+  const std::vector<bvh::Hit> cameraHits = batch.closest(cameraRays);
+  std::vector<SurfacePoint> points;
+  std::vector<bvh::Ray> bounceRays, obscuranceRays; // kSeenObscuranceRays of each per point
+  for (std::uint32_t cell = 0; cell < kCells; ++cell) {
+    const auto hit = gridHit(scene, cameraRays[cell], cameraHits[cell]);
+    if (!hit) continue;
+    const glm::vec3 n = hit->normal;
+    points.push_back({hit->position, n, reflectance_[hit->primitive]});
+    const glm::vec3 origin = hit->position + offsetAt(hit->position, offset_) * n;
+    StreamRng& rng = cellRng[cell];
+    for (std::uint32_t k = 0; k < kSeenObscuranceRays; ++k) {
+      const float u1 = rng.next(), u2 = rng.next();
+      bounceRays.push_back({.origin = origin, .direction = cosineDirection(n, u1, u2)});
+      const float v1 = rng.next(), v2 = rng.next();
+      obscuranceRays.push_back({.origin = origin, .direction = cosineDirection(n, v1, v2), .tmin = 0.0f, .tmax = view.dMax});
     }
-  seenBounce_ = bounceRays ? glm::vec3(bounce / static_cast<double>(bounceRays)) : glm::vec3(0.0f);
+  }
+  const std::vector<bvh::Hit> bounceHits = batch.closest(bounceRays);
+  const std::vector<bvh::Hit> obscuranceHits = batch.closest(obscuranceRays);
+  glm::dvec3 bounce(0.0);
+  for (const bvh::Hit& any : bounceHits)
+    if (any.hit()) bounce += glm::dvec3(reflectance_[any.primitive]);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const SurfacePoint& p = points[i];
+    glm::dvec3 w(0.0);
+    for (std::uint32_t k = 0; k < kSeenObscuranceRays; ++k) {
+      const bvh::Hit& q = obscuranceHits[i * kSeenObscuranceRays + k];
+      glm::vec3 r = view.colourBleeding ? view.averageReflectance : glm::vec3(1.0f);
+      float rho = 1.0f;
+      if (q.hit()) {
+        rho = obscuranceRho(q.t, view.dMax, view.rho, view.tau);
+        r = view.colourBleeding ? reflectance_[q.primitive] : glm::vec3(1.0f);
+      }
+      w += glm::dvec3(r) * static_cast<double>(rho);
+    }
+    seenModel_ += glm::dvec3(p.reflectance) * w / static_cast<double>(kSeenObscuranceRays);
+    seen_.push_back(p);
+    seenLo_ = glm::min(seenLo_, p.position - glm::vec3(view.dMax));
+    seenHi_ = glm::max(seenHi_, p.position + glm::vec3(view.dMax));
+  }
+  seenBounce_ = bounceRays.empty() ? glm::vec3(0.0f) : glm::vec3(bounce / static_cast<double>(bounceRays.size()));
 }
 
 } // namespace obscura::render

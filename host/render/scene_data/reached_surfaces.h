@@ -31,7 +31,8 @@
 // still linear in the light's emission (flux per landing), so relighting holds; it is fitted to
 // one camera (like the default dmax). The rays run on the CPU (bvh::closestHit / anyHit): a few
 // thousand per light, deterministic for a given scene (fixed seeds), so an incremental edit and a
-// fresh render agree.
+// fresh render agree. They are traced a stage at a time through a RayBatch (ray_batch.h): the
+// renderer's on the GPU, or the CPU's BVH (the calls without one, and the tests' twin).
 //
 // Every ray draws its random numbers from a stream of its own (the light's name, the kind of ray
 // and its index), so no ray's outcome shifts another's numbers. That is what lets a geometry edit
@@ -40,6 +41,7 @@
 // move, finds in the edited scene what it found before.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <utility>
 #include <vector>
@@ -48,6 +50,7 @@
 
 #include "bvh/bvh.h"
 #include "render/scene_data/light_set.h"
+#include "render/scene_data/ray_batch.h"
 #include "scene/scene.h"
 
 namespace obscura::render {
@@ -107,12 +110,18 @@ float obscuranceRho(float d, float dMax, std::uint32_t kind, float tau);
 
 class ReachedSurfaces {
 public:
-  // `reflectance[t]`: mean reflectance of triangle t (ambient.h, triangleReflectances). Keeps a
-  // copy of the BVH; the scene must outlive it (as it outlives the renderer).
-  ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<glm::vec3>& reflectance);
+  // `reflectance[t]`: mean reflectance of triangle t (ambient.h, triangleReflectances). The scene
+  // must outlive it (as it outlives the renderer). The calls without a RayBatch trace the CPU's
+  // BVH: a copy of `bvh` (so that they may run on threads while the caller's changes), or, with
+  // `copyBvh` false (all rays through a RayBatch: a copy would be an edit's O(n) host work),
+  // `bvh` itself, which must then outlive it.
+  ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh, const std::vector<glm::vec3>& reflectance,
+                  bool copyBvh = true);
 
   // What light `light` of `lights` reaches. Zero area when it reaches nothing (zero power, or
   // enclosed): the caller falls back to the whole scene.
+  LightReach measure(RayBatch& rays, const LightSet& lights, std::size_t light) const;
+  // The same on the CPU's BVH.
   LightReach measure(const LightSet& lights, std::size_t light) const;
 
   // The same measurement in this (edited) scene, from `previous`, what `before` (the scene before
@@ -120,6 +129,8 @@ public:
   // have changed are traced again, those whose segment meets one of `changed` (the edited
   // objects' old and new boxes, padded by the caller for ray offsets) or whose end points moved.
   // The result equals measure() on this scene bit for bit (ReachedSurfaces.Remeasure* test it).
+  LightReach remeasure(RayBatch& rays, const ReachedSurfaces& before, const LightReach& previous,
+                       const LightSet& lights, std::size_t light, const std::vector<scene::Bounds>& changed) const;
   LightReach remeasure(const ReachedSurfaces& before, const LightReach& previous, const LightSet& lights,
                        std::size_t light, const std::vector<scene::Bounds>& changed) const;
 
@@ -127,7 +138,10 @@ public:
 
   // Seen points for the Seen fit (measure() then fits F_s); without them measure() leaves
   // seenFitted false.
+  void setSeenView(RayBatch& rays, const SeenView& view);
   void setSeenView(const SeenView& view);
+  // The BVH the CPU's rays run through (a copy of the one it was made with).
+  const bvh::Bvh& bvh() const { return bvhCopy_ ? *bvhCopy_ : *callersBvh_; }
   std::size_t seenPoints() const { return seen_.size(); }
 
   // Light rays per light and surface samples over the scene (OURS: a few thousand keep the
@@ -150,7 +164,7 @@ private:
     bool operator==(const SurfacePoint&) const = default;
   };
   struct Replay; // what remeasure reuses
-  LightReach trace(const LightSet& lights, std::size_t light, const Replay* replay) const;
+  LightReach trace(RayBatch& rays, const LightSet& lights, std::size_t light, const Replay* replay) const;
   struct Photon { // a landing point as a virtual point light of the Seen fit
     glm::vec3 position, normal, reflectance;
     glm::dvec3 flux;
@@ -164,9 +178,11 @@ private:
   float sceneRadius() const;
   BeamRect seenBoxAcross(glm::vec3 direction) const;
   bool beamCrossesSeenBox(glm::vec3 from, glm::vec3 direction) const;
-  std::vector<Photon> beamPhotons(const LightSet& lights, std::size_t light, StreamRng& rng) const;
+  std::vector<Photon> beamPhotons(RayBatch& rays, const LightSet& lights, std::size_t light, StreamRng& rng,
+                                  std::uint64_t& traced) const;
   const scene::Scene* scene_;
-  bvh::Bvh bvh_;
+  std::optional<bvh::Bvh> bvhCopy_;
+  const bvh::Bvh* callersBvh_; // bvh(): the copy when there is one
   std::vector<SurfacePoint> samples_;
   std::vector<glm::vec3> reflectance_; // per triangle
   std::vector<SurfacePoint> seen_;     // camera points (reflectance = R(P))

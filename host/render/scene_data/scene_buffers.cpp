@@ -223,6 +223,20 @@ bool SceneBuffers::updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh
   return true;
 }
 
+bool SceneBuffers::updateMaterials(const scene::Scene& scene) {
+  texturesAbsent_ = texturesAbsent(scene);
+  const std::vector<gpu::GpuMaterial> table = materialData(scene);
+  const std::size_t bytes = table.size() * sizeof(gpu::GpuMaterial);
+  if (bytes == materials_.buffer().size()) {
+    materials_.upload(*context_, table.data(), bytes);
+    return false;
+  }
+  bytes_ -= materials_.buffer().size();
+  materials_ = tableTexels(*context_, table, "materials", "scene.materials");
+  bytes_ += materials_.buffer().size();
+  return true;
+}
+
 void SceneBuffers::bindTo(gpu::Kernel& kernel, std::uint32_t set, const gpu::Buffer* status) const {
   const std::uint32_t kernelVectors = kernel.specConstant(gpu::kSpecConstantCompactStack);
   if (!bvh::compactStackHolds(kernelVectors, compactStackVectors_))

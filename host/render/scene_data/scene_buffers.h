@@ -98,6 +98,12 @@ public:
   // Returns true when the buffers were re-created. A caller with compact-stack kernels checks
   // compactStackVectors() after it: bound in place, they would not notice a deeper BVH.
   bool updateGeometry(const scene::Scene& scene, const bvh::Bvh& bvh);
+  // After an edit that added materials but no texture (an emissive quad, an inserted object whose
+  // materials use the scene's textures): the material table again, the textures kept (uploading
+  // modern-hall's again cost an edit hundreds of ms). Call with updateGeometry; returns true
+  // when the table's buffer was re-created (rebind). specialisation() may change: the kernels'
+  // texture lookups follow the materials.
+  bool updateMaterials(const scene::Scene& scene);
 
   // Marks the important secondary reflectors (one flag per triangle of `scene`, whose triangles
   // these buffers hold; secondary_reflectors.h). updateGeometry keeps the marks.

@@ -1,4 +1,4 @@
-#include "bench/ray_tracer.h"
+#include "render/ray_tracer.h"
 
 #include <algorithm>
 
@@ -6,12 +6,12 @@
 
 #include "trace.spv.h"
 
-namespace obscura::bench {
+namespace obscura::render {
 
 namespace {
 gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::uint32_t compactStackVectors,
-                                render::Traversal traversal) {
-  auto bindings = render::sceneBindingKinds();
+                                Traversal traversal) {
+  auto bindings = sceneBindingKinds();
   // rays (two RGBA32F texels each), hits (one RGBA32F texel each), steps (R32UI): texel views,
   // which lavapipe reads and writes a texel per lane at a time (an SSBO: a word per lane at a time).
   bindings.push_back(gpu::BindingKind::UniformTexelBuffer);
@@ -26,29 +26,31 @@ gpu::KernelDesc traceKernelDesc(const TraceShape& shape, bool recordSteps, std::
                             {gpu::kSpecConstantTraceWorkgroupSize, shape.workgroupSize},
                             {gpu::kSpecConstantCompactStack, compactStackVectors},
                             {gpu::kSpecConstantBvhItemsFromStorage, shape.bvhItemsFromStorage ? 1u : 0u},
-                            {gpu::kSpecConstantBvhLayout, render::bvhLayoutOf(traversal)},
-                            {gpu::kSpecConstantBinaryLoop, render::binaryWhileWhile(traversal) ? 1u : 0u},
+                            {gpu::kSpecConstantBvhLayout, bvhLayoutOf(traversal)},
+                            {gpu::kSpecConstantBinaryLoop, binaryWhileWhile(traversal) ? 1u : 0u},
                             {gpu::kSpecConstantBinaryCullOnPop, shape.binaryCullOnPop ? 1u : 0u}}};
 }
 } // namespace
 
-TraceShape TraceShape::forDevice(const gpu::Context& context, render::Traversal traversal) {
-  if (traversal != render::Traversal::Wide) return forBinary();
+TraceShape TraceShape::forDevice(const gpu::Context& context, Traversal traversal) {
+  if (traversal != Traversal::Wide) return forBinary();
   return context.info().type == "cpu" ? forCpu() : forGpu();
 }
 
-RayTracer::RayTracer(const gpu::Context& context, const render::SceneBuffers& scene, std::optional<TraceShape> shape,
+RayTracer::RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape,
                      std::optional<std::uint32_t> compactStackVectors)
-    : context_(&context), shape_(shape.value_or(TraceShape::forDevice(context, scene.traversal()))),
-      kernel_(context, traceKernelDesc(shape_, false, compactStackVectors.value_or(scene.compactStackVectors()),
-                                       scene.traversal())),
-      stepsKernel_(context, traceKernelDesc(shape_, true, compactStackVectors.value_or(scene.compactStackVectors()),
-                                            scene.traversal())),
-      timestamps_(context) {
-  scene.bindTo(kernel_);
-  scene.bindTo(stepsKernel_);
-  kernel_.bind(gpu::kBindingPassFirst + 3, scene.bvhItemsBuffer());
-  stepsKernel_.bind(gpu::kBindingPassFirst + 3, scene.bvhItemsBuffer());
+    : context_(&context), shape_(shape.value_or(TraceShape::forDevice(context, scene.traversal()))), scene_(&scene),
+      compactStackVectors_(compactStackVectors.value_or(scene.compactStackVectors())),
+      kernel_(context, traceKernelDesc(shape_, false, compactStackVectors_, scene.traversal())), timestamps_(context) {
+  rebind();
+}
+
+void RayTracer::rebind() {
+  for (gpu::Kernel* kernel : {&kernel_, stepsKernel_ ? &*stepsKernel_ : nullptr}) {
+    if (!kernel) continue;
+    scene_->bindTo(*kernel);
+    kernel->bind(gpu::kBindingPassFirst + 3, scene_->bvhItemsBuffer());
+  }
 }
 
 TraceResult RayTracer::trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps) {
@@ -85,7 +87,11 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
                              Usage::eStorageTexelBuffer, "trace.hits");
   gpu::TexelBuffer stepBuffer(*context_, recordSteps ? std::max(n, 1u) * 4ull : 4ull, vk::Format::eR32Uint,
                               Usage::eStorageTexelBuffer, "trace.steps");
-  gpu::Kernel& kernel = recordSteps ? stepsKernel_ : kernel_;
+  if (recordSteps && !stepsKernel_) {
+    stepsKernel_.emplace(*context_, traceKernelDesc(shape_, true, compactStackVectors_, scene_->traversal()));
+    rebind();
+  }
+  gpu::Kernel& kernel = recordSteps ? *stepsKernel_ : kernel_;
   kernel.bind(gpu::kBindingPassFirst, rayBuffer);
   kernel.bind(gpu::kBindingPassFirst + 1, hitBuffer);
   kernel.bind(gpu::kBindingPassFirst + 2, stepBuffer);
@@ -127,4 +133,4 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
   return result;
 }
 
-} // namespace obscura::bench
+} // namespace obscura::render

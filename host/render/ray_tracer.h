@@ -1,5 +1,6 @@
 // ray_tracer.h — traces a list of rays on the GPU with the production traversal (trace.comp).
-// Used by `obscura bench-rays` and the traversal tests, so the benchmark measures tested code.
+// Used by `obscura bench-rays` and the traversal tests, so the benchmark measures tested code, and
+// by the reach measurement (GpuRayBatch), whose rays an edit would otherwise wait for on the CPU.
 #pragma once
 #include <optional>
 #include <span>
@@ -9,7 +10,7 @@
 #include "gpu/timestamps.h"
 #include "render/scene_data/scene_buffers.h"
 
-namespace obscura::bench {
+namespace obscura::render {
 
 enum class TraceMode : std::uint32_t { Closest = 0, Any = 1 };
 
@@ -37,7 +38,7 @@ struct TraceShape {
   // ray gets); other shapes refill (lib/bvh_stream.glsl, traverseBinaryStream).
   static TraceShape forBinary() { return {gpu::kTraceBinaryWorkgroupSize, 1}; }
   // For the wide layout forCpu() on a CPU device, forGpu() otherwise; forBinary() for a binary one.
-  static TraceShape forDevice(const gpu::Context& context, render::Traversal traversal);
+  static TraceShape forDevice(const gpu::Context& context, Traversal traversal);
 };
 
 class RayTracer {
@@ -46,9 +47,12 @@ public:
   // `compactStackVectors` (kSpecConstantCompactStack) defaults to what the scene's BVH needs; a
   // test may force the general kernel (0) or any compact stack (which throws where the BVH
   // could overflow it).
-  RayTracer(const gpu::Context& context, const render::SceneBuffers& scene, std::optional<TraceShape> shape = {},
+  RayTracer(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape = {},
             std::optional<std::uint32_t> compactStackVectors = {});
   const TraceShape& shape() const { return shape_; }
+  // The scene's buffers were made again or re-uploaded (a geometry edit): bind them anew. The
+  // traversal and stack the kernel was made for must still hold (SceneBuffers::specialisation).
+  void rebind();
 
   TraceResult trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps = false);
   // The same rays traced `repeats` times back to back in one submission, each repeat timed: a
@@ -63,9 +67,11 @@ private:
 
   const gpu::Context* context_;
   TraceShape shape_;
-  gpu::Kernel kernel_;      // the timed one
-  gpu::Kernel stepsKernel_; // also records each ray's loop passes (compiled on first use)
+  const SceneBuffers* scene_;
+  std::uint32_t compactStackVectors_;
+  gpu::Kernel kernel_;                     // the timed one
+  std::optional<gpu::Kernel> stepsKernel_; // also records each ray's loop passes (made on first use)
   gpu::Timestamps timestamps_;
 };
 
-} // namespace obscura::bench
+} // namespace obscura::render

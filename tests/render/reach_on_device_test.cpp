@@ -1,0 +1,134 @@
+// What a light reaches (render/scene_data/reached_surfaces.h) measured with its rays traced on the
+// device (GpuRayBatch: trace.comp through the scene's buffers, as a renderer does) against the
+// same measurement on the CPU's BVH (CpuRayBatch, the twin). The two traversals agree on a ray's
+// hit up to rounding, so a ray that grazes an edge may land on the neighbouring triangle: the
+// tolerances allow a few such rays in a thousand and nothing more.
+#include <bit>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "bvh/bvh.h"
+#include "gpu_test.h"
+#include "render/gpu_ray_batch.h"
+#include "render/scene_data/ambient.h"
+#include "render/scene_data/bvh_layout.h"
+#include "render/scene_data/reached_surfaces.h"
+#include "render/scene_data/scene_buffers.h"
+#include "scene/gltf_loader.h"
+#include "scene/scene_edit.h"
+
+namespace obscura::test {
+namespace {
+
+std::vector<glm::vec3> reflectances(const scene::Scene& s) {
+  std::vector<glm::vec3> albedo;
+  for (const auto& m : s.materials) albedo.push_back(render::materialMeanAlbedo(m));
+  return render::triangleReflectances(s, albedo);
+}
+
+// The Cornell box's own lamp, a point light, a spot and the sun (through the open front): every
+// way a light's points and directions are drawn.
+render::LightSet everyKindOfLight(const scene::Scene& s) {
+  render::LightSet lights = render::buildLightSet(s);
+  scene::PunctualLight point{.name = "bulb", .type = scene::PunctualType::Point, .intensity = 3.0f,
+                             .position = {0.3f, 1.2f, 0.2f}};
+  scene::PunctualLight spot{.name = "spot", .type = scene::PunctualType::Spot, .intensity = 5.0f,
+                            .position = {-0.4f, 1.6f, 0.3f}, .direction = glm::normalize(glm::vec3(0.3f, -1.0f, -0.2f)),
+                            .outerConeAngle = 0.5f};
+  scene::PunctualLight sun{.name = "sun", .type = scene::PunctualType::Directional, .intensity = 2.0f,
+                           .direction = glm::normalize(glm::vec3(-0.2f, -0.3f, -1.0f))};
+  for (const auto& l : {point, spot, sun}) render::appendPunctual(lights, l, s.bounds);
+  return lights;
+}
+
+render::SeenView cornellView(const scene::Scene& s) {
+  const scene::Camera& c = s.cameras.front();
+  return {.position = c.position, .forward = c.forward, .up = c.up, .yfov = c.yfov, .aspect = 1.0f, .dMax = 0.5f};
+}
+
+class ReachOnDevice : public GpuTest {};
+
+TEST_F(ReachOnDevice, MatchesTheCpuTwinForEveryKindOfLight) {
+  const scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(s), render::treeOptionsFor(render::traversalFor(context())));
+  const render::LightSet lights = everyKindOfLight(s);
+  const render::SceneBuffers buffers(context(), s, tree);
+  render::GpuRayBatch device(context(), buffers);
+  render::ReachedSurfaces onDevice(s, tree, reflectances(s), /*copyBvh=*/false);
+  render::ReachedSurfaces onCpu(s, tree, reflectances(s));
+  onDevice.setSeenView(device, cornellView(s));
+  onCpu.setSeenView(cornellView(s));
+  ASSERT_EQ(onDevice.seenPoints(), onCpu.seenPoints()) << "the camera's grid points hit the same surfaces";
+  ASSERT_GT(onCpu.seenPoints(), 0u);
+
+  for (std::size_t light = 0; light < lights.size(); ++light) {
+    SCOPED_TRACE(lights.names[light]);
+    const render::LightReach gpu = onDevice.measure(device, lights, light);
+    const render::LightReach cpu = onCpu.measure(lights, light);
+    ASSERT_EQ(gpu.rays.landingPrimitive.size(), cpu.rays.landingPrimitive.size());
+    std::size_t sameLanding = 0, sameSeenTry = 0;
+    for (std::size_t i = 0; i < cpu.rays.landingPrimitive.size(); ++i)
+      sameLanding += gpu.rays.landingPrimitive[i] == cpu.rays.landingPrimitive[i] ? 1 : 0;
+    for (std::size_t j = 0; j < cpu.rays.firstSeenTry.size(); ++j)
+      sameSeenTry += gpu.rays.firstSeenTry[j] == cpu.rays.firstSeenTry[j] ? 1 : 0;
+    EXPECT_GE(sameLanding, cpu.rays.landingPrimitive.size() * 995 / 1000) << "light rays landing elsewhere";
+    EXPECT_GE(sameSeenTry, cpu.rays.firstSeenTry.size() * 995 / 1000) << "surface samples seeing otherwise";
+    EXPECT_GT(cpu.fraction, 0.0);
+    EXPECT_NEAR(gpu.fraction, cpu.fraction, 0.005);
+    EXPECT_NEAR(gpu.escapeDirect, cpu.escapeDirect, 0.005);
+    EXPECT_NEAR(gpu.escapeBounce, cpu.escapeBounce, 0.01);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(gpu.reflectance[c], cpu.reflectance[c], 0.01f);
+    ASSERT_TRUE(gpu.seenFitted && cpu.seenFitted);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_GT(cpu.seenFirstBounce[c], 0.0f);
+      EXPECT_NEAR(gpu.seenFirstBounce[c], cpu.seenFirstBounce[c], 0.03f * cpu.seenFirstBounce[c]);
+    }
+  }
+}
+
+// An edit's re-measurement on the device, re-tracing only the rays the move can change, gives
+// exactly what measuring the moved scene on the device from scratch gives: the device's traversal
+// finds the same hit for a ray whatever else moved.
+TEST_F(ReachOnDevice, RemeasureAfterAMoveEqualsMeasuringTheMovedScene) {
+  const scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
+  const bvh::BuildOptions options = render::treeOptionsFor(render::traversalFor(context()));
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(s), options);
+  const render::LightSet lights = everyKindOfLight(s);
+  const render::SceneBuffers buffers(context(), s, tree);
+  render::GpuRayBatch device(context(), buffers);
+  render::ReachedSurfaces reached(s, tree, reflectances(s), false);
+  std::vector<render::LightReach> before;
+  for (std::size_t light = 0; light < lights.size(); ++light) before.push_back(reached.measure(device, lights, light));
+
+  scene::Scene moved = s;
+  const std::size_t cube = scene::objectIndex(moved, "cube_2", "test");
+  std::vector<scene::Bounds> changed{scene::objectBounds(moved, cube)};
+  scene::moveObject(moved, cube, {0.3f, 0.0f, 0.0f}, glm::vec3(0.0f));
+  changed.push_back(scene::objectBounds(moved, cube));
+  for (scene::Bounds& b : changed) b = {b.lo - 1e-3f, b.hi + 1e-3f};
+  bvh::Bvh movedTree = tree;
+  bvh::refit(movedTree, render::triangleSoup(moved));
+  const render::SceneBuffers movedBuffers(context(), moved, movedTree);
+  render::GpuRayBatch movedDevice(context(), movedBuffers);
+  render::ReachedSurfaces movedReach(moved, movedTree, reflectances(moved), false);
+
+  for (std::size_t light = 0; light < lights.size(); ++light) {
+    SCOPED_TRACE(lights.names[light]);
+    const render::LightReach fresh = movedReach.measure(movedDevice, lights, light);
+    const render::LightReach replayed = movedReach.remeasure(movedDevice, reached, before[light], lights, light, changed);
+    EXPECT_EQ(replayed.rays.landingPrimitive, fresh.rays.landingPrimitive);
+    EXPECT_EQ(replayed.rays.firstSeenTry, fresh.rays.firstSeenTry);
+    for (std::size_t i = 0; i < fresh.rays.landingT.size(); ++i)
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(replayed.rays.landingT[i]), std::bit_cast<std::uint32_t>(fresh.rays.landingT[i]))
+          << "light ray " << i;
+    EXPECT_EQ(replayed.area, fresh.area);
+    EXPECT_EQ(replayed.escapeDirect, fresh.escapeDirect);
+    EXPECT_EQ(replayed.escapeBounce, fresh.escapeBounce);
+    EXPECT_EQ(replayed.landedTriangles, fresh.landedTriangles);
+    EXPECT_LT(replayed.rays.traced, fresh.rays.traced) << "the replay traced every ray again";
+  }
+}
+
+} // namespace
+} // namespace obscura::test
