@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "core/host_cpu_time.h"
+#include "render/scene_data/ray_rounds.h"
 #include "render/scene_data/scene_buffers.h"
 
 namespace obscura::render {
@@ -139,10 +140,20 @@ std::vector<LightReach> LightReachModel::reachOfEveryLight(const ReachedSurfaces
                                                            const std::vector<scene::Bounds>& changed) const {
   const bool incremental = before && previous.size() == lights.size();
   std::vector<LightReach> reach(lights.size());
-  if (rays_) { // the device's: a light at a time, each a few submissions
+  if (rays_) {
+    // The device's: every light on a thread of its own, their stages traced together (RayRounds),
+    // a few submissions in all.
+    RayRounds rounds(*rays_, lights.size());
+    std::vector<std::future<void>> measured;
     for (std::size_t s = 0; s < lights.size(); ++s)
-      reach[s] = incremental ? reached.remeasure(*rays_, *before, previous[s], lights, s, changed)
-                             : reached.measure(*rays_, lights, s);
+      measured.push_back(std::async(std::launch::async, [&, s] {
+        const HelperThreadCpu counted; // the edit's host work
+        RayRounds::Member member(rounds);
+        reach[s] = incremental ? reached.remeasure(member, *before, previous[s], lights, s, changed)
+                               : reached.measure(member, lights, s);
+      }));
+    for (auto& m : measured) m.wait(); // all of them before any error leaves `rounds`
+    for (auto& m : measured) m.get();
     return reach;
   }
   // Lights spread over the cores (measure is const and draws its own numbers): the CPU rays of

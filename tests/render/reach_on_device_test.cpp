@@ -5,6 +5,7 @@
 // tolerances allow a few such rays in a thousand and nothing more.
 #include <bit>
 #include <cmath>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,7 @@
 #include "render/gpu_ray_batch.h"
 #include "render/scene_data/ambient.h"
 #include "render/scene_data/bvh_layout.h"
+#include "render/scene_data/ray_rounds.h"
 #include "render/scene_data/reached_surfaces.h"
 #include "render/scene_data/scene_buffers.h"
 #include "scene/gltf_loader.h"
@@ -85,6 +87,46 @@ TEST_F(ReachOnDevice, MatchesTheCpuTwinForEveryKindOfLight) {
       EXPECT_NEAR(gpu.seenFirstBounce[c], cpu.seenFirstBounce[c], 0.03f * cpu.seenFirstBounce[c]);
     }
   }
+}
+
+// Every light on a thread of its own with their stages traced together in one submission per
+// round (RayRounds, as LightReachModel measures them on the device) finds what each light measured
+// alone finds, ray for ray: merging the rays changes no ray's hit.
+TEST_F(ReachOnDevice, LightsMeasuredTogetherEqualEachMeasuredAlone) {
+  const scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(s), render::treeOptionsFor(render::traversalFor(context())));
+  const render::LightSet lights = everyKindOfLight(s);
+  const render::SceneBuffers buffers(context(), s, tree);
+  render::GpuRayBatch device(context(), buffers);
+  render::ReachedSurfaces reached(s, tree, reflectances(s), false);
+  reached.setSeenView(device, cornellView(s));
+  std::vector<render::LightReach> alone;
+  for (std::size_t light = 0; light < lights.size(); ++light) alone.push_back(reached.measure(device, lights, light));
+
+  const std::uint64_t raysBefore = device.rays();
+  std::vector<render::LightReach> together(lights.size());
+  {
+    render::RayRounds rounds(device, lights.size());
+    std::vector<std::thread> threads;
+    for (std::size_t light = 0; light < lights.size(); ++light)
+      threads.emplace_back([&, light] {
+        render::RayRounds::Member member(rounds);
+        together[light] = reached.measure(member, lights, light);
+      });
+    for (auto& t : threads) t.join();
+  }
+  std::uint64_t traced = 0;
+  for (std::size_t light = 0; light < lights.size(); ++light) {
+    SCOPED_TRACE(lights.names[light]);
+    EXPECT_EQ(together[light].rays.landingPrimitive, alone[light].rays.landingPrimitive);
+    EXPECT_EQ(together[light].rays.firstSeenTry, alone[light].rays.firstSeenTry);
+    EXPECT_EQ(together[light].rays.tryBlockedAt.size(), alone[light].rays.tryBlockedAt.size());
+    EXPECT_EQ(together[light].area, alone[light].area);
+    EXPECT_EQ(together[light].escapeBounce, alone[light].escapeBounce);
+    EXPECT_EQ(together[light].seenFirstBounce, alone[light].seenFirstBounce);
+    traced += together[light].rays.traced;
+  }
+  EXPECT_EQ(device.rays() - raysBefore, traced) << "every ray traced once, through the device";
 }
 
 // An edit's re-measurement on the device, re-tracing only the rays the move can change, gives
