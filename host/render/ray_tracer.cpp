@@ -50,7 +50,31 @@ void RayTracer::rebind() {
     if (!kernel) continue;
     scene_->bindTo(*kernel);
     kernel->bind(gpu::kBindingPassFirst + 3, scene_->bvhItemsBuffer());
+    if (capacity_ == 0) continue;
+    kernel->bind(gpu::kBindingPassFirst, rayBuffer_);
+    kernel->bind(gpu::kBindingPassFirst + 1, hitBuffer_);
+    kernel->bind(gpu::kBindingPassFirst + 2, stepBuffer_);
   }
+}
+
+void RayTracer::reserve(std::size_t rays) {
+  if (rays <= capacity_) return;
+  using Usage = vk::BufferUsageFlagBits;
+  std::size_t capacity = 4096;
+  while (capacity < rays) capacity *= 2;
+  const std::size_t maxRays = context_->info().maxTexelBufferElements / 2;
+  capacity = std::min(capacity, std::max(maxRays, rays));
+  rayBuffer_ = gpu::TexelBuffer(*context_, capacity * sizeof(gpu::GpuRay), vk::Format::eR32G32B32A32Sfloat, {},
+                                "trace.rays");
+  hitBuffer_ = gpu::TexelBuffer(*context_, capacity * sizeof(gpu::GpuHit), vk::Format::eR32G32B32A32Sfloat,
+                                Usage::eStorageTexelBuffer, "trace.hits");
+  stepBuffer_ = gpu::TexelBuffer(*context_, capacity * 4ull, vk::Format::eR32Uint, Usage::eStorageTexelBuffer,
+                                 "trace.steps");
+  rayStaging_ = gpu::Buffer(*context_, capacity * sizeof(gpu::GpuRay), {}, "trace.rays.staging", gpu::Residence::Host);
+  hitReadback_ = gpu::Buffer(*context_, capacity * sizeof(gpu::GpuHit), {}, "trace.hits.readback", gpu::Residence::Host);
+  stepReadback_ = gpu::Buffer(*context_, capacity * 4ull, {}, "trace.steps.readback", gpu::Residence::Host);
+  capacity_ = capacity;
+  rebind();
 }
 
 TraceResult RayTracer::trace(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps) {
@@ -78,23 +102,14 @@ TraceResult RayTracer::traceRepeated(std::span<const gpu::GpuRay> rays, TraceMod
 
 TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps,
                                     std::uint32_t repeats) {
-  using Usage = vk::BufferUsageFlagBits;
   const auto n = static_cast<std::uint32_t>(rays.size());
-  gpu::TexelBuffer rayBuffer(*context_, std::max<std::size_t>(rays.size_bytes(), sizeof(gpu::GpuRay)),
-                             vk::Format::eR32G32B32A32Sfloat, {}, "trace.rays");
-  if (n) rayBuffer.upload(*context_, rays.data(), rays.size_bytes());
-  gpu::TexelBuffer hitBuffer(*context_, std::max(n, 1u) * sizeof(gpu::GpuHit), vk::Format::eR32G32B32A32Sfloat,
-                             Usage::eStorageTexelBuffer, "trace.hits");
-  gpu::TexelBuffer stepBuffer(*context_, recordSteps ? std::max(n, 1u) * 4ull : 4ull, vk::Format::eR32Uint,
-                              Usage::eStorageTexelBuffer, "trace.steps");
   if (recordSteps && !stepsKernel_) {
     stepsKernel_.emplace(*context_, traceKernelDesc(shape_, true, compactStackVectors_, scene_->traversal()));
     rebind();
   }
+  reserve(std::max<std::size_t>(n, 1));
+  if (n) rayStaging_.upload(*context_, rays.data(), rays.size_bytes());
   gpu::Kernel& kernel = recordSteps ? *stepsKernel_ : kernel_;
-  kernel.bind(gpu::kBindingPassFirst, rayBuffer);
-  kernel.bind(gpu::kBindingPassFirst + 1, hitBuffer);
-  kernel.bind(gpu::kBindingPassFirst + 2, stepBuffer);
 
   const std::string label = mode == TraceMode::Closest ? "trace.closest" : "trace.any";
   const std::uint32_t maxGroups = std::min(context_->info().maxComputeWorkGroupCount[0], 65535u);
@@ -104,15 +119,24 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
   std::vector<double> before(repeats, 0.0);
   for (std::uint32_t r = 0; r < repeats; ++r)
     if (timestamps_.totalsMs().contains(repeatLabel(r))) before[r] = timestamps_.totalsMs().at(repeatLabel(r));
+  const vk::DeviceSize hitBytes = vk::DeviceSize(n) * sizeof(gpu::GpuHit), stepBytes = vk::DeviceSize(n) * 4;
   context_->submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
     timestamps_.reset(cmd);
+    if (n) {
+      cmd.copyBuffer(rayStaging_.handle(), rayBuffer_.buffer().handle(), vk::BufferCopy{.size = rays.size_bytes()});
+      const vk::MemoryBarrier uploaded{.srcAccessMask = vk::AccessFlagBits::eTransferWrite,
+                                       .dstAccessMask = vk::AccessFlagBits::eShaderRead};
+      cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader, {}, uploaded,
+                          nullptr, nullptr);
+    }
+    const vk::MemoryBarrier written{.srcAccessMask = vk::AccessFlagBits::eShaderWrite,
+                                    .dstAccessMask = vk::AccessFlagBits::eShaderWrite};
+    const vk::MemoryBarrier toCopy{.srcAccessMask = vk::AccessFlagBits::eShaderWrite,
+                                   .dstAccessMask = vk::AccessFlagBits::eTransferRead};
     for (std::uint32_t r = 0; r < repeats; ++r) {
-      if (r > 0) { // the repeats write the same hits
-        vk::MemoryBarrier barrier{.srcAccessMask = vk::AccessFlagBits::eShaderWrite,
-                                  .dstAccessMask = vk::AccessFlagBits::eShaderWrite};
+      if (r > 0) // the repeats write the same hits
         cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
-                            barrier, nullptr, nullptr);
-      }
+                            written, nullptr, nullptr);
       timestamps_.begin(cmd, repeatLabel(r));
       for (std::uint32_t first = 0; first < n; first += raysPerDispatch) {
         std::uint32_t count = std::min(raysPerDispatch, n - first);
@@ -121,15 +145,28 @@ TraceResult RayTracer::traceFitting(std::span<const gpu::GpuRay> rays, TraceMode
       }
       timestamps_.end(cmd, repeatLabel(r));
     }
+    if (n == 0) return;
+    // The hits (and steps) into host memory in the same submission: no second one to read back.
+    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eTransfer, {}, toCopy,
+                        nullptr, nullptr);
+    cmd.copyBuffer(hitBuffer_.buffer().handle(), hitReadback_.handle(), vk::BufferCopy{.size = hitBytes});
+    if (recordSteps) cmd.copyBuffer(stepBuffer_.buffer().handle(), stepReadback_.handle(), vk::BufferCopy{.size = stepBytes});
+    const vk::MemoryBarrier copied{.srcAccessMask = vk::AccessFlagBits::eTransferWrite,
+                                   .dstAccessMask = vk::AccessFlagBits::eHostRead};
+    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eHost, {}, copied, nullptr,
+                        nullptr);
   });
   timestamps_.collect();
   TraceResult result;
   for (std::uint32_t r = 0; r < repeats; ++r)
     result.repeatGpuMs.push_back(timestamps_.available() ? timestamps_.totalsMs().at(repeatLabel(r)) - before[r] : 0.0);
   result.gpuMs = result.repeatGpuMs.front();
-  result.hits = hitBuffer.buffer().download<gpu::GpuHit>(*context_);
   result.hits.resize(n);
-  if (recordSteps) result.steps = stepBuffer.buffer().download<std::uint32_t>(*context_);
+  if (n) hitReadback_.download(*context_, result.hits.data(), hitBytes);
+  if (recordSteps) {
+    result.steps.resize(n);
+    if (n) stepReadback_.download(*context_, result.steps.data(), stepBytes);
+  }
   return result;
 }
 

@@ -64,6 +64,10 @@ public:
 private:
   TraceResult traceFitting(std::span<const gpu::GpuRay> rays, TraceMode mode, bool recordSteps,
                            std::uint32_t repeats);
+  // The buffers of a trace of `rays` rays, kept from one trace to the next and grown when a trace
+  // needs more (rebinding them): a renderer traces a few small sets per edit (the lights' reach),
+  // and allocating device memory, staging and an extra submission for each cost an H200 ~4 ms.
+  void reserve(std::size_t rays);
 
   const gpu::Context* context_;
   TraceShape shape_;
@@ -72,6 +76,10 @@ private:
   gpu::Kernel kernel_;                     // the timed one
   std::optional<gpu::Kernel> stepsKernel_; // also records each ray's loop passes (made on first use)
   gpu::Timestamps timestamps_;
+  std::size_t capacity_ = 0;  // rays the buffers below hold
+  gpu::TexelBuffer rayBuffer_, hitBuffer_, stepBuffer_;
+  // Host memory the rays come from and the hits go to, copied in the trace's own submission.
+  gpu::Buffer rayStaging_, hitReadback_, stepReadback_;
 };
 
 } // namespace obscura::render
