@@ -82,6 +82,33 @@ void Buffer::download(const Context& context, void* data, vk::DeviceSize size,
   staging.download(context, data, size);
 }
 
+void UploadBatch::add(Buffer& destination, const void* data, vk::DeviceSize size) {
+  if (size == 0) return;
+  if (size > destination.size())
+    throw std::logic_error(fmt::format("upload of {} bytes overflows buffer '{}' ({} bytes)", size,
+                                       destination.name(), destination.size()));
+  if (destination.mapped()) {
+    destination.upload(*context_, data, size);
+    return;
+  }
+  const auto at = static_cast<vk::DeviceSize>(staged_.size());
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  staged_.insert(staged_.end(), bytes, bytes + size);
+  copies_.push_back({destination.handle(), at, size});
+}
+
+void UploadBatch::submit() {
+  if (copies_.empty()) return;
+  Buffer staging(*context_, staged_.size(), {}, "upload_batch.staging", Residence::Host);
+  staging.upload(*context_, staged_.data(), staged_.size());
+  context_->submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
+    for (const Copy& c : copies_)
+      cmd.copyBuffer(staging.handle(), c.destination, vk::BufferCopy{.srcOffset = c.at, .dstOffset = 0, .size = c.size});
+  });
+  copies_.clear();
+  staged_.clear();
+}
+
 void Buffer::fill(const Context& context, std::uint32_t value) {
   context.submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
     cmd.fillBuffer(*buffer_, 0, VK_WHOLE_SIZE, value);

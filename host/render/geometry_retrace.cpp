@@ -9,8 +9,8 @@ namespace obscura::render {
 GeometryRetrace::GeometryRetrace(const gpu::Context& context, const FrameLayout& layout, const bvh::Bvh& bvh)
     : dirty_(context, layout.bandCount()), bvhOrder_(bvh.order), bvhNodes_(bvh.nodes.size()) {}
 
-void GeometryRetrace::setLights(const gpu::Context& context, const LightSet& lights) {
-  lightBounds_ = gpu::uploadArray(context, lightBounds(lights), "dirty.light_bounds");
+bool GeometryRetrace::setLights(const gpu::Context& context, const LightSet& lights, gpu::UploadBatch& uploads) {
+  return gpu::refillArray(context, uploads, lightBounds_, lightBounds(lights), "dirty.light_bounds");
 }
 
 void GeometryRetrace::useBvh(const bvh::Bvh& bvh) {

@@ -47,8 +47,9 @@ class GeometryRetrace {
 public:
   GeometryRetrace(const gpu::Context& context, const FrameLayout& layout, const bvh::Bvh& bvh);
 
-  // The lights whose shafts the dirty test follows (after every change of the light set).
-  void setLights(const gpu::Context& context, const LightSet& lights);
+  // The lights whose shafts the dirty test follows (after every change of the light set), through
+  // `uploads`; true when their buffer was made anew (bind again).
+  bool setLights(const gpu::Context& context, const LightSet& lights, gpu::UploadBatch& uploads);
   void bind(std::uint32_t band, const ObscuranceFrame& frame) { dirty_.bind(band, frame, lightBounds_); }
 
   // The scene's BVH is now `bvh`: a rebuild lays the triangles out anew, and the kept lobe hits

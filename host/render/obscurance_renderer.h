@@ -283,7 +283,9 @@ private:
   // Makes the tracing passes again for what a scene needs (SceneBuffers::specialisation); bind
   // them after.
   void makeTracingPasses(const SceneSpecialisation& scene);
-  void uploadLights();
+  // The light tables to the device (refilled in place where they fit); `bind`: bind every kernel
+  // again even where no table was made anew (the scene's buffers were).
+  void uploadLights(bool bind = false);
   // Records `record(band)` for every band of the frame, timed as one pass named `label`.
   template <class Record>
   void recordBands(const vk::raii::CommandBuffer& cmd, const std::string& label, Record&& record) {

@@ -86,26 +86,10 @@ step() { # name command...: runs it under a time limit, everything into log.txt
   cat "$work/modern-hall-wide.metrics.json"; echo
   step render-sponza "$obscura" render "$sponza_scene" --width "${sponza[0]}" --height "${sponza[1]}" \
     --spp 8 --background 2,2,2 -o "$out/sponza.png" --metrics "$out/sponza.metrics.json"
-  cat > "$work/edits.json" <<'JSON'
-[{"light": "light_rectangle_6", "scale": 0.3},
- {"light": "light_rectangle_6", "color": [1.0, 0.6, 0.3]},
- {"add_light": {"type": "point", "name": "bench_bulb", "position": [0.0, 3.0, 1.0], "color": [1, 1, 1], "intensity": 5}},
- {"remove_light": "bench_bulb"},
- {"move": "Mesh017", "translate": [0.1, 0.0, 0.1]},
- {"add_light": {"type": "quad", "name": "bench_panel", "corner": [0.0, 3.0, 1.0], "edge1": [0.5, 0, 0],
-                "edge2": [0, 0, 0.5], "emission": [4, 4, 4]}},
- {"light": "light_rectangle_6", "scale": 0.6},
- {"light": "light_rectangle_6", "color": [0.8, 0.8, 1.0]},
- {"add_light": {"type": "point", "name": "bench_bulb_2", "position": [0.5, 2.5, 0.5], "color": [1, 1, 1], "intensity": 5}},
- {"remove_light": "bench_bulb_2"},
- {"move": "Mesh017", "translate": [-0.1, 0.0, -0.1]},
- {"add_light": {"type": "quad", "name": "bench_panel_2", "corner": [1.0, 3.0, 1.0], "edge1": [0.5, 0, 0],
-                "edge2": [0, 0, 0.5], "emission": [4, 4, 4]}}]
-JSON
   step view-offscreen "$obscura" view "$hall_scene" --offscreen --width "${view[0]}" --height "${view[1]}" --spp 1 \
     --script "$tools/view_benchmark_script.json" --log "$out/view.jsonl" --screenshot "$out/view.png"
   python3 "$tools/../view_log_summary.py" "$out/view.jsonl"
-  step relight-hall "$obscura" relight "$hall_scene" --edits "$work/edits.json" \
+  step relight-hall "$obscura" relight "$hall_scene" --edits "$tools/bench_edits.json" \
     -o "$work/relight" --width "${hall[0]}" --height "${hall[1]}" --spp 1 --png
   cat "$work/relight/edits.jsonl"
   cp "$work/relight/frame-012.png" "$out/relight-last-frame.png"

@@ -51,6 +51,24 @@ gpu::TexelBuffer tableTexels(const gpu::Context& context, const std::vector<Row>
                       : gpu::TexelBuffer(context, rows.data(), rows.size() * sizeof(Row), name);
 }
 
+// tableTexels' rows into `table` through `uploads`, keeping the buffer where it holds them and
+// else making it twice as large as they need (gpu::refillArray's rule); true when it made a new one.
+template <typename Row>
+bool refillTable(const gpu::Context& context, gpu::UploadBatch& uploads, gpu::TexelBuffer& table,
+                 const std::vector<Row>& rows, const char* what, const std::string& name) {
+  static_assert(sizeof(Row) % sizeof(gpu::vec4) == 0, "a row is whole RGBA32F texels");
+  const std::size_t count = std::max<std::size_t>(rows.size(), 1);
+  bool made = false;
+  if (table.buffer().size() < count * sizeof(Row)) {
+    checkTexelLimit(context, 2 * count * (sizeof(Row) / sizeof(gpu::vec4)), what);
+    table = gpu::TexelBuffer(context, 2 * count * sizeof(Row), vk::Format::eR32G32B32A32Sfloat, {}, name);
+    made = true;
+  }
+  if (rows.empty()) uploads.add(table.buffer(), std::vector<Row>(1));
+  else uploads.add(table.buffer(), rows);
+  return made;
+}
+
 // What the kernels that trace and shade a scene are specialised for, as the scene needs: the
 // compact traversal stack of its BVH (kSpecConstantCompactStack; 0: the general stack with its
 // second loop) and the kinds of texture none of its materials uses (kSpecConstantTexturesAbsent:
