@@ -1,6 +1,7 @@
 #include "gpu/buffer.h"
 
 #include <cstring>
+#include <optional>
 
 #include <fmt/core.h>
 
@@ -99,11 +100,25 @@ void UploadBatch::add(Buffer& destination, const void* data, vk::DeviceSize size
 
 void UploadBatch::submit() {
   if (copies_.empty()) return;
-  Buffer staging(*context_, staged_.size(), {}, "upload_batch.staging", Residence::Host);
-  staging.upload(*context_, staged_.data(), staged_.size());
+  // Small uploads go inline in the command buffer (vkCmdUpdateBuffer: at most 65,536 bytes, whole
+  // words), with no staging memory to allocate; larger ones through one staging buffer.
+  constexpr vk::DeviceSize kInline = 65536;
+  vk::DeviceSize stagedBytes = 0;
+  for (const Copy& c : copies_)
+    if (c.size > kInline || c.size % 4 != 0) stagedBytes += c.size;
+  std::optional<Buffer> staging;
+  if (stagedBytes > 0) {
+    staging.emplace(*context_, staged_.size(), vk::BufferUsageFlags{}, "upload_batch.staging", Residence::Host);
+    staging->upload(*context_, staged_.data(), staged_.size());
+  }
   context_->submitAndWait([&](const vk::raii::CommandBuffer& cmd) {
-    for (const Copy& c : copies_)
-      cmd.copyBuffer(staging.handle(), c.destination, vk::BufferCopy{.srcOffset = c.at, .dstOffset = 0, .size = c.size});
+    for (const Copy& c : copies_) {
+      if (c.size <= kInline && c.size % 4 == 0)
+        cmd.updateBuffer<std::uint8_t>(
+            c.destination, 0, vk::ArrayProxy<const std::uint8_t>(static_cast<std::uint32_t>(c.size), staged_.data() + c.at));
+      else
+        cmd.copyBuffer(staging->handle(), c.destination, vk::BufferCopy{.srcOffset = c.at, .dstOffset = 0, .size = c.size});
+    }
   });
   copies_.clear();
   staged_.clear();

@@ -493,7 +493,10 @@ void ObscuranceRenderer::setEmissions(const std::vector<glm::vec3>& emissions) {
   if (emissions.size() != lights_.size())
     throw std::logic_error(fmt::format("setEmissions: {} emissions for {} lights", emissions.size(), lights_.size()));
   emissions_ = emissions;
-  emissionBuffer_.upload(*context_, emissionRows(emissions_));
+  // Inline in one small submission (UploadBatch): a light's scale or colour is this upload alone.
+  gpu::UploadBatch uploads(*context_);
+  uploads.add(emissionBuffer_, emissionRows(emissions_));
+  uploads.submit();
 }
 
 void ObscuranceRenderer::setAmbientModel(AmbientModel model) {
@@ -807,7 +810,7 @@ void ObscuranceRenderer::removeLight(std::size_t index) {
     // Area lights stay: their triangles name them by index. Off is a scale of 0, which is what
     // a scene without that emission renders (D_s, M_s and I_a's share all vanish).
     emissions_[index] = glm::vec3(0.0f);
-    emissionBuffer_.upload(*context_, emissionRows(emissions_));
+    setEmissions(emissions_);
     return;
   }
   frame_.removeLightSlot(stream_, static_cast<std::uint32_t>(index));
