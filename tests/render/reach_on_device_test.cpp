@@ -17,8 +17,8 @@
 #include "render/scene_data/ray_rounds.h"
 #include "render/scene_data/reached_surfaces.h"
 #include "render/scene_data/scene_buffers.h"
+#include "render/test_scenes.h"
 #include "scene/gltf_loader.h"
-#include "scene/scene_edit.h"
 
 namespace obscura::test {
 namespace {
@@ -49,14 +49,26 @@ render::SeenView cornellView(const scene::Scene& s) {
   return {.position = c.position, .forward = c.forward, .up = c.up, .yfov = c.yfov, .aspect = 1.0f, .dMax = 0.5f};
 }
 
-class ReachOnDevice : public GpuTest {};
+// The Cornell box with every kind of light, its tree as the device's traversal wants it, and its
+// buffers on the device with a GpuRayBatch over them.
+class ReachOnDevice : public GpuTest {
+protected:
+  ReachOnDevice()
+      : scene_(scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"))),
+        tree_(bvh::build(render::triangleSoup(scene_), render::treeOptionsFor(render::traversalFor(context())))),
+        lights_(everyKindOfLight(scene_)), buffers_(context(), scene_, tree_), device_(context(), buffers_) {}
+  const scene::Scene scene_;
+  const bvh::Bvh tree_;
+  const render::LightSet lights_;
+  const render::SceneBuffers buffers_;
+  render::GpuRayBatch device_;
+};
 
 TEST_F(ReachOnDevice, MatchesTheCpuTwinForEveryKindOfLight) {
-  const scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
-  const bvh::Bvh tree = bvh::build(render::triangleSoup(s), render::treeOptionsFor(render::traversalFor(context())));
-  const render::LightSet lights = everyKindOfLight(s);
-  const render::SceneBuffers buffers(context(), s, tree);
-  render::GpuRayBatch device(context(), buffers);
+  const scene::Scene& s = scene_;
+  const bvh::Bvh& tree = tree_;
+  const render::LightSet& lights = lights_;
+  render::GpuRayBatch& device = device_;
   render::ReachedSurfaces onDevice(s, tree, reflectances(s), /*copyBvh=*/false);
   render::ReachedSurfaces onCpu(s, tree, reflectances(s));
   onDevice.setSeenView(device, cornellView(s));
@@ -93,12 +105,10 @@ TEST_F(ReachOnDevice, MatchesTheCpuTwinForEveryKindOfLight) {
 // round (RayRounds, as LightReachModel measures them on the device) finds what each light measured
 // alone finds, ray for ray: merging the rays changes no ray's hit.
 TEST_F(ReachOnDevice, LightsMeasuredTogetherEqualEachMeasuredAlone) {
-  const scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
-  const bvh::Bvh tree = bvh::build(render::triangleSoup(s), render::treeOptionsFor(render::traversalFor(context())));
-  const render::LightSet lights = everyKindOfLight(s);
-  const render::SceneBuffers buffers(context(), s, tree);
-  render::GpuRayBatch device(context(), buffers);
-  render::ReachedSurfaces reached(s, tree, reflectances(s), false);
+  const scene::Scene& s = scene_;
+  const render::LightSet& lights = lights_;
+  render::GpuRayBatch& device = device_;
+  render::ReachedSurfaces reached(s, tree_, reflectances(s), false);
   reached.setSeenView(device, cornellView(s));
   std::vector<render::LightReach> alone;
   for (std::size_t light = 0; light < lights.size(); ++light) alone.push_back(reached.measure(device, lights, light));
@@ -133,27 +143,16 @@ TEST_F(ReachOnDevice, LightsMeasuredTogetherEqualEachMeasuredAlone) {
 // exactly what measuring the moved scene on the device from scratch gives: the device's traversal
 // finds the same hit for a ray whatever else moved.
 TEST_F(ReachOnDevice, RemeasureAfterAMoveEqualsMeasuringTheMovedScene) {
-  const scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
-  const bvh::BuildOptions options = render::treeOptionsFor(render::traversalFor(context()));
-  const bvh::Bvh tree = bvh::build(render::triangleSoup(s), options);
-  const render::LightSet lights = everyKindOfLight(s);
-  const render::SceneBuffers buffers(context(), s, tree);
-  render::GpuRayBatch device(context(), buffers);
-  render::ReachedSurfaces reached(s, tree, reflectances(s), false);
+  const render::LightSet& lights = lights_;
+  render::ReachedSurfaces reached(scene_, tree_, reflectances(scene_), false);
   std::vector<render::LightReach> before;
-  for (std::size_t light = 0; light < lights.size(); ++light) before.push_back(reached.measure(device, lights, light));
+  for (std::size_t light = 0; light < lights.size(); ++light) before.push_back(reached.measure(device_, lights, light));
 
-  scene::Scene moved = s;
-  const std::size_t cube = scene::objectIndex(moved, "cube_2", "test");
-  std::vector<scene::Bounds> changed{scene::objectBounds(moved, cube)};
-  scene::moveObject(moved, cube, {0.3f, 0.0f, 0.0f}, glm::vec3(0.0f));
-  changed.push_back(scene::objectBounds(moved, cube));
-  for (scene::Bounds& b : changed) b = {b.lo - 1e-3f, b.hi + 1e-3f};
-  bvh::Bvh movedTree = tree;
-  bvh::refit(movedTree, render::triangleSoup(moved));
-  const render::SceneBuffers movedBuffers(context(), moved, movedTree);
+  const MovedObject m = moveAndRefit(scene_, tree_, "cube_2", {0.3f, 0.0f, 0.0f}, 1e-3f);
+  const std::vector<scene::Bounds>& changed = m.changed;
+  const render::SceneBuffers movedBuffers(context(), m.scene, m.tree);
   render::GpuRayBatch movedDevice(context(), movedBuffers);
-  render::ReachedSurfaces movedReach(moved, movedTree, reflectances(moved), false);
+  render::ReachedSurfaces movedReach(m.scene, m.tree, reflectances(m.scene), false);
 
   for (std::size_t light = 0; light < lights.size(); ++light) {
     SCOPED_TRACE(lights.names[light]);

@@ -129,15 +129,9 @@ TEST(ReachedSurfaces, RemeasureAfterAMoveEqualsMeasuringTheMovedScene) {
   render::ReachedSurfaces reached(s, tree, render::triangleReflectances(s, albedos(s)));
   const render::LightReach before = reached.measure(lights, 0);
 
-  scene::Scene moved = s;
-  const std::size_t cube = scene::objectIndex(moved, "cube_2", "test");
-  std::vector<scene::Bounds> changed{scene::objectBounds(moved, cube)};
-  scene::moveObject(moved, cube, {0.3f, 0.0f, 0.0f}, glm::vec3(0.0f));
-  changed.push_back(scene::objectBounds(moved, cube));
-  for (scene::Bounds& b : changed) b = {b.lo - 1e-3f, b.hi + 1e-3f};
-  bvh::Bvh movedTree = tree;
-  bvh::refit(movedTree, render::triangleSoup(moved));
-  render::ReachedSurfaces movedReach(moved, movedTree, render::triangleReflectances(moved, albedos(moved)));
+  const MovedObject m = moveAndRefit(s, tree, "cube_2", {0.3f, 0.0f, 0.0f}, 1e-3f);
+  const std::vector<scene::Bounds>& changed = m.changed;
+  render::ReachedSurfaces movedReach(m.scene, m.tree, render::triangleReflectances(m.scene, albedos(m.scene)));
 
   const render::LightReach fresh = movedReach.measure(lights, 0);
   const render::LightReach replayed = movedReach.remeasure(reached, before, lights, 0, changed);

@@ -10,6 +10,8 @@
 #include <thread>
 
 #include "bvh/wide_node.h"
+#include "render/scene_data/scene_buffers.h"
+#include "scene/scene_edit.h"
 #include "shared/host_device.h"
 
 namespace obscura::test {
@@ -143,6 +145,18 @@ std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vecto
   std::lock_guard lock(mutex);
   answers.emplace(key, out);
   return out;
+}
+
+MovedObject moveAndRefit(const scene::Scene& scene, const bvh::Bvh& tree, const std::string& name, glm::vec3 by,
+                         float padding) {
+  MovedObject moved{scene, tree, {}};
+  const std::size_t object = scene::objectIndex(moved.scene, name, "test");
+  moved.changed.push_back(scene::objectBounds(moved.scene, object));
+  scene::moveObject(moved.scene, object, by, glm::vec3(0.0f));
+  moved.changed.push_back(scene::objectBounds(moved.scene, object));
+  for (scene::Bounds& b : moved.changed) b = {b.lo - padding, b.hi + padding};
+  bvh::refit(moved.tree, render::triangleSoup(moved.scene));
+  return moved;
 }
 
 scene::Camera lookCamera(glm::vec3 position, glm::vec3 forward, glm::vec3 up, float yfov) {

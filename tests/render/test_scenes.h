@@ -42,4 +42,14 @@ bvh::Bvh combBvh(const bvh::TriangleSoup& soup);
 // A camera at `position` looking along `forward` with the given vertical field of view.
 scene::Camera lookCamera(glm::vec3 position, glm::vec3 forward, glm::vec3 up, float yfov);
 
+// `scene` with object `name` translated by `by`, its BVH refitted from `tree`, and the object's
+// old and new boxes padded by `padding` (what an edit tells a re-measurement it changed).
+struct MovedObject {
+  scene::Scene scene;
+  bvh::Bvh tree;
+  std::vector<scene::Bounds> changed;
+};
+MovedObject moveAndRefit(const scene::Scene& scene, const bvh::Bvh& tree, const std::string& name, glm::vec3 by,
+                         float padding);
+
 } // namespace obscura::test
