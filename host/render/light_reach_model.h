@@ -1,4 +1,4 @@
-// light_reach_model.h — what each light reaches, measured with CPU rays for I_a's Reached and Seen
+// light_reach_model.h — what each light reaches, measured with rays for I_a's Reached and Seen
 // models (render/scene_data/reached_surfaces.h, OURS after [RTO §6]) and for marking secondary
 // reflectors: measured when a renderer is made, re-measured after an edit (only the rays a move
 // can change), a new light measured alone.

@@ -21,8 +21,8 @@ struct EditReport {
   std::map<std::string, std::uint64_t> rays;  // per pass, traced by the edit
   std::map<std::string, double> gpuMs;        // per pass, GPU time of the edit
   std::optional<BvhUpdate> bvh;               // geometry edits: how the BVH followed
-  // What the lights reach (the Reached ambient model's CPU rays), measured again: geometry edits
-  // and added lights.
+  // What the lights reach (the Reached ambient model's rays, traced on the device), measured
+  // again: geometry edits and added lights.
   std::optional<render::ObscuranceRenderer::ReachUpdate> reach;
   double totalMs = 0.0;                       // wall time, edit to composed frame when composed
   // Host work: the wall time not spent in the GPU passes above (BVH update, the reach's CPU
