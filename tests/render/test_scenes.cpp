@@ -9,6 +9,8 @@
 #include <string_view>
 #include <thread>
 
+#include <gtest/gtest.h>
+
 #include "bvh/wide_node.h"
 #include "render/scene_data/scene_buffers.h"
 #include "scene/scene_edit.h"
@@ -145,6 +147,19 @@ std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vecto
   std::lock_guard lock(mutex);
   answers.emplace(key, out);
   return out;
+}
+
+void expectReplayEqualsFresh(const render::LightReach& replayed, const render::LightReach& fresh) {
+  EXPECT_EQ(replayed.rays.landingPrimitive, fresh.rays.landingPrimitive);
+  EXPECT_EQ(replayed.rays.firstSeenTry, fresh.rays.firstSeenTry);
+  ASSERT_EQ(replayed.rays.landingT.size(), fresh.rays.landingT.size());
+  for (std::size_t i = 0; i < fresh.rays.landingT.size(); ++i)
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(replayed.rays.landingT[i]), std::bit_cast<std::uint32_t>(fresh.rays.landingT[i]))
+        << "light ray " << i;
+  EXPECT_EQ(replayed.area, fresh.area);
+  EXPECT_EQ(replayed.escapeDirect, fresh.escapeDirect);
+  EXPECT_EQ(replayed.escapeBounce, fresh.escapeBounce);
+  EXPECT_EQ(replayed.landedTriangles, fresh.landedTriangles);
 }
 
 MovedObject moveAndRefit(const scene::Scene& scene, const bvh::Bvh& tree, const std::string& name, glm::vec3 by,

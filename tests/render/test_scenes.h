@@ -7,6 +7,7 @@
 #include <glm/glm.hpp>
 
 #include "bvh/bvh.h"
+#include "render/scene_data/reached_surfaces.h"
 #include "scene/scene.h"
 #include "shared/host_device.h"
 
@@ -49,6 +50,11 @@ struct MovedObject {
   bvh::Bvh tree;
   std::vector<scene::Bounds> changed;
 };
+// Asserts that `replayed` (a re-measurement after an edit) found exactly what `fresh` (the edited
+// scene measured from scratch) found: every light ray's landing, every sample's first seen try,
+// and the reach, escapes and landed triangles they make.
+void expectReplayEqualsFresh(const render::LightReach& replayed, const render::LightReach& fresh);
+
 MovedObject moveAndRefit(const scene::Scene& scene, const bvh::Bvh& tree, const std::string& name, glm::vec3 by,
                          float padding);
 
