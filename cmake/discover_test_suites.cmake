@@ -9,7 +9,9 @@
 # still named in the output (--output-on-failure), and every test still fails on a validation
 # message of its own (tests/gpu_test.h).
 #
-# Inputs (-D): TEST_EXECUTABLE, CTEST_FILE (written), TEST_TIMEOUT (seconds per suite).
+# Inputs (-D): TEST_EXECUTABLE, CTEST_FILE (written), TEST_TIMEOUT (seconds per suite), and
+# SUITE_ENVIRONMENT: "Suite=NAME=VALUE" entries (;-separated) that one suite's process runs with
+# besides OBSCURA_VALIDATE=1.
 execute_process(COMMAND "${TEST_EXECUTABLE}" --gtest_list_tests
                 OUTPUT_VARIABLE listing RESULT_VARIABLE status ERROR_VARIABLE errors)
 if(NOT status EQUAL 0)
@@ -21,18 +23,25 @@ set(suite "")
 set(count 0)
 macro(flush_suite)
   if(NOT suite STREQUAL "")
+    set(environment "OBSCURA_VALIDATE=1")
+    foreach(entry IN LISTS SUITE_ENVIRONMENT)
+      if(entry MATCHES "^${suite}=(.+)$")
+        string(APPEND environment ";${CMAKE_MATCH_1}")
+      endif()
+    endforeach()
     # COST: CTest starts the costliest first on a clean build (no timings yet); a suite's tests
     # are the best guess there is before one has run.
     string(APPEND content
            "add_test([=[${suite}]=] [=[${TEST_EXECUTABLE}]=] [=[--gtest_filter=${suite}.*]=])\n"
-           "set_tests_properties([=[${suite}]=] PROPERTIES ENVIRONMENT OBSCURA_VALIDATE=1 "
+           "set_tests_properties([=[${suite}]=] PROPERTIES ENVIRONMENT \"${environment}\" "
            "TIMEOUT ${TEST_TIMEOUT} COST ${count} LABELS gtest)\n")
   endif()
 endmacro()
 foreach(line IN LISTS lines)
   if(line MATCHES "^([A-Za-z0-9_/]+)\\.")
+    set(next_suite "${CMAKE_MATCH_1}") # before flush_suite(), whose matching sets CMAKE_MATCH_1
     flush_suite()
-    set(suite "${CMAKE_MATCH_1}")
+    set(suite "${next_suite}")
     set(count 0)
   elseif(line MATCHES "^  [A-Za-z0-9_/]+")
     math(EXPR count "${count} + 1")

@@ -31,8 +31,10 @@ private:
 // A scene made of a triangle soup, with one default material.
 scene::Scene soupScene(const bvh::TriangleSoup& soup);
 
-// The oracle of the traversal tests: brute force over every triangle, on all cores.
+// The oracle of the traversal tests: brute force over every triangle, on all cores (each ray meets
+// every triangle's padded box first; the answers are bvh::closestHitBruteForce's).
 std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vector<gpu::GpuRay>& rays);
+std::vector<bvh::Hit> bruteForce(const bvh::TriangleSoup& soup, const std::vector<bvh::Ray>& rays);
 
 // A wide BVH built by hand over `soup` (n >= 2 triangles, every box the whole soup's), in which
 // a ray along +x pushes one stack entry per level: "spine" node k has the next spine node in
