@@ -30,7 +30,7 @@ EditSession::EditSession(const gpu::Context& context, scene::Scene scene, bvh::B
                          const render::ObscuranceSettings& settings, bvh::BuildOptions rebuildOptions)
     : history_(std::move(scene), std::move(bvh), rebuildOptions) {
   renderer_ = std::make_unique<render::ObscuranceRenderer>(context, history_.scene(), history_.bvh(), settings);
-  renderer_->prepareForEdits(); // so that the first edit's time is its own
+  renderer_->prepareForEdits(); // so that the first edit's time is its own (on a GPU)
   const render::LightSet& set = renderer_->lights();
   for (std::size_t i = 0; i < set.names.size(); ++i) {
     lights_.insert(i, {.name = set.names[i], .base = renderer_->emissions()[i],
