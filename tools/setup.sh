@@ -14,7 +14,7 @@ done
 packages=(
   cmake ninja-build g++ pkg-config git
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools glslang-tools
-  libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libopenimageio-dev
+  libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev zlib1g-dev libopenimageio-dev
   libcli11-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
   libembree-dev
   libglfw3-dev libimgui-dev xvfb xauth

@@ -1,6 +1,7 @@
-// image_io.h — images in and out through OpenImageIO. A build without it
-// (-DOBSCURA_WITH_OPENIMAGEIO=OFF) reads and writes PNG through stb (io/stb_codec.h), reads no
-// EXR and writes uncompressed EXR (io/exr_writer.h).
+// image_io.h — images in and out. PNG is written, and PNG, JPEG, BMP, TGA and HDR are read,
+// through stb (io/stb_codec.h); EXR and the other formats through OpenImageIO, in a module loaded
+// on first use (io/oiio_codec.h). A build without OpenImageIO (-DOBSCURA_WITH_OPENIMAGEIO=OFF)
+// reads no EXR and writes uncompressed EXR (io/exr_writer.h).
 //
 // EXR holds linear radiance and every AOV as channel layers ("albedo.R", "depth.Z", …). PNG is
 // for viewing only: exposure, then the sRGB curve, 8 bits [SPEC §5]. Files are written to a
@@ -38,7 +39,8 @@ void writePng(const std::string& path, const Image& image, int firstChannel = 0,
               int count = 3);
 // The pixels writePng writes, packed RGBA8 (R in the low byte, alpha 255), as the window shows them.
 std::vector<std::uint32_t> encodeRgba8(const Image& image, int firstChannel = 0, float exposure = 0.0f, int count = 3);
-// Reads any image OpenImageIO reads (without it: what stb reads) (linear floats as stored; PNG values / 255, no decoding).
+// Reads PNG, JPEG, BMP, TGA and HDR through stb, any other image OpenImageIO reads through it
+// (linear floats as stored; PNG values / 255, no decoding).
 Image readImage(const std::string& path);
 
 // Appends `from`'s channels to `to` (same size; InputError otherwise).

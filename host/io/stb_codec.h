@@ -1,8 +1,8 @@
 // stb_codec.h — images through stb (stb_image_write, stb_image), which every build has.
 //
-// OpenImageIO reads and writes images where the build has it (OBSCURA_WITH_OPENIMAGEIO, the
-// default); a build without it (a machine lent for GPU benchmarks, where OpenImageIO's ~400 MB of
-// dependencies cannot travel) reads and writes PNG through here. Its tests run in every build.
+// Every build writes PNG and reads PNG, JPEG, BMP, TGA and HDR through here, without loading
+// OpenImageIO (io/oiio_codec.h says why); a build without OpenImageIO (a machine lent for GPU
+// benchmarks, where its ~400 MB of dependencies cannot travel) has nothing else.
 #pragma once
 #include <string>
 

@@ -372,5 +372,36 @@ TEST_F(CliBadInput, HostOutOfMemoryIsAClearError) {
   EXPECT_EQ(strayFiles(), std::vector<std::string>{});
 }
 
+// OpenImageIO is a module loaded on first use (host/io/oiio_codec.h): a binary moved away from
+// libobscura_oiio.so still writes PNG, and refuses EXR naming the file and the module, leaving
+// nothing behind.
+TEST_F(CliBadInput, ExrWithoutOpenImageIosModuleIsAClearErrorAndPngStillWorks) {
+#ifndef OBSCURA_HAVE_OPENIMAGEIO
+  GTEST_SKIP() << "this build writes EXR without OpenImageIO";
+#endif
+  const fs::path alone = dir_ / "alone";
+  fs::create_directories(alone);
+  fs::copy_file(OBSCURA_BINARY_PATH, alone / "obscura");
+  const auto run = [&](const std::string& output) {
+    const std::string command = "cd " + dir_.string() + " && " + (alone / "obscura").string() + " render " + scene() +
+                                " --width 8 --height 8 --spp 1 -o " + output + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    RunResult r{-1, ""};
+    std::array<char, 4096> buffer;
+    while (pipe && std::fgets(buffer.data(), buffer.size(), pipe)) r.output += buffer.data();
+    const int status = pipe ? pclose(pipe) : -1;
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+  };
+  const RunResult png = run("out.png");
+  ASSERT_EQ(png.exitCode, 0) << png.output;
+  EXPECT_TRUE(fs::exists(path("out.png")));
+  const RunResult exr = run("out.exr");
+  EXPECT_EQ(exr.exitCode, 2) << exr.output;
+  EXPECT_CONTAINS(exr.output, "out.exr");
+  EXPECT_CONTAINS(exr.output, "libobscura_oiio.so");
+  EXPECT_EQ(strayFiles({"alone", "alone/obscura", "out.png"}), std::vector<std::string>{});
+}
+
 } // namespace
 } // namespace obscura::test
