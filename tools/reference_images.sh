@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # The fixed set of images a change that must not change behaviour is checked against: the same
-# commands with two binaries, then `compare` says which files differ (byte for byte).
+# commands with two binaries, then `compare` says which files differ (an EXR byte for byte, a PNG
+# pixel for pixel).
 #
 #   tools/reference_images.sh render BINARY DIR    renders the set into DIR (and DIR/sha256.txt)
-#   tools/reference_images.sh compare DIR_A DIR_B  lists the files whose bytes differ; exit 1 if any
+#   tools/reference_images.sh hash DIR             hashes DIR's images again (DIR/sha256.txt)
+#   tools/reference_images.sh compare DIR_A DIR_B  lists the files that differ; exit 1 if any
 #
 # The set: the README's Cornell box; modern-hall 400x300 with --emission-samples 4; `relight
 # --edits` on modern-hall (a light's scale, an added point light, a move, a remove, an added
@@ -15,12 +17,46 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 shared="$repo/../shared"
 
 # DIR/sha256.txt: a hash per image. An EXR's header holds the date it was written (capDate): it
-# is hashed with that value blanked.
+# is hashed with that value blanked. A PNG is hashed by its size, format and pixels (its rows
+# unfiltered), not its bytes: how it was deflated is the encoder's business.
 hash_images() {
   (cd "$1" && find . -type f \( -name '*.png' -o -name '*.exr' \) | sort | python3 -c '
-import hashlib, struct, sys
+import hashlib, struct, sys, zlib
+
+def png_pixels(data):
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    at, idat, header = 8, b"", None
+    while at < len(data):
+        size, kind = struct.unpack(">I4s", data[at:at + 8])
+        body = data[at + 8:at + 8 + size]
+        if kind == b"IHDR": header = body
+        elif kind == b"IDAT": idat += body
+        at += 12 + size
+    width, height, depth, colour = struct.unpack(">IIBB", header[:10])
+    channels = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}[colour]
+    step = max(1, channels * depth // 8)
+    stride = (width * channels * depth + 7) // 8
+    raw, rows, previous = zlib.decompress(idat), [], bytearray(stride)
+    for y in range(height):
+        kind, row = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = row[i - step] if i >= step else 0
+            b, c = previous[i], previous[i - step] if i >= step else 0
+            if kind == 1: row[i] = (row[i] + a) & 255
+            elif kind == 2: row[i] = (row[i] + b) & 255
+            elif kind == 3: row[i] = (row[i] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                row[i] = (row[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(bytes(row))
+        previous = row
+    return header[:10] + b"".join(rows)
+
 for name in sys.stdin.read().split():
     data = bytearray(open(name, "rb").read())
+    if name.endswith(".png"):
+        data = png_pixels(bytes(data))
     key = b"capDate\0string\0"
     at = data.find(key)
     if name.endswith(".exr") and at >= 0:
@@ -106,7 +142,7 @@ compare() {
     fi
   done <"$1/sha256.txt"
   [[ $(wc -l <"$1/sha256.txt") == $(wc -l <"$2/sha256.txt") ]] || { echo "the sets hold different files"; differ=1; }
-  ((differ)) || echo "all $(wc -l <"$1/sha256.txt") images byte-identical"
+  ((differ)) || echo "all $(wc -l <"$1/sha256.txt") images identical (EXR bytes, PNG pixels)"
   return $differ
 }
 

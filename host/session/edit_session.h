@@ -1,7 +1,7 @@
 // edit_session.h — one scene being rendered and edited [IVR §3]: the one place that `relight
 // --edits`, the window and (through Python or a farm) anything else drives. It owns
 //   - the renderer (render/obscurance_renderer.h), made for edits (kept rays, the edit kernels
-//     compiled up front);
+//     compiled up front on a GPU);
 //   - the scene's versions and their BVHs, and the refit-or-rebuild choice (session/scene_history.h);
 //   - the lights by name with their edited intensity and colour (session/light_controls.h), kept
 //     in step with the renderer's light order, which shifts as lights come and go.
