@@ -241,20 +241,15 @@ void ObscuranceRenderer::bindAll() {
 }
 
 void ObscuranceRenderer::prepareForEdits() const {
-  // On lavapipe the edits' kernels are compiled when an edit first needs them: there a pipeline
-  // is an LLVM compile under the validation layer, ~1.7 s for these on 2 cores, which every
-  // window and edit session paid at start whether or not it edited (most of `view`'s start and
-  // of the window tests' time), while an edit there takes hundreds of ms anyway. A GPU's driver
-  // compiles them here, so that a first edit does not stall a real-time window.
-  if (context_->info().type == "cpu") return;
   const bool kept = frame_.contents().keptRaySamples > 0;
   shadow_.compileEditKernels(kept);
   obscurance_.compileEditKernels(false);
   specularPass_.compileEditKernels(kept);
   // An edit that rebuilds the BVH (an emissive quad, an insert) leaves the kept rays naming other
-  // triangles: its added light and probes take the variants without them, compiled now too
-  // rather than inside the edit (tens of ms of host work each).
-  if (kept) {
+  // triangles: its added light and probes take the variants without them. A GPU's driver compiles
+  // those now rather than inside the edit (tens of ms of host work each); lavapipe, whose JIT
+  // would cost every session of the test suite seconds, compiles them when an edit first needs them.
+  if (kept && context_->info().type != "cpu") {
     shadow_.compileEditKernels(false);
     specularPass_.compileEditKernels(false);
   }

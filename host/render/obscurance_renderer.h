@@ -216,7 +216,6 @@ public:
   // Compiles the kernels that only edits use (the probes of a geometry edit, the passes for one
   // light alone), which are otherwise compiled on an edit's first dispatch: a program that will
   // edit (relight --edits, the window) calls this first, so that the first edit's time is its own.
-  // On a GPU only: lavapipe compiles them on first use (the .cpp says why).
   void prepareForEdits() const;
   // A geometry edit [IVR §3.3]: `edited` (with its BVH) replaces the scene — the same lights,
   // materials and camera — and `changed` holds the world boxes of what changed (an object's old

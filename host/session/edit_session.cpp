@@ -27,10 +27,11 @@ render::ObscuranceSettings editSettings(render::ObscuranceSettings settings, std
 }
 
 EditSession::EditSession(const gpu::Context& context, scene::Scene scene, bvh::Bvh bvh,
-                         const render::ObscuranceSettings& settings, bvh::BuildOptions rebuildOptions)
+                         const render::ObscuranceSettings& settings, bvh::BuildOptions rebuildOptions,
+                         EditKernels editKernels)
     : history_(std::move(scene), std::move(bvh), rebuildOptions) {
   renderer_ = std::make_unique<render::ObscuranceRenderer>(context, history_.scene(), history_.bvh(), settings);
-  renderer_->prepareForEdits(); // so that the first edit's time is its own (on a GPU)
+  if (editKernels == EditKernels::UpFront) renderer_->prepareForEdits(); // the first edit's time is its own
   const render::LightSet& set = renderer_->lights();
   for (std::size_t i = 0; i < set.names.size(); ++i) {
     lights_.insert(i, {.name = set.names[i], .base = renderer_->emissions()[i],

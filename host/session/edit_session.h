@@ -1,7 +1,7 @@
 // edit_session.h — one scene being rendered and edited [IVR §3]: the one place that `relight
 // --edits`, the window and (through Python or a farm) anything else drives. It owns
 //   - the renderer (render/obscurance_renderer.h), made for edits (kept rays, the edit kernels
-//     compiled up front on a GPU);
+//     compiled up front unless the caller says otherwise);
 //   - the scene's versions and their BVHs, and the refit-or-rebuild choice (session/scene_history.h);
 //   - the lights by name with their edited intensity and colour (session/light_controls.h), kept
 //     in step with the renderer's light order, which shifts as lights come and go.
@@ -29,12 +29,17 @@
 
 namespace obscura::session {
 
+// When the kernels only edits use are compiled: before anything else, so that the first edit's
+// time is its own (what `relight --edits` reports), or when an edit first needs them (a window on
+// lavapipe, where they cost ~1.8 s of CPU that a session which never edits would pay at start).
+enum class EditKernels { UpFront, OnFirstUse };
+
 class EditSession {
 public:
   // `settings` as the renderer takes them (editSettings gives what edits want); `rebuildOptions`:
   // the BVH build of edits that add triangles (the device's tree, render::treeOptionsFor).
   EditSession(const gpu::Context& context, scene::Scene scene, bvh::Bvh bvh, const render::ObscuranceSettings& settings,
-              bvh::BuildOptions rebuildOptions = {});
+              bvh::BuildOptions rebuildOptions = {}, EditKernels editKernels = EditKernels::UpFront);
 
   // Applies `edit`; `where` names it in errors (the file and entry, the script's event). An
   // InputError (no such light or object, a name taken, moving a light no edit added) leaves the
