@@ -65,6 +65,9 @@ struct SceneObject {
   std::uint32_t firstTriangle = 0;
   std::uint32_t triangleCount = 0;
   glm::mat4 world{1.0f};             // the node's world transform at load (or after edits)
+  // Removed by an edit (scene_edit.h removeObject): its triangles collapsed to a point, its index
+  // kept (triangles and lights are addressed by index), its name no longer an object's.
+  bool removed = false;
 };
 
 struct Camera {

@@ -37,9 +37,10 @@ void makeObjectNamesUnique(Scene& scene) {
 
 std::size_t objectIndex(const Scene& scene, const std::string& name, const std::string& where) {
   for (std::size_t i = 0; i < scene.objects.size(); ++i)
-    if (scene.objects[i].name == name) return i;
+    if (!scene.objects[i].removed && scene.objects[i].name == name) return i;
   std::vector<std::string> names;
-  for (const auto& o : scene.objects) names.push_back(o.name);
+  for (const auto& o : scene.objects)
+    if (!o.removed) names.push_back(o.name);
   throw InputError(fmt::format("{}: no object named '{}' (objects: {})", where, name, fmt::join(names, ", ")));
 }
 
@@ -69,7 +70,8 @@ void moveObject(Scene& scene, std::size_t index, glm::vec3 translate, glm::vec3 
 }
 
 void removeObject(Scene& scene, std::size_t index) {
-  const SceneObject& o = scene.objects.at(index);
+  SceneObject& o = scene.objects.at(index);
+  o.removed = true;
   const std::vector<std::uint32_t> vertices = objectVertices(scene, o);
   if (vertices.empty()) return;
   const glm::vec3 point = scene.positions[vertices.front()];
@@ -79,7 +81,7 @@ void removeObject(Scene& scene, std::size_t index) {
 
 std::size_t insertObject(Scene& scene, const Scene& other, const std::string& name, glm::vec3 translate) {
   for (const auto& o : scene.objects)
-    if (o.name == name) throw InputError(fmt::format("insert '{}': an object of that name exists", name));
+    if (!o.removed && o.name == name) throw InputError(fmt::format("insert '{}': an object of that name exists", name));
   if (!other.lightGroups.empty() || !other.punctualLights.empty())
     throw InputError(fmt::format("insert '{}' from {}: it emits light; add lights with add_light edits", name,
                                  other.sourcePath));
@@ -117,7 +119,8 @@ std::size_t insertEmissiveQuad(Scene& scene, const EmissiveQuad& quad) {
   if (glm::any(glm::lessThan(quad.emission, glm::vec3(0.0f))))
     throw InputError(fmt::format("add quad '{}': emission must not be negative", quad.name));
   for (const auto& o : scene.objects)
-    if (o.name == quad.name) throw InputError(fmt::format("add quad '{}': an object of that name exists", quad.name));
+    if (!o.removed && o.name == quad.name)
+      throw InputError(fmt::format("add quad '{}': an object of that name exists", quad.name));
   for (const auto& g : scene.lightGroups)
     if (g.name == quad.name) throw InputError(fmt::format("add quad '{}': a light of that name exists", quad.name));
   Material m;

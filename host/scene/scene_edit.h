@@ -26,8 +26,9 @@ Bounds objectBounds(const Scene& scene, std::size_t index);
 void moveObject(Scene& scene, std::size_t index, glm::vec3 translate, glm::vec3 rotateDegrees);
 
 // Removes object `index`: its triangles collapse to one point, so they are never hit, and every
-// index (triangles, lights, objects) stays. An emissive object's light then has no area and
-// contributes nothing, as a scene without it renders.
+// index (triangles, lights, objects) stays; the object is marked removed, so its name no longer
+// finds it (objectIndex) and an insert may take it, as in an edits file's sequence. An emissive
+// object's light then has no area and contributes nothing, as a scene without it renders.
 void removeObject(Scene& scene, std::size_t index);
 
 // Inserts every triangle of `other` as one object `name`, translated by `translate`; its materials
