@@ -1,5 +1,6 @@
 #include "gpu/buffer.h"
 
+#include <atomic>
 #include <cstring>
 #include <optional>
 
@@ -11,7 +12,20 @@ namespace obscura::gpu {
 namespace {
 constexpr vk::BufferUsageFlags kTransfer =
     vk::BufferUsageFlagBits::eTransferSrc | vk::BufferUsageFlagBits::eTransferDst;
+std::atomic<std::uint64_t> liveBufferBytes{0};
 } // namespace
+
+std::uint64_t bufferBytesInUse() { return liveBufferBytes.load(); }
+
+LiveBytes::LiveBytes(vk::DeviceSize bytes) : bytes_(bytes) { liveBufferBytes += bytes; }
+LiveBytes& LiveBytes::operator=(LiveBytes&& other) noexcept {
+  if (this != &other) {
+    liveBufferBytes -= bytes_;
+    bytes_ = std::exchange(other.bytes_, 0);
+  }
+  return *this;
+}
+LiveBytes::~LiveBytes() { liveBufferBytes -= bytes_; }
 
 Buffer::Buffer(const Context& context, vk::DeviceSize size, vk::BufferUsageFlags usage,
                const std::string& name, Residence residence)
@@ -33,6 +47,7 @@ Buffer::Buffer(const Context& context, vk::DeviceSize size, vk::BufferUsageFlags
             : context.findMemoryType(requirements.memoryTypeBits, kHost, kHostCached);
     memory_ = context.device().allocateMemory(
         {.allocationSize = requirements.size, .memoryTypeIndex = type});
+    liveBytes_ = LiveBytes(requirements.size);
     buffer_.bindMemory(*memory_, 0);
     auto flags = context.memoryTypeFlags(type);
     if ((flags & kHost) == kHost) {

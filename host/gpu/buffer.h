@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <vulkan/vulkan_raii.hpp>
@@ -16,6 +17,25 @@
 #include "gpu/context.h"
 
 namespace obscura::gpu {
+
+// Device memory held by this process's buffers now, all contexts together: what a program that
+// makes and drops renderers (the Python API's sessions, a test of leaks) checks comes back.
+std::uint64_t bufferBytesInUse();
+
+// A buffer's share of bufferBytesInUse(), counted while it lives and moved with it.
+class LiveBytes {
+public:
+  LiveBytes() = default;
+  explicit LiveBytes(vk::DeviceSize bytes);
+  LiveBytes(LiveBytes&& other) noexcept : bytes_(std::exchange(other.bytes_, 0)) {}
+  LiveBytes& operator=(LiveBytes&& other) noexcept;
+  LiveBytes(const LiveBytes&) = delete;
+  LiveBytes& operator=(const LiveBytes&) = delete;
+  ~LiveBytes();
+
+private:
+  vk::DeviceSize bytes_ = 0;
+};
 
 // Where a buffer lives: device-local (the default), or host-visible for staging (buffer.cpp says
 // which memory types each takes).
@@ -56,6 +76,7 @@ public:
 private:
   // Declaration order is creation order; members are destroyed bottom-up (buffer before memory).
   vk::raii::DeviceMemory memory_ = nullptr;
+  LiveBytes liveBytes_; // memory_'s size in bufferBytesInUse()
   vk::raii::Buffer buffer_ = nullptr;
   vk::DeviceSize size_ = 0;
   void* mapped_ = nullptr; // persistent mapping when the memory is host-visible
