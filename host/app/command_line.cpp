@@ -3,15 +3,16 @@
 #include <cstdio>
 #include <new>
 
-#include <fmt/core.h>
+#include <fmt/format.h>
 
 #include "app/commands.h"
 #include "core/error.h"
 
 namespace obscura::app {
 
-int runCommandLine(int argc, const char* const* argv) {
-  CLI::App app{"obscura: ray-traced obscurances and interactive relighting (Vulkan compute)"};
+namespace {
+
+void addCommands(CLI::App& app) {
   app.require_subcommand(1);
   addRenderCommand(app);
   addInfoCommand(app);
@@ -23,6 +24,26 @@ int runCommandLine(int argc, const char* const* argv) {
   addRecoverCommand(app);
   addRemodelCommand(app);
   addMergeCommand(app);
+}
+
+constexpr const char* kDescription = "obscura: ray-traced obscurances and interactive relighting (Vulkan compute)";
+
+} // namespace
+
+void runCommand(const std::vector<std::string>& args) {
+  CLI::App app{kDescription};
+  addCommands(app);
+  std::vector<std::string> reversed(args.rbegin(), args.rend()); // CLI11 takes them last first
+  try {
+    app.parse(reversed);
+  } catch (const CLI::ParseError& e) {
+    throw InputError(fmt::format("{}: {}", args.empty() ? "obscura" : args.front(), e.what()));
+  }
+}
+
+int runCommandLine(int argc, const char* const* argv) {
+  CLI::App app{kDescription};
+  addCommands(app);
   // Errors in input are caught here once: nothing else ever ends the program.
   try {
     app.parse(argc, argv);

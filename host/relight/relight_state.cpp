@@ -24,6 +24,32 @@ glm::vec3 vec3From(const nlohmann::json& j, const std::string& file, const std::
   return {j[0].get<float>(), j[1].get<float>(), j[2].get<float>()};
 }
 
+// state.json's fields but the transport; InputError naming `file` when one is missing or malformed.
+RelightState stateFromJson(const nlohmann::json& json, const std::string& file) {
+  RelightState state;
+  state.document = json;
+  try {
+    if (!json.contains("version") || json.at("version").get<int>() != kStateVersion)
+      throw InputError(fmt::format("{}: state version {} (this obscura reads version {}); render it again",
+                                   file, json.contains("version") ? json.at("version").dump() : "missing",
+                                   kStateVersion));
+    state.scene = json.at("scene").get<std::string>();
+    state.samples = json.at("samples").get<std::uint32_t>();
+    state.settings = json.at("settings");
+    for (const auto& l : json.at("lights")) {
+      LightRecord r;
+      r.name = l.at("name").get<std::string>();
+      r.type = l.at("type").get<std::string>();
+      r.emission = vec3From(l.at("emission"), file, "lights[].emission");
+      r.ambientWeight = vec3From(l.at("ambient_weight"), file, "lights[].ambient_weight");
+      state.lights.push_back(r);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: malformed state ({})", file, e.what()));
+  }
+  return state;
+}
+
 } // namespace
 
 std::vector<glm::vec3> RelightState::emissions() const {
@@ -96,33 +122,26 @@ void saveState(const std::string& dir, const nlohmann::json& state, const render
   }
 }
 
+RelightState currentState(const render::ObscuranceRenderer& renderer, const std::string& scenePath) {
+  RelightState state = stateFromJson(stateJson(renderer, scenePath), scenePath);
+  state.transport = renderer.transport();
+  return state;
+}
+
+void saveState(const std::string& dir, const RelightState& state) { saveState(dir, state.document, state.transport); }
+
 RelightState loadState(const std::string& dir) {
   if (!fs::is_directory(dir)) throw InputError(fmt::format("{}: not a relighting state folder (it does not exist)", dir));
   const std::string jsonPath = (fs::path(dir) / "state.json").string();
   const std::string exrPath = (fs::path(dir) / "transport.exr").string();
   const nlohmann::json json =
       io::readJsonFile(jsonPath, "missing (not a state written by 'obscura render --save-state')");
-  RelightState state;
+  RelightState state = stateFromJson(json, jsonPath);
   try {
-    if (!json.contains("version") || json.at("version").get<int>() != kStateVersion)
-      throw InputError(fmt::format("{}: state version {} (this obscura reads version {}); render it again",
-                                   jsonPath, json.contains("version") ? json.at("version").dump() : "missing",
-                                   kStateVersion));
-    state.scene = json.at("scene").get<std::string>();
-    state.samples = json.at("samples").get<std::uint32_t>();
-    state.settings = json.at("settings");
     const int width = json.at("width").get<int>(), height = json.at("height").get<int>();
     const bool specular = json.at("specular").get<bool>();
     std::vector<std::string> names;
-    for (const auto& l : json.at("lights")) {
-      LightRecord r;
-      r.name = l.at("name").get<std::string>();
-      r.type = l.at("type").get<std::string>();
-      r.emission = vec3From(l.at("emission"), jsonPath, "lights[].emission");
-      r.ambientWeight = vec3From(l.at("ambient_weight"), jsonPath, "lights[].ambient_weight");
-      names.push_back(r.name);
-      state.lights.push_back(r);
-    }
+    for (const auto& l : state.lights) names.push_back(l.name);
     if (!fs::exists(exrPath)) throw InputError(fmt::format("{}: missing", exrPath));
     io::Image image = io::readImage(exrPath);
     if (image.width != width || image.height != height)

@@ -25,6 +25,7 @@ struct LightRecord {
 };
 
 struct RelightState {
+  nlohmann::json document; // state.json as written or read (what saveState(dir, state) writes back)
   std::string scene;
   std::uint32_t samples = 0;
   nlohmann::json settings;
@@ -50,6 +51,12 @@ void saveState(const std::string& dir, const render::ObscuranceRenderer& rendere
 nlohmann::json stateJson(const render::ObscuranceRenderer& renderer, const std::string& scenePath);
 // Writes DIR from state.json's contents and the resolved transport (a farm's merged parts).
 void saveState(const std::string& dir, const nlohmann::json& state, const render::Transport& transport);
+
+// The state of `renderer`'s frame now (its transport resolved on the host): what saveState writes,
+// without the files (the Python API's results).
+RelightState currentState(const render::ObscuranceRenderer& renderer, const std::string& scenePath);
+// Writes DIR from a state (as loaded or made by currentState).
+void saveState(const std::string& dir, const RelightState& state);
 
 // Reads DIR; InputError naming the file for a missing, truncated, foreign-version or inconsistent
 // state.

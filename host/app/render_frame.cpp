@@ -1,0 +1,170 @@
+#include "app/render_frame.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "render/aovs.h"
+#include "render/denoise/denoiser.h"
+#include "render/path_tracer.h"
+
+namespace obscura::app {
+
+void checkFrameOptions(const RenderOptions& o) {
+  if (o.denoise && o.method == render::Method::PathTrace)
+    throw InputError("--denoise with --method pathtrace: the denoiser filters the obscurance method's direct and "
+                     "ambient terms divided by the albedo, which path tracing does not keep; use --method obscurance");
+  static const std::vector<std::string> pathAovs = {"combined"};
+  std::vector<std::string> known = o.method == render::Method::PathTrace ? pathAovs : render::obscuranceAovNames();
+  if (o.denoise) known.push_back("denoised");
+  for (const auto& aov : o.aovs)
+    if (std::find(known.begin(), known.end(), aov) == known.end())
+      throw InputError(fmt::format("--aov {}: unknown AOV (known: {}){}", aov, fmt::join(known, ", "),
+                                   aov == "denoised" ? "; it needs --denoise" : ""));
+  checkRenderOptions(o);
+}
+
+nlohmann::json statsJson(const render::RenderStats& stats) {
+  nlohmann::json passes = nlohmann::json::object();
+  double totalMs = 0.0;
+  std::uint64_t totalRays = 0;
+  for (const auto& [name, pass] : stats.passes) {
+    passes[name] = {{"gpu_ms", pass.gpuMs}, {"rays", pass.rays},
+                    {"mrays_per_s", pass.gpuMs > 0 ? static_cast<double>(pass.rays) / (pass.gpuMs * 1e3) : 0.0}};
+    totalMs += pass.gpuMs;
+    totalRays += pass.rays;
+  }
+  return {{"passes", passes},
+          {"gpu_ms", totalMs},
+          {"rays", totalRays},
+          {"mrays_per_s", totalMs > 0 ? static_cast<double>(totalRays) / (totalMs * 1e3) : 0.0},
+          {"wall_s", stats.wallSeconds},
+          {"device_bytes", stats.deviceBytes},
+          {"truncated_traversals", stats.truncatedTraversals}};
+}
+
+void checkTraversals(const render::RenderStats& stats) {
+  if (stats.truncatedTraversals > 0)
+    throw DeviceError(fmt::format("{} traversals ran out of steps (kMaxTraversalSteps); the image would be wrong",
+                                  stats.truncatedTraversals));
+}
+
+namespace {
+
+RenderedFrame pathTrace(const RenderOptions& o, const scene::Scene& scene, const bvh::Bvh& bvh, const gpu::Context& context,
+                        const render::ObscuranceSettings& settings, const render::ProgressFn& progress) {
+  render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
+                               .camera = settings.camera, .maxDepth = settings.maxDepth,
+                               .lightSampling = settings.lightSampling,
+                               .emissionSamples = settings.emissionSamples};
+  render::PathTracer tracer(context, scene, bvh, pt);
+  tracer.render(progress);
+  RenderedFrame frame;
+  frame.image = tracer.image();
+  frame.stats = tracer.stats();
+  frame.method = {{"method", nameString(render::kMethodNames, o.method)}, {"max_depth", pt.maxDepth},
+                  {"emission_samples", pt.emissionSamples}};
+  return frame;
+}
+
+} // namespace
+
+void addFrameOptions(CLI::App& cmd, RenderOptions& o) {
+  cmd.add_option("--aov", o.aovs, "AOV(s) to write; the first goes to PNG (default: all / preview)");
+  cmd.add_option("--exposure", o.exposure, "PNG exposure in stops");
+  cmd.add_flag("--denoise", o.denoise,
+               "denoise the obscurance frame (render/denoise/: demodulated direct and ambient terms, edge-aware "
+               "a-trous filter): the PNG of combined shows it, the EXR gets a `denoised` layer");
+}
+
+RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh::Bvh& bvh, const gpu::Context& context,
+                          const FrameOutputs& outputs, const render::ProgressFn& progress) {
+  checkFrameOptions(o);
+  const scene::Camera camera = chooseCamera(scene, o.camera);
+  chooseSize(o, camera);
+  render::ObscuranceSettings settings = obscuranceSettings(o, camera);
+  settings.editableGeometry = false; // rendered, handed over, done
+  if (o.method == render::Method::PathTrace) {
+    if (outputs.state)
+      throw InputError("--save-state: only the obscurance method keeps per-light transport (--method obscurance)");
+    return pathTrace(o, scene, bvh, context, settings, progress);
+  }
+  // Only what the output shows is kept: a PNG of combined needs neither the primary AOVs nor the
+  // other composed ones (a 4K frame then fits lavapipe's 2 GiB).
+  const std::vector<std::string> wanted =
+      o.aovs.empty() ? (outputs.allAovs ? render::obscuranceAovNames() : std::vector<std::string>{"combined"}) : o.aovs;
+  // The denoiser's guides and terms are the primary and composed AOVs.
+  const bool keepAll = o.denoise;
+  const auto& primaryNames = render::aovNames();
+  settings.primaryAovs = keepAll || std::any_of(wanted.begin(), wanted.end(), [&](const std::string& a) {
+    return a != "emission" && std::find(primaryNames.begin(), primaryNames.end(), a) != primaryNames.end();
+  });
+  settings.composedAovs = keepAll || std::any_of(wanted.begin(), wanted.end(), [](const std::string& a) { return a != "combined"; });
+  render::ObscuranceRenderer renderer(context, scene, bvh, settings);
+  renderer.reset();
+  renderer.iterate(settings.spp, progress);
+  renderer.compose(o.exposure);
+  RenderedFrame frame;
+  frame.stats = renderer.stats();
+  frame.image = renderer.image();
+  // One layer per light group (light.<name>), so that a compositor can relight the frame.
+  if (outputs.lightLayers) appendChannels(frame.image, renderer.lightLayers());
+  if (outputs.state) frame.state = relight::currentState(renderer, o.scenePath);
+  frame.display = renderer.display();
+  nlohmann::json denoiseJson = nullptr;
+  if (o.denoise) {
+    // One frame: the renderer's samples alone (no history), filtered; the image gets it as the
+    // `denoised` layer beside the rest (combined stays the sum of the light layers), the display
+    // shows it.
+    render::Denoiser denoiser(context, renderer);
+    denoiser.denoise(renderer, o.exposure);
+    io::Image denoised = denoiser.image();
+    denoised.channels = render::aovChannels("denoised");
+    appendChannels(frame.image, denoised);
+    frame.display = denoiser.display();
+    denoiseJson = {{"gpu_ms", denoiser.lastGpuMs()}, {"passes_gpu_ms", denoiser.lastPassMs()},
+                   {"iterations", denoiser.settings().iterations}};
+    std::string passes;
+    for (const auto& [name, ms] : denoiser.lastPassMs()) passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", name, ms);
+    frame.summary += fmt::format("denoise: {:.1f} ms GPU ({})\n", denoiser.lastGpuMs(), passes);
+  }
+  const glm::vec3 ia = renderer.ambientIntensity(), rAve = renderer.ambient().averageReflectance;
+  const glm::vec3 iaGlobal = renderer.ambient().globalIntensity(renderer.emissions());
+  frame.summary += fmt::format(
+      "obscurance: dmax {:.4g}, rho {}, {} sampling, {}; R_ave ({:.4f}, {:.4f}, {:.4f}), "
+      "I_a ({:.4g}, {:.4g}, {:.4g}) from {} (the paper's whole-scene formula: ({:.4g}, {:.4g}, {:.4g})); "
+      "{} lights; frame in {} band(s)",
+      renderer.dMax(), nameOf(render::kRhoKindNames, settings.rho),
+      nameOf(render::kObscuranceSamplingNames, settings.systematic), o.noBleed ? "grey" : "colour bleeding", rAve.x,
+      rAve.y, rAve.z, ia.x, ia.y, ia.z,
+      settings.ambient == render::AmbientModel::Global ? "the whole scene"
+      : settings.ambient == render::AmbientModel::Seen
+          ? "the surfaces the lights reach, first bounce fitted to the camera's view"
+          : "the surfaces the lights reach",
+      iaGlobal.x, iaGlobal.y, iaGlobal.z, renderer.lights().size(), renderer.layout().bandCount());
+  if (settings.secondaryReflectors > 0.0f)
+    frame.summary += fmt::format("\nsecondary reflectors: {} of {} triangles marked (threshold {:g} x each light's mean "
+                                 "direct irradiance)",
+                                 renderer.secondaryReflectors(), scene.triangles.size(),
+                                 settings.secondaryReflectors);
+  if (renderer.ambient().reflectanceClamped)
+    frame.summary += "\nnote: the average reflectance reaches 1; it was clamped to 0.999 (I_a would be infinite)";
+  frame.method = {{"method", nameString(render::kMethodNames, o.method)}, {"dmax", renderer.dMax()},
+                  {"rho", nameString(render::kRhoKindNames, settings.rho)}, {"tau", settings.tau},
+                  {"sampling", nameString(render::kObscuranceSamplingNames, settings.systematic)},
+                  {"colour_bleeding", !o.noBleed}, {"max_depth", settings.maxDepth},
+                  {"vertex_rays", nameString(render::kVertexRaysNames, settings.vertexRaysByThroughput)},
+                  {"light_sampling", nameString(render::kLightSamplingNames, settings.lightSampling)},
+                  {"ambient", nameString(render::kAmbientModelNames, settings.ambient)},
+                  {"secondary_reflectors", settings.secondaryReflectors},
+                  {"secondary_reflector_triangles", renderer.secondaryReflectors()},
+                  {"i_a", {ia.x, ia.y, ia.z}}, {"i_a_global", {iaGlobal.x, iaGlobal.y, iaGlobal.z}},
+                  {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
+                  {"emission_samples", settings.emissionSamples}, {"r_ave", {rAve.x, rAve.y, rAve.z}},
+                  {"ambient_intensity", {ia.x, ia.y, ia.z}}, {"lights", renderer.lights().names},
+                  {"bands", renderer.layout().bandCount()}, {"denoise", denoiseJson}};
+  return frame;
+}
+
+} // namespace obscura::app
