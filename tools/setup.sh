@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what Obscura needs on Debian 12 (idempotent; quick when everything is present).
+# The Python module (python/) needs python3-dev, pybind11-dev and python3-numpy.
 # --tests: also what only some tests need: Slurm and munge for tests/farm/slurm_test.sh, which
-# starts and stops a one-node cluster of its own. (On a systemd host Debian's packages enable
+# starts and stops a one-node cluster of its own; pytest for the Python API's tests. (On a systemd host Debian's packages enable
 # munge.service, and slurmctld/slurmd units that do not start without /etc/slurm/slurm.conf.)
 set -euo pipefail
 with_tests=0
@@ -20,8 +21,9 @@ packages=(
   libglfw3-dev libimgui-dev xvfb xauth
   clang libclang-rt-14-dev
   python3-matplotlib
+  python3-dev pybind11-dev python3-numpy
 )
-((with_tests)) && packages+=(slurm-wlm munge)
+((with_tests)) && packages+=(slurm-wlm munge python3-pytest)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
