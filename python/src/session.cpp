@@ -17,6 +17,7 @@
 #include "keyword_options.h"
 #include "progress.h"
 #include "relight/light_edits.h"
+#include "relight/relight_state.h"
 #include "render/scene_data/bvh_layout.h"
 #include "result.h"
 #include "scene.h"
@@ -94,6 +95,13 @@ public:
                     std::move(stats));
   }
 
+  void saveState(const std::string& dir) {
+    session::EditSession& s = open("save_state");
+    py::gil_scoped_release release;
+    std::lock_guard busy(device_->busy);
+    relight::saveState(dir, s.renderer(), options_.scenePath);
+  }
+
   py::array display() {
     session::EditSession& s = open("display");
     const auto& layout = s.renderer().layout();
@@ -157,6 +165,9 @@ now. close(), or leaving a `with` block, frees its device memory.)")
            "rays and gpu_ms per pass, bvh, reach, host_ms, cpu_ms, total_ms. InputError (the session unchanged) "
            "for a malformed edit or a name that does not exist.")
       .def("result", &Session::result, "The frame now as a Result (AOVs, light stack, relight(), save_state()).")
+      .def("save_state", &Session::saveState, py::arg("dir"),
+           "Writes the frame's relighting state to `dir` (state.json, transport.exr) with the edited lights' "
+           "emissions, as `render --save-state` does: `obscura relight DIR` and obscura.load_state read it.")
       .def_property_readonly("display", &Session::display,
                              "The frame now, tonemapped (uint8 H x W x 4), from the fast compose every edit ends with.")
       .def_property_readonly("light_names", &Session::lightNames, "The lights now, added ones included.")

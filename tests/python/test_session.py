@@ -71,3 +71,31 @@ def test_two_sessions_in_one_process_keep_their_own_frames(cornell):
         a.apply({"remove": "cube_2"})
         assert_same(b.result().aovs["combined"], 2.0 * alone, "the other session's frame", rtol=1e-5, atol=1e-6)
         assert "cube_2" not in a.object_names and "closed_box" in b.object_names
+
+
+def test_renders_from_two_threads_equal_renders_one_after_the_other(cornell):
+    import threading
+    box = obscura.Scene(str(LIGHT_IN_BOX))
+    alone = [obscura.render(s, **SMALL).aovs["combined"].copy() for s in (cornell, box)]
+    results = [None, None]
+
+    def render(i, scene):
+        results[i] = obscura.render(scene, **SMALL).aovs["combined"]
+
+    threads = [threading.Thread(target=render, args=(i, s)) for i, s in enumerate((cornell, box))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for i in range(2):
+        assert_same(results[i], alone[i], f"thread {i}")
+
+
+def test_a_session_saves_a_state_that_relight_dir_reads(binary, cornell, tmp_path):
+    with obscura.Session(cornell, **SMALL) as s:
+        s.apply({"light": "light_rectangle_1", "color": [1.0, 0.5, 0.5]})
+        s.save_state(str(tmp_path / "state"))
+        frame = s.result()
+    run_cli(binary, "relight", tmp_path / "state", "--light", "light_rectangle_1=2", "-o", tmp_path / "relit.exr")
+    relit = obscura.read_image(str(tmp_path / "relit.exr"))["combined"]
+    assert_same(relit, frame.relight({"light_rectangle_1": 2.0}), "relight DIR against Result.relight", atol=1e-6)
