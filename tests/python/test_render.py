@@ -103,3 +103,15 @@ def test_path_tracing_returns_combined_and_no_light_stack(cornell):
     assert list(r.aovs) == ["combined"] and r.light_names == []
     with pytest.raises(obscura.InputError, match="per-light transport"):
         r.relight({})
+
+
+def test_a_scene_lists_what_edits_and_relighting_can_name(cornell):
+    info = obscura.info(str(CORNELL))
+    assert [light["name"] for light in info["lights"]] == cornell.light_names == ["light_rectangle_1"]
+    assert info["lights"][0]["type"] == "area" and info["lights"][0]["triangles"] == 2
+    assert len(cornell.objects) == 8 and cornell.objects[5]["name"] == "cube_1"
+    lo, hi = cornell.bounds
+    assert np.allclose(lo, (-1, 0, -1), atol=1e-6) and np.allclose(hi, (1, 2, 1), atol=1e-6)
+    assert cornell.cameras[0]["name"] == "mitsuba_sensor" and cornell.triangles == 36
+    with pytest.raises(obscura.InputError, match="light_groups='material'"):
+        obscura.render(cornell, light_groups="material")
