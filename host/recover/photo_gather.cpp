@@ -7,6 +7,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "recover/recovery_scene.h"
+#include "render/gpu_ray_batch.h"
 #include "render/scene_data/scene_buffers.h"
 
 namespace obscura::recover {
@@ -54,7 +55,7 @@ std::int64_t projectToPixel(const scene::Camera& camera, int width, int height, 
   return std::int64_t(py) * width + std::int64_t(px);
 }
 
-PhotoGather::PhotoGather(const scene::Scene& room, const bvh::Bvh& bvh, const scene::Camera& camera,
+PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const scene::Camera& camera,
                          const PixelGeometry& pixels, const std::vector<Shot>& shots, std::uint32_t raysPerPixel,
                          std::uint32_t seed, int smoothRadius)
     : geometry_(&pixels), smoothRadius_(smoothRadius), pixels_(pixels.position.size()), shots_(shots.size()), raysPerPixel_(raysPerPixel) {
@@ -64,57 +65,94 @@ PhotoGather::PhotoGather(const scene::Scene& room, const bvh::Bvh& bvh, const sc
   const float samePlane = 2e-3f * scale;    // a seen pixel's point within this of the hit's plane
   seenStart_.reserve(pixels_ + 1);
   hiddenStart_.reserve(pixels_ + 1);
-  for (std::size_t p = 0; p < pixels_; ++p) {
-    seenStart_.push_back(static_cast<std::uint32_t>(seen_.size()));
-    hiddenStart_.push_back(static_cast<std::uint32_t>(hiddenObject_.size()));
-    if (pixels.object[p] < 0) continue;
-    rays_ += raysPerPixel;
-    const glm::vec3 n = pixels.normal[p];
-    const glm::vec3 origin = pixels.position[p] + offset * n;
-    glm::vec3 t, b;
-    frame(n, t, b);
-    // Stratified in the first dimension, van der Corput in the second, shifted per pixel.
-    const std::uint32_t h = hash(static_cast<std::uint32_t>(p) ^ hash(seed));
-    const float shift1 = unit(h), shift2 = unit(hash(h));
-    for (std::uint32_t k = 0; k < raysPerPixel; ++k) {
-      const float u1 = std::fmod((float(k) + 0.5f) / float(raysPerPixel) + shift1, 1.0f);
-      const float u2 = std::fmod(radicalInverse2(k) + shift2, 1.0f);
-      const float r = std::sqrt(u1), phi = 2.0f * glm::pi<float>() * u2;
-      const glm::vec3 dir = r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(std::max(0.0f, 1.0f - u1)) * n;
-      const bvh::Hit hit = bvh::closestHit(bvh, bvh::Ray{origin, dir});
-      if (!hit.hit()) continue; // leaves the scene: black
-      const glm::uvec3 tri = room.triangles[hit.primitive];
-      const glm::vec3 a = room.positions[tri.x];
-      const glm::vec3 q = a + hit.u * (room.positions[tri.y] - a) + hit.v * (room.positions[tri.z] - a);
-      glm::vec3 nq = glm::normalize(glm::cross(room.positions[tri.y] - a, room.positions[tri.z] - a));
-      if (glm::dot(nq, dir) > 0.0f) nq = -nq; // the side facing P reflects towards it
-      const auto object = static_cast<std::int32_t>(objectOf[hit.primitive]);
-      const std::int64_t v = projectToPixel(camera, pixels.width, pixels.height, q);
-      if (v >= 0) {
-        const auto vi = static_cast<std::size_t>(v);
-        // The camera sees Q's side if that pixel shows the same object on the same plane, from
-        // the same side (its normal faces the camera, so it must agree with nq).
-        if (pixels.object[vi] == object && std::abs(glm::dot(pixels.position[vi] - q, nq)) < samePlane &&
-            glm::dot(pixels.normal[vi], nq) > 0.9f) {
-          seen_.push_back(static_cast<std::uint32_t>(vi));
-          continue;
-        }
-      }
-      hiddenObject_.push_back(static_cast<std::uint32_t>(object));
-      const glm::vec3 lit = q + offset * nq;
-      for (const Shot& shot : shots) {
-        const glm::vec3 toLamp = shot.position - lit;
-        const float d2 = glm::dot(toLamp, toLamp);
-        const float cosine = glm::dot(nq, toLamp) / std::sqrt(d2);
-        float direct = 0.0f;
-        if (cosine > 0.0f && !bvh::anyHit(bvh, bvh::Ray{lit, toLamp, 0.0f, 1.0f - 1e-4f}))
-          direct = shot.intensity * cosine / (glm::pi<float>() * d2);
-        hiddenDirect_.push_back(direct);
+  // The pixels a chunk at a time, each chunk's rays traced together (one dispatch on a device):
+  // its gather rays, then the shadow rays from its hidden hits to every shot's lamp.
+  const std::size_t pixelsPerChunk = std::max<std::size_t>(1, kRaysPerBatch / std::max(raysPerPixel, 1u));
+  std::vector<bvh::Ray> gatherRays, shadowRays;
+  struct PendingDirect {
+    std::size_t at;  // in hiddenDirect_
+    float unblocked; // the lamp's light there if nothing is in the way
+  };
+  std::vector<PendingDirect> pending;
+  for (std::size_t first = 0; first < pixels_; first += pixelsPerChunk) {
+    const std::size_t last = std::min(pixels_, first + pixelsPerChunk);
+    gatherRays.clear();
+    for (std::size_t p = first; p < last; ++p) {
+      if (pixels.object[p] < 0) continue;
+      const glm::vec3 n = pixels.normal[p];
+      const glm::vec3 origin = pixels.position[p] + offset * n;
+      glm::vec3 t, b;
+      frame(n, t, b);
+      // Stratified in the first dimension, van der Corput in the second, shifted per pixel.
+      const std::uint32_t h = hash(static_cast<std::uint32_t>(p) ^ hash(seed));
+      const float shift1 = unit(h), shift2 = unit(hash(h));
+      for (std::uint32_t k = 0; k < raysPerPixel; ++k) {
+        const float u1 = std::fmod((float(k) + 0.5f) / float(raysPerPixel) + shift1, 1.0f);
+        const float u2 = std::fmod(radicalInverse2(k) + shift2, 1.0f);
+        const float r = std::sqrt(u1), phi = 2.0f * glm::pi<float>() * u2;
+        gatherRays.push_back(
+            {origin, r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(std::max(0.0f, 1.0f - u1)) * n});
       }
     }
+    const std::vector<bvh::Hit> hits = rays.closest(gatherRays);
+    shadowRays.clear();
+    pending.clear();
+    std::size_t ray = 0;
+    for (std::size_t p = first; p < last; ++p) {
+      seenStart_.push_back(static_cast<std::uint32_t>(seen_.size()));
+      hiddenStart_.push_back(static_cast<std::uint32_t>(hiddenObject_.size()));
+      if (pixels.object[p] < 0) continue;
+      rays_ += raysPerPixel;
+      for (std::uint32_t k = 0; k < raysPerPixel; ++k, ++ray) {
+        const bvh::Hit& hit = hits[ray];
+        if (!hit.hit()) continue; // leaves the scene: black
+        const glm::vec3 dir = gatherRays[ray].direction;
+        const glm::uvec3 tri = room.triangles[hit.primitive];
+        const glm::vec3 a = room.positions[tri.x];
+        const glm::vec3 q = a + hit.u * (room.positions[tri.y] - a) + hit.v * (room.positions[tri.z] - a);
+        glm::vec3 nq = glm::normalize(glm::cross(room.positions[tri.y] - a, room.positions[tri.z] - a));
+        if (glm::dot(nq, dir) > 0.0f) nq = -nq; // the side facing P reflects towards it
+        const auto object = static_cast<std::int32_t>(objectOf[hit.primitive]);
+        const std::int64_t v = projectToPixel(camera, pixels.width, pixels.height, q);
+        if (v >= 0) {
+          const auto vi = static_cast<std::size_t>(v);
+          // The camera sees Q's side if that pixel shows the same object on the same plane, from
+          // the same side (its normal faces the camera, so it must agree with nq).
+          if (pixels.object[vi] == object && std::abs(glm::dot(pixels.position[vi] - q, nq)) < samePlane &&
+              glm::dot(pixels.normal[vi], nq) > 0.9f) {
+            seen_.push_back(static_cast<std::uint32_t>(vi));
+            continue;
+          }
+        }
+        hiddenObject_.push_back(static_cast<std::uint32_t>(object));
+        const glm::vec3 lit = q + offset * nq;
+        for (const Shot& shot : shots) {
+          const glm::vec3 toLamp = shot.position - lit;
+          const float d2 = glm::dot(toLamp, toLamp);
+          const float cosine = glm::dot(nq, toLamp) / std::sqrt(d2);
+          if (cosine > 0.0f) {
+            pending.push_back({hiddenDirect_.size(), shot.intensity * cosine / (glm::pi<float>() * d2)});
+            shadowRays.push_back({lit, toLamp, 0.0f, 1.0f - 1e-4f});
+          }
+          hiddenDirect_.push_back(0.0f);
+        }
+      }
+    }
+    const std::vector<float> blocked = rays.blockedAt(shadowRays);
+    for (std::size_t i = 0; i < pending.size(); ++i)
+      if (std::isinf(blocked[i])) hiddenDirect_[pending[i].at] = pending[i].unblocked;
   }
   seenStart_.push_back(static_cast<std::uint32_t>(seen_.size()));
   hiddenStart_.push_back(static_cast<std::uint32_t>(hiddenObject_.size()));
+}
+
+PhotoGather PhotoGather::onDevice(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
+                                  const scene::Camera& camera, const PixelGeometry& pixels,
+                                  const std::vector<Shot>& shots, std::uint32_t raysPerPixel, std::uint32_t seed,
+                                  int smoothRadius) {
+  const render::SceneBuffers buffers(context, room, bvh);
+  render::GpuRayBatch rays(context, buffers, render::TraceShape::forDevice(context, buffers.traversal()));
+  return PhotoGather(room, rays, camera, pixels, shots, raysPerPixel, seed, smoothRadius);
 }
 
 std::vector<std::vector<glm::vec3>> PhotoGather::indirect(const std::vector<Shot>& shots,

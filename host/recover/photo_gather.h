@@ -10,8 +10,9 @@
 // object, the lamp's direct light (a CPU shadow ray) and the current mean indirect light b_i.
 // Rays that leave the scene see nothing (the photographs' world is black).
 //
-// The rays depend on the geometry only: they are traced once (CPU BVH), and each recovery
-// iteration (new R_o, b_i) re-sums them without a ray.
+// The rays depend on the geometry only: they are traced once, through a RayBatch (the device's
+// traversal, render/gpu_ray_batch.h, or the CPU's twin), and each recovery iteration (new R_o,
+// b_i) re-sums them without a ray.
 //
 // The estimate's variance comes from bright spots (near a lamp the walls are 30x the median) met
 // by few rays. Indirect light varies slowly over a surface, so B_i is then averaged over a
@@ -24,7 +25,9 @@
 #include <glm/glm.hpp>
 
 #include "bvh/bvh.h"
+#include "gpu/context.h"
 #include "recover/photo_set.h"
+#include "render/scene_data/ray_batch.h"
 #include "scene/scene.h"
 
 namespace obscura::recover {
@@ -39,8 +42,18 @@ struct PixelGeometry {
 
 class PhotoGather {
 public:
-  PhotoGather(const scene::Scene& room, const bvh::Bvh& bvh, const scene::Camera& camera, const PixelGeometry& pixels,
+  // The pixels' gather rays and their hidden hits' shadow rays through `rays` (about
+  // kRaysPerBatch gather rays at a time).
+  PhotoGather(const scene::Scene& room, render::RayBatch& rays, const scene::Camera& camera, const PixelGeometry& pixels,
               const std::vector<Shot>& shots, std::uint32_t raysPerPixel, std::uint32_t seed, int smoothRadius);
+  // The same with the rays on `context`'s device, through the renderer's traversal of the room's
+  // buffers (uploaded for this and dropped after).
+  static PhotoGather onDevice(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
+                              const scene::Camera& camera, const PixelGeometry& pixels, const std::vector<Shot>& shots,
+                              std::uint32_t raysPerPixel, std::uint32_t seed, int smoothRadius);
+  // Gather rays traced together (a 256 x 256 view's 64 per pixel in 4 batches): few submissions,
+  // and the rays and hits of one batch in tens of MiB of host memory.
+  static constexpr std::size_t kRaysPerBatch = std::size_t(1) << 20;
 
   // B_i per pixel for every shot (per unit reflectance, radiance units), with the photographs'
   // radiance where the camera sees the hit, and objectReflectance / hiddenAmbient[i] elsewhere.

@@ -232,8 +232,9 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   std::unique_ptr<PhotoGather> gather;
   if (options.indirect == IndirectModel::Gather) {
     stepStart = Clock::now();
-    gather = std::make_unique<PhotoGather>(room, bvh, camera, lighting.geometry, photos.shots, options.gatherRays,
-                                           options.seed, options.gatherSmoothing);
+    gather = std::make_unique<PhotoGather>(PhotoGather::onDevice(context, room, bvh, camera, lighting.geometry,
+                                                                 photos.shots, options.gatherRays, options.seed,
+                                                                 options.gatherSmoothing));
     out.gatherSeen = gather->seenFraction();
     out.gatherHidden = gather->hiddenFraction();
     if (log)

@@ -105,8 +105,8 @@ RemodelledFrame renderRemodelled(const gpu::Context& context, const RecoveredRoo
   for (std::size_t p = 0; p < pixels; ++p) out.synthesizedPixels += fill.hole[p];
 
   // B by successive gathers of the relit radiance (remodel.h).
-  const PhotoGather gather(edited, editedBvh, camera, view, lamps, options.gatherRays, options.seed,
-                           options.gatherSmoothing);
+  const PhotoGather gather = PhotoGather::onDevice(context, edited, editedBvh, camera, view, lamps, options.gatherRays,
+                                                   options.seed, options.gatherSmoothing);
   std::vector<glm::vec3> lampColour;
   for (const Shot& lamp : lamps) lampColour.push_back(lamp.color);
   out.indirect.assign(pixels, glm::vec3(0.0f));

@@ -11,9 +11,10 @@ constexpr float kInfinity = std::numeric_limits<float>::infinity();
 // One ray per invocation, straight through traverseBvh as a pass's rays go, on every device: a
 // light's stages are a thousand to a few ten thousand rays, which lavapipe's refilling shape (64
 // rays per lane, 2,048 per workgroup) would leave to one or two workgroups.
-GpuRayBatch::GpuRayBatch(const gpu::Context& context, const SceneBuffers& scene)
-    : tracer_(context, scene, scene.traversal() == Traversal::Wide ? TraceShape{gpu::kTraceWorkgroupSize, 1u}
-                                                                  : TraceShape::forBinary()) {}
+GpuRayBatch::GpuRayBatch(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape)
+    : tracer_(context, scene,
+              shape ? *shape
+                    : scene.traversal() == Traversal::Wide ? TraceShape{gpu::kTraceWorkgroupSize, 1u} : TraceShape::forBinary()) {}
 
 TraceResult GpuRayBatch::trace(std::span<const bvh::Ray> rays, TraceMode mode) {
   std::vector<gpu::GpuRay> gpuRays;

@@ -12,7 +12,9 @@ namespace obscura::render {
 
 class GpuRayBatch final : public RayBatch {
 public:
-  GpuRayBatch(const gpu::Context& context, const SceneBuffers& scene);
+  // `shape`: by default one ray per invocation, for a light's stages of a thousand to a few ten
+  // thousand rays; sets of millions (recover's gather) take the device's (TraceShape::forDevice).
+  GpuRayBatch(const gpu::Context& context, const SceneBuffers& scene, std::optional<TraceShape> shape = {});
   std::vector<bvh::Hit> closest(std::span<const bvh::Ray> rays) override;
   std::vector<float> blockedAt(std::span<const bvh::Ray> rays) override;
   // The scene's buffers changed (a geometry edit): see RayTracer::rebind.
