@@ -280,7 +280,8 @@ void runBench(const BenchOptions& o) {
   if (!(std::isfinite(o.frameWork.dMax) && o.frameWork.dMax > 0.0f))
     throw InputError(fmt::format("--frame-dmax {}: must be a finite positive distance in scene units", o.frameWork.dMax));
   LoadedScene loaded = loadScene(o.scenePath, "node", std::nullopt);
-  gpu::Context context(o.device.contextOptions());
+  const std::shared_ptr<gpu::Context> contextHandle = commandContext(o.device);
+  const gpu::Context& context = *contextHandle;
   loaded.bvh = bvh::build(render::triangleSoup(loaded.scene), treeOptions(o, context));
   if (!o.move.empty()) applyMove(o, loaded, context);
   if (!o.json) fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);

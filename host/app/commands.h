@@ -1,5 +1,7 @@
 // commands.h — the `obscura` subcommands; each lives in its own file.
 #pragma once
+#include <memory>
+
 #include <CLI/CLI.hpp>
 
 #include "gpu/context.h"
@@ -14,6 +16,15 @@ struct DeviceOptions {
   gpu::ContextOptions contextOptions() const { return {.validate = validate, .device = device, .traversal = traversal}; }
 };
 void addDeviceOptions(CLI::App& command, DeviceOptions& options);
+
+// The Vulkan context a command renders on: a new one, unless this process keeps them
+// (keepCommandContexts): then one per device choice (the options and the environment that shapes
+// a context: OBSCURA_VALIDATE, the Vulkan ICD variables, LP_NUM_THREADS) is made on first use and
+// serves every later command, its compiled pipelines with it (an LLVM compile per kernel on
+// lavapipe). A process that runs many commands keeps them: the CLI tests, the Python module.
+// Not thread-safe: commands run one at a time.
+std::shared_ptr<gpu::Context> commandContext(const DeviceOptions& options);
+void keepCommandContexts(bool keep);
 
 void addRenderCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);

@@ -52,7 +52,8 @@ void runConverge(const ConvergeOptions& o) {
   fs::create_directories(o.outputDir, ec);
   if (ec || !fs::is_directory(o.outputDir))
     throw InputError(fmt::format("{}: cannot create the output folder{}", o.outputDir, ec ? ": " + ec.message() : ""));
-  gpu::Context context(o.device.contextOptions());
+  const std::shared_ptr<gpu::Context> contextHandle = commandContext(o.device);
+  const gpu::Context& context = *contextHandle;
   buildTreeFor(loaded, context);
   fmt::print("{}\ndevice: {} ({})\n", sceneSummary(loaded), context.info().name, context.info().driver);
   warnIfUnlit(loaded);

@@ -174,7 +174,8 @@ void runRecover(RecoverOptions& o) {
       throw InputError(fmt::format("{}: the answer key is {}x{}, the photographs {}x{}", o.truth, w, h, photos.width,
                                    photos.height));
   }
-  gpu::Context context(o.device.contextOptions());
+  const std::shared_ptr<gpu::Context> contextHandle = commandContext(o.device);
+  const gpu::Context& context = *contextHandle;
   const recover::Recovery r = recover::recoverReflectance(
       context, loaded.scene, loaded.bvh, camera, photos, rec, [](const std::string& line) { fmt::print(stderr, "{}\n", line); });
   std::error_code ec;

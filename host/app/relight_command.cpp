@@ -122,7 +122,8 @@ void relightScene(RelightOptions& o) {
 
   const scene::Camera camera = chooseCamera(loaded.scene, o.render.camera);
   chooseSize(o.render, camera);
-  gpu::Context context(o.render.device.contextOptions());
+  const std::shared_ptr<gpu::Context> contextHandle = commandContext(o.render.device);
+  const gpu::Context& context = *contextHandle;
   buildTreeFor(loaded, context);
   const auto spareLights = static_cast<std::uint32_t>(std::count_if(edits.begin(), edits.end(), [](const relight::Edit& e) {
     return e.kind == relight::Edit::Kind::AddLight || e.kind == relight::Edit::Kind::AddQuad;

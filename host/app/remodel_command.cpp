@@ -179,7 +179,8 @@ void runRemodel(const RemodelCommandOptions& o) {
   lampSet.shots = on;
   recover::checkLamps(edited, editedBvh, lampSet);
 
-  gpu::Context context(o.device.contextOptions());
+  const std::shared_ptr<gpu::Context> contextHandle = commandContext(o.device);
+  const gpu::Context& context = *contextHandle;
   const scene::Camera camera = loaded.scene.cameras[static_cast<std::size_t>(folder.camera)];
   const recover::RemodelledFrame frame =
       recover::renderRemodelled(context, folder.room, edited, editedBvh, camera, on, o.remodel);

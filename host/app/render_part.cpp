@@ -97,7 +97,8 @@ void renderPart(RenderOptions& o) {
   part.job = jobIdentity(o);
   warnIfUnlit(loaded);
 
-  gpu::Context context(o.device.contextOptions());
+  const std::shared_ptr<gpu::Context> contextHandle = commandContext(o.device);
+  const gpu::Context& context = *contextHandle;
   fmt::print(stderr, "device: {} ({})\n", context.info().name, context.info().driver);
   buildTreeFor(loaded, context);
   fmt::print(stderr, "{}\n", sceneSummary(loaded));

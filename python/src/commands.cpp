@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include "app/command_line.h"
+#include "app/commands.h"
 #include "arrays.h"
 #include "bindings.h"
 #include "io/image_io.h"
@@ -16,6 +17,8 @@ namespace py = pybind11;
 namespace obscura::python {
 
 void bindCommands(py::module_& m) {
+  // The module runs many commands: their contexts (and compiled kernels) are kept between them.
+  app::keepCommandContexts(true);
   m.def(
       "run_command",
       [](const std::vector<std::string>& args) {

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "app/command_line.h"
+#include "app/commands.h"
 
 #include "gpu_test.h"
 
@@ -46,6 +47,9 @@ std::optional<std::vector<std::string>> plainWords(const std::string& args) {
 // Runs `obscura words` through app::runCommandLine with this process's stdout and stderr sent
 // to one file (as the shell's 2>&1 does), then read back.
 RunResult runInProcess(const std::vector<std::string>& words) {
+  // As a program that runs many commands: each device choice's context, and its compiled
+  // pipelines, serve every later command of the test process (app/commands.h).
+  app::keepCommandContexts(true);
   std::vector<const char*> argv{"obscura"};
   for (const std::string& w : words) argv.push_back(w.c_str());
   std::FILE* capture = std::tmpfile();

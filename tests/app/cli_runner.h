@@ -16,7 +16,8 @@ struct RunResult {
 // Runs `prefix obscura args` as a user does. The command line runs in this process
 // (app::runCommandLine, what main() is; a prefix of NAME=value assignments set for the call), its
 // stdout and stderr captured, which spares each case a process start (the Vulkan loader and the
-// validation layer). With another prefix (limits, env -u),
+// validation layer) and, with the contexts kept (app::keepCommandContexts), the compile of every
+// kernel an earlier case compiled. With another prefix (limits, env -u),
 // shell syntax in `args`, or OBSCURA_CLI_SUBPROCESS=1 in the environment, the obscura binary
 // runs in a shell. ctest runs every test with OBSCURA_VALIDATE=1, which both
 // inherit: a validation message either prints fails the test.
