@@ -10,6 +10,7 @@
 #include "app/commands.h"
 #include "arrays.h"
 #include "bindings.h"
+#include "devices.h"
 #include "io/image_io.h"
 
 namespace py = pybind11;
@@ -17,12 +18,11 @@ namespace py = pybind11;
 namespace obscura::python {
 
 void bindCommands(py::module_& m) {
-  // The module runs many commands: their contexts (and compiled kernels) are kept between them.
-  app::keepCommandContexts(true);
   m.def(
       "run_command",
       [](const std::vector<std::string>& args) {
         py::gil_scoped_release release;
+        std::lock_guard work(deviceWork());
         app::runCommand(args);
       },
       py::arg("args"),

@@ -1,8 +1,5 @@
 #include "devices.h"
 
-#include <map>
-#include <tuple>
-
 #include <pybind11/stl.h>
 
 #include "bindings.h"
@@ -12,14 +9,6 @@ namespace py = pybind11;
 
 namespace obscura::python {
 namespace {
-
-using DeviceKey = std::tuple<std::string, bool, std::string>;
-
-std::mutex devicesMutex;
-std::map<DeviceKey, std::shared_ptr<Device>>& devices() {
-  static auto* kept = new std::map<DeviceKey, std::shared_ptr<Device>>(); // outlives the interpreter's teardown
-  return *kept;
-}
 
 py::dict deviceInfo(const gpu::DeviceInfo& d, bool chosen) {
   py::dict info;
@@ -36,18 +25,18 @@ py::dict deviceInfo(const gpu::DeviceInfo& d, bool chosen) {
 
 } // namespace
 
-std::shared_ptr<Device> sharedDevice(const app::DeviceOptions& options) {
-  const DeviceKey key{options.device, options.validate, options.traversal};
-  std::lock_guard lock(devicesMutex);
-  auto& kept = devices();
-  auto found = kept.find(key);
-  if (found != kept.end()) return found->second;
-  auto device = std::make_shared<Device>(options.contextOptions());
-  kept.emplace(key, device);
-  return device;
+std::mutex& deviceWork() {
+  static auto* work = new std::mutex(); // outlives the interpreter's teardown, as the contexts do
+  return *work;
+}
+
+std::shared_ptr<gpu::Context> sharedContext(const app::DeviceOptions& options) {
+  return app::commandContext(options);
 }
 
 void bindDevices(py::module_& m) {
+  // The module runs many renders and commands: one context per device choice serves them all.
+  app::keepCommandContexts(true);
   m.def(
       "devices",
       [] {
@@ -60,11 +49,13 @@ void bindDevices(py::module_& m) {
   m.def(
       "release_devices",
       [] {
-        std::lock_guard lock(devicesMutex);
-        devices().clear();
+        py::gil_scoped_release release;
+        std::lock_guard work(deviceWork());
+        app::keepCommandContexts(false); // drops them
+        app::keepCommandContexts(true);
       },
       "Drops the module's kept Vulkan contexts and their compiled pipelines (sessions still open keep "
-      "theirs until closed). The next render makes its context again.");
+      "theirs until closed). The next render or command makes its context again.");
   m.def("validation_messages", &gpu::Context::validationMessages,
         "The Khronos validation layer's warnings and errors so far (with OBSCURA_VALIDATE=1 or "
         "validate=True), all contexts together.");

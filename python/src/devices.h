@@ -1,8 +1,9 @@
-// devices.h — the Vulkan contexts the module's renders and sessions share: one per device choice
-// (--device, --validate, --traversal), made on first use and kept, so that the compiled pipelines
-// (gpu/pipeline_cache.h, seconds of LLVM per kernel on lavapipe) serve every later render. A
-// context serves one operation at a time (its queue and command pool are not thread-safe):
-// callers hold `busy` while they use it, with the GIL released.
+// devices.h — the Vulkan contexts the module's renders, sessions and commands share: the ones
+// app::commandContext keeps for a process that runs many commands (one per device choice, made on
+// first use with its compiled pipelines: an LLVM compile per kernel on lavapipe), so that
+// run_command's commands and render() compile each kernel once between them. A context's queue
+// and command pool are not thread-safe: every call's device work holds deviceWork(), with the GIL
+// released.
 #pragma once
 #include <memory>
 #include <mutex>
@@ -12,13 +13,10 @@
 
 namespace obscura::python {
 
-struct Device {
-  explicit Device(const gpu::ContextOptions& options) : context(options) {}
-  gpu::Context context;
-  std::mutex busy;
-};
+// Held by every call while it uses a device (and while it gets its context).
+std::mutex& deviceWork();
 
-// The device `options` choose, made on first use (InputError/DeviceError when there is none).
-std::shared_ptr<Device> sharedDevice(const app::DeviceOptions& options);
+// The context `options` choose (InputError/DeviceError when there is none); deviceWork() held.
+std::shared_ptr<gpu::Context> sharedContext(const app::DeviceOptions& options);
 
 } // namespace obscura::python

@@ -93,22 +93,22 @@ Result render(const std::shared_ptr<Scene>& scene, const std::vector<std::string
   const render::ProgressFn onProgress = progressCallback(progress);
   py::gil_scoped_release release;
   app::checkFrameOptions(o);
-  const auto device = sharedDevice(o.device);
-  std::lock_guard busy(device->busy);
-  const auto tree = scene->treeFor(device->context);
+  std::lock_guard work(deviceWork());
+  const std::shared_ptr<gpu::Context> context = sharedContext(o.device);
+  const auto tree = scene->treeFor(*context);
   std::optional<scene::Scene> withSky; // --background gives the scene a sky light: a copy of its own
   if (!o.background.empty()) {
     withSky = scene->scene();
     withSky->background = glm::vec3(o.background[0], o.background[1], o.background[2]);
   }
   const bool obscurance = o.method == render::Method::Obscurance;
-  app::RenderedFrame frame = app::renderFrame(o, withSky ? *withSky : scene->scene(), *tree, device->context,
+  app::RenderedFrame frame = app::renderFrame(o, withSky ? *withSky : scene->scene(), *tree, *context,
                                               {.lightLayers = false, .state = obscurance, .allAovs = true}, onProgress);
   app::checkTraversals(frame.stats);
   nlohmann::json stats = app::statsJson(frame.stats);
   stats["method"] = frame.method;
   stats["notes"] = frame.stats.notes;
-  stats["device"] = device->context.info().name;
+  stats["device"] = context->info().name;
   stats["width"] = o.width;
   stats["height"] = o.height;
   stats["spp"] = o.spp;

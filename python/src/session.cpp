@@ -40,14 +40,14 @@ public:
     options_.scenePath = scene_->path();
     const render::ProgressFn onProgress = progressCallback(progress);
     py::gil_scoped_release release;
-    device_ = sharedDevice(options_.device);
-    std::lock_guard busy(device_->busy);
+    std::lock_guard work(deviceWork());
+    context_ = sharedContext(options_.device);
     scene::Scene copy = scene_->scene(); // the session's own: edits change it
     if (!options_.background.empty())
       copy.background = glm::vec3(options_.background[0], options_.background[1], options_.background[2]);
     const scene::Camera camera = app::chooseCamera(copy, options_.camera);
     app::chooseSize(options_, camera);
-    const gpu::Context& context = device_->context;
+    const gpu::Context& context = *context_;
     session_ = std::make_unique<session::EditSession>(
         context, std::move(copy), bvh::Bvh(*scene_->treeFor(context)),
         session::editSettings(app::obscuranceSettings(options_, camera), spareLights),
@@ -72,7 +72,7 @@ public:
           throw InputError(fmt::format("{}: entry {}: '{}': no such file", where, edits_, e.path));
         e.inserted = std::make_shared<const scene::Scene>(scene::loadGltf(e.path));
       }
-      std::lock_guard busy(device_->busy);
+      std::lock_guard work(deviceWork());
       session::EditReport report = s.apply(e, fmt::format("{}: entry {}", where, edits_));
       s.composeDisplay(report, options_.exposure);
       line = report.json();
@@ -84,13 +84,13 @@ public:
   Result result() {
     session::EditSession& s = open("result");
     py::gil_scoped_release release;
-    std::lock_guard busy(device_->busy);
+    std::lock_guard work(deviceWork());
     render::ObscuranceRenderer& renderer = s.renderer();
     std::vector<std::uint32_t> display = renderer.display();
     renderer.compose(options_.exposure);
     auto image = std::make_shared<const io::Image>(renderer.image());
     nlohmann::json stats = {{"edits", edits_}, {"samples", renderer.samples()},
-                            {"device_bytes", renderer.deviceBytes()}, {"device", device_->context.info().name}};
+                            {"device_bytes", renderer.deviceBytes()}, {"device", context_->info().name}};
     return resultOf(relight::currentState(renderer, options_.scenePath), std::move(image), std::move(display),
                     std::move(stats));
   }
@@ -98,7 +98,7 @@ public:
   void saveState(const std::string& dir) {
     session::EditSession& s = open("save_state");
     py::gil_scoped_release release;
-    std::lock_guard busy(device_->busy);
+    std::lock_guard work(deviceWork());
     relight::saveState(dir, s.renderer(), options_.scenePath);
   }
 
@@ -125,7 +125,7 @@ public:
   void close() {
     if (!session_) return;
     py::gil_scoped_release release;
-    std::lock_guard busy(device_->busy);
+    std::lock_guard work(deviceWork());
     session_.reset();
   }
   bool closed() const { return !session_; }
@@ -138,7 +138,7 @@ private:
 
   std::shared_ptr<Scene> scene_;
   app::RenderOptions options_;
-  std::shared_ptr<Device> device_;
+  std::shared_ptr<gpu::Context> context_;
   std::unique_ptr<session::EditSession> session_;
   std::size_t edits_ = 0;
 };
