@@ -46,6 +46,7 @@ layout(std430, set = 0, binding = kBindingPathRadiance) buffer RadianceBuffer { 
 #include "lib/light_bindings.glsl" // at kBindingPathLights and kBindingPathEmitters
 layout(std430, set = 0, binding = kBindingPathLightTree) readonly buffer LightTreeBuffer { GpuLightNode lightTree[]; };
 layout(std430, set = 0, binding = kBindingPathScales) readonly buffer ScaleBuffer { vec4 emissionScale[]; };
+layout(std430, set = 0, binding = kBindingPathEmitterEdges) buffer EmitterEdges { uint emitterEdges[]; };
 
 #include "lib/intersect.glsl"
 #include "lib/bvh.glsl"
@@ -90,7 +91,7 @@ void main() {
   // (lib/emission_samples.glsl), as the obscurance renderer's M_s does; the path's vertex 1 then
   // adds none.
   const uint emissionSamples = min(pc.emissionSamples, kMaxEmissionSamples);
-  const bool ownEmissionRays = emissionSamples > 1u;
+  bool ownEmissionRays = emissionSamples > 1u;
 
   // The camera ray exactly as primary.comp makes it: the same per-pixel shift of the same R2
   // sub-pixel sequence, so sample i of both renderers goes through the same point of the pixel.
@@ -105,6 +106,19 @@ void main() {
   StepBudget budget = newStepBudget();
   uint rays = 1u;
   RayHit hit = traceWithBudget(budget, origin, direction, 0.0, 1.0 / 0.0, false);
+  // --emission-samples auto: the K rays only where an emitter's edge crosses the pixel, probed at
+  // its first sample as primary.comp does.
+  if (ownEmissionRays && pc.emissionAtEdges != 0u) {
+    if (lightCount == 0u) { // nothing emits with power: no edge to find
+      ownEmissionRays = false;
+    } else if (pc.sampleIndex == pc.firstSample) {
+      ownEmissionRays = emitterEdgeCrossesPixel(budget, pc.camera, p, vec2(size), lightCount);
+      emitterEdges[pixel] = ownEmissionRays ? 1u : 0u;
+      rays += kEdgeProbeRays;
+    } else {
+      ownEmissionRays = emitterEdges[pixel] != 0u;
+    }
+  }
 
   vec3 L = vec3(0.0);
   if (ownEmissionRays) {

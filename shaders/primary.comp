@@ -23,6 +23,7 @@ layout(std430, set = 0, binding = kBindingPrimaryEmissionBasis) buffer EmissionB
 layout(std430, set = 0, binding = kBindingPrimaryHitBounds) buffer HitBounds { vec4 hitBounds[]; };
 layout(std430, set = 0, binding = kBindingPrimaryDirty) readonly buffer DirtyMask { uint dirty[]; };
 layout(std430, set = 0, binding = kBindingPrimarySampleCounts) buffer SampleCounts { uint sampleCounts[]; };
+layout(std430, set = 0, binding = kBindingPrimaryEmitterEdges) buffer EmitterEdges { uint emitterEdges[]; };
 
 // Kernel variants (PrimaryPass picks one per dispatch from its flags): the code a dispatch never
 // takes is left out, because on lavapipe it still costs (registers are allocated over the whole
@@ -131,8 +132,23 @@ void main() {
   // sum; a dirty pixel's retrace restarts its own here (a store per light per pixel).
   if (first && (pc.flags & kPrimaryFlagDirtyOnly) != 0u)
     for (uint s = 0u; s < lightCount; ++s) OBS_ACCUMULATE_FIRST(emissionBasis, s * bp.count + pixel, vec4(0.0))
-  const bool ownRays = kEmissionRays && emissionSamples > 1u;
+  bool ownRays = kEmissionRays && emissionSamples > 1u;
+  uint emissionRays = 0u; // traced for the seen emission alone (the status word counts them)
+  if (ownRays && (pc.flags & kPrimaryFlagEmissionAtEdges) != 0u) {
+    // Only where an emitter's edge crosses the pixel: probed at its first sample, kept after.
+    if (lightCount == 0u) { // no light: no edge to find
+      ownRays = false;
+    } else if (first) {
+      ownRays = emitterEdgeCrossesPixel(budget, pc.camera, p, vec2(size), lightCount);
+      emitterEdges[pixel] = ownRays ? 1u : 0u;
+      emissionRays += kEdgeProbeRays;
+    } else {
+      ownRays = emitterEdges[pixel] != 0u;
+    }
+  }
   const uint rays = ownRays ? emissionSamples : 1u;
+  if (ownRays) emissionRays += rays;
+  if (emissionRays > 0u) atomicAdd(status[kStatusEmissionRays], emissionRays);
   const uint sky = floatBitsToUint(pc.camera.up.w);
   bool emissionTruncated = false;
   uint runLight = kInvalidIndex;

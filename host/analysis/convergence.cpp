@@ -40,4 +40,25 @@ TimeAt timeToReach(const Curve& curve, double target, ErrorKind kind, Metric met
   return {.ms = last.gpuMs * (e / target) * (e / target), .extrapolated = true, .valid = true};
 }
 
+ErrorAt errorAtTime(const Curve& curve, double ms, ErrorKind kind, Metric metric) {
+  if (curve.points.empty() || ms <= 0.0) return {};
+  const auto& first = curve.points.front();
+  const auto& last = curve.points.back();
+  // error ~ t^(-1/2) from point p: e_p sqrt(t_p / t).
+  auto along = [&](const CurvePoint& p) {
+    return ErrorAt{.error = errorOf(p, kind, metric) * std::sqrt(p.gpuMs / ms), .extrapolated = true, .valid = true};
+  };
+  if (ms < first.gpuMs) return along(first);
+  for (std::size_t i = 1; i < curve.points.size(); ++i) {
+    const auto& a = curve.points[i - 1];
+    const auto& b = curve.points[i];
+    if (ms > b.gpuMs) continue;
+    const double f = a.gpuMs == b.gpuMs ? 1.0 : (std::log(ms) - std::log(a.gpuMs)) / (std::log(b.gpuMs) - std::log(a.gpuMs));
+    const double ea = errorOf(a, kind, metric), eb = errorOf(b, kind, metric);
+    if (ea <= 0.0 || eb <= 0.0) return {.error = ea + f * (eb - ea), .extrapolated = false, .valid = true};
+    return {.error = std::exp(std::log(ea) + f * (std::log(eb) - std::log(ea))), .extrapolated = false, .valid = true};
+  }
+  return ms == first.gpuMs ? ErrorAt{.error = errorOf(first, kind, metric), .valid = true} : along(last);
+}
+
 } // namespace obscura::analysis

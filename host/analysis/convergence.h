@@ -39,4 +39,14 @@ double errorOf(const ImageError& e, Metric metric);
 // the Monte Carlo rate of an unbiased estimator (only meaningful for noise).
 TimeAt timeToReach(const Curve& curve, double target, ErrorKind kind, Metric metric = Metric::Rmse);
 
+// The curve's error at GPU time `ms`: interpolated in log-log between the measured points around
+// it; outside them, extended from the nearest point along error ~ time^(-1/2). Invalid (ms 0) for
+// an empty curve.
+struct ErrorAt {
+  double error = 0.0;
+  bool extrapolated = false;
+  bool valid = false;
+};
+ErrorAt errorAtTime(const Curve& curve, double ms, ErrorKind kind, Metric metric = Metric::Rmse);
+
 } // namespace obscura::analysis

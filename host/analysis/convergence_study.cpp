@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,13 @@
 namespace obscura::analysis {
 
 namespace {
+
+// The cached reference's .txt line with its own noise (RMSE, trimmed RMSE, MAE).
+constexpr const char* kOwnNoiseKey = "own_noise(rmse,rmse_trimmed,mae):";
+
+std::string emissionName(std::uint32_t samples, bool atEdges) {
+  return atEdges ? fmt::format("{}_at_edges", samples) : std::to_string(samples);
+}
 
 // Each method with its best estimators, the paper's estimator for reproduction, and a real-time
 // budget (one primary sample with 1 + 1 rays per hit). Path tracing comes last.
@@ -53,7 +61,7 @@ std::vector<StudyMethod> studyMethods(const StudySettings& o) {
     m.secondaryReflectors = o.secondaryReflectors;
     methods.insert(methods.end() - 1, m);
   }
-  if (o.emissionSamples > 1) { // what the emission rays change, in the same run
+  if (o.emissionSamples > 1) { // what the emission rays change, in the same run (default: at the edges)
     StudyMethod m = methods.front();
     m.name = "obscurance-primary-emission";
     m.what = "as obscurance, the seen emission from the primary rays alone (--emission-samples 1)";
@@ -80,7 +88,8 @@ StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, st
   const render::RenderStats* stats = nullptr;
   if (m.pathTrace) {
     render::PathTraceSettings s{.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_,
-                                .lightSampling = m.lightSampling, .emissionSamples = o_.pathEmissionSamples};
+                                .lightSampling = m.lightSampling, .emissionSamples = o_.pathEmissionSamples,
+                                .emissionAtEdges = o_.pathEmissionAtEdges};
     if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, scene_, bvh_, s);
     pathTracer_->configure(s);
     pathTracer_->render();
@@ -93,6 +102,7 @@ StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, st
     s.height = height_;
     s.spp = spp;
     s.emissionSamples = m.emissionSamples ? m.emissionSamples : o_.emissionSamples;
+    s.emissionAtEdges = m.emissionSamples ? false : o_.emissionAtEdges;
     s.seed = seed;
     s.camera = camera_;
     s.shadowRays = m.raysPerHit;
@@ -159,10 +169,11 @@ io::Image ConvergenceStudy::reference(const StudyMethod& m) {
   std::filesystem::path exr = std::filesystem::path(o_.outputDir) / fmt::format("{}.{}.reference.exr", stem_, m.name);
   std::filesystem::path txt = exr;
   txt.replace_extension(".txt");
-  std::string description = fmt::format("scene={} method={} width={} height={} spp={} seed={} rays_per_hit={} "
-                                        "emission_samples={} light_sampling={}{}{}",
+  std::string description = fmt::format("scene={} method={} width={} height={} spp={} (two halves) seed={} "
+                                        "rays_per_hit={} emission_samples={} light_sampling={}{}{}",
                                         o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
-                                        m.pathTrace ? o_.pathEmissionSamples : o_.emissionSamples,
+                                        m.pathTrace ? emissionName(o_.pathEmissionSamples, o_.pathEmissionAtEdges)
+                                                    : emissionName(o_.emissionSamples, o_.emissionAtEdges),
                                         nameOf(render::kLightSamplingNames, m.lightSampling),
                                         m.pathTrace ? "" : fmt::format(" ambient=seen+reached+global dmax={} secondary_reflectors={}",
                                                                        o_.dMax, m.secondaryReflectors),
@@ -174,30 +185,76 @@ io::Image ConvergenceStudy::reference(const StudyMethod& m) {
     if (first == description &&
         (m.pathTrace || (std::filesystem::exists(otherPath(exr, "global")) && std::filesystem::exists(otherPath(exr, "reached"))))) {
       fmt::print("reference {}: cached ({})\n", m.name, exr.string());
+      for (std::string line; std::getline(in, line);) {
+        std::istringstream words(line);
+        std::string key;
+        ImageError noise;
+        if (words >> key >> noise.rmse >> noise.rmseTrimmed >> noise.mae && key == kOwnNoiseKey)
+          referenceNoise_[m.name] = noise;
+      }
       if (!m.pathTrace)
         for (const char* model : {"global", "reached"})
           otherReferences_[model][m.name] = io::readImage(otherPath(exr, model).string());
       return io::readImage(exr.string());
     }
   }
-  fmt::print("reference {}: rendering {} spp at {}x{}...\n", m.name, spp, width_, height_);
+  fmt::print("reference {}: rendering 2 x {} spp at {}x{}...\n", m.name, spp / 2, width_, height_);
   std::fflush(stdout);
-  StudyRender r = render(m, spp, o_.seed + 7919);
-  io::Image combined = combinedOnly(r.image);
-  io::writeExr(exr.string(), combined);
-  if (!m.pathTrace) {
-    // The same samples composed with the paper's whole-scene I_a and with the reached one
-    // (compose only, no ray).
-    for (auto [model, name] : {std::pair{render::AmbientModel::Global, "global"}, std::pair{render::AmbientModel::Reached, "reached"}}) {
-      obscurance_->setAmbientModel(model);
-      obscurance_->compose();
-      otherReferences_[name][m.name] = combinedOnly(obscurance_->image());
-      io::writeExr(otherPath(exr, name).string(), otherReferences_[name][m.name]);
+  // Two halves with seeds of their own: the reference is their mean, and their difference says how
+  // converged it is (referenceNoise). Each obscurance half is also composed with the paper's
+  // whole-scene I_a and with the reached one (compose only, no ray).
+  struct Half {
+    io::Image seen;
+    std::map<std::string, io::Image> other; // model -> image
+    double gpuMs = 0.0;
+  };
+  auto renderHalf = [&](std::uint32_t seed) {
+    Half h;
+    StudyRender r = render(m, std::max(1u, spp / 2), seed);
+    h.seen = combinedOnly(r.image);
+    h.gpuMs = r.gpuMs;
+    if (!m.pathTrace) {
+      for (auto [model, name] : {std::pair{render::AmbientModel::Global, "global"}, std::pair{render::AmbientModel::Reached, "reached"}}) {
+        obscurance_->setAmbientModel(model);
+        obscurance_->compose();
+        h.other[name] = combinedOnly(obscurance_->image());
+      }
+      obscurance_->setAmbientModel(render::AmbientModel::Seen);
     }
-    obscurance_->setAmbientModel(render::AmbientModel::Seen);
+    return h;
+  };
+  const Half a = renderHalf(o_.seed + 7919), b = renderHalf(o_.seed + 7919 + 104729);
+  const io::Image combined = meanOf(a.seen, b.seen);
+  referenceNoise_[m.name] = ownNoise(a.seen, b.seen);
+  io::writeExr(exr.string(), combined);
+  for (const auto& [name, image] : a.other) {
+    otherReferences_[name][m.name] = meanOf(image, b.other.at(name));
+    io::writeExr(otherPath(exr, name).string(), otherReferences_[name][m.name]);
   }
-  std::ofstream(txt) << description << "\nmade by: " << o_.commandLine << "\ngpu_ms: " << r.gpuMs << "\n";
+  const ImageError& noise = referenceNoise_.at(m.name);
+  std::ofstream(txt) << description << "\nmade by: " << o_.commandLine << "\ngpu_ms: " << a.gpuMs + b.gpuMs
+                     << "\n" << fmt::format("{} {} {} {}", kOwnNoiseKey, noise.rmse, noise.rmseTrimmed, noise.mae) << "\n";
   return combined;
+}
+
+// Half of each measure of A - B: the error of (A + B) / 2 when A and B are independent estimates
+// with the same spread (A - B has twice the variance of either, their mean half of it, so the
+// mean's RMSE is RMSE(A - B) / 2; for normal errors the mean absolute error scales the same).
+ImageError ConvergenceStudy::ownNoise(const io::Image& a, const io::Image& b) {
+  const ImageError d = imageError(a, b);
+  return {.rmse = d.rmse / 2.0, .relMse = d.relMse / 4.0, .mae = d.mae / 2.0, .rmseTrimmed = d.rmseTrimmed / 2.0,
+          .meanRatio = 1.0};
+}
+
+io::Image ConvergenceStudy::meanOf(const io::Image& a, const io::Image& b) {
+  io::Image out = a;
+  for (std::size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = 0.5f * (a.pixels[i] + b.pixels[i]);
+  return out;
+}
+
+const ImageError* ConvergenceStudy::referenceNoise(const std::string& method) const {
+  const auto it = referenceNoise_.find(method);
+  return it == referenceNoise_.end() ? nullptr : &it->second;
 }
 
 io::Image ConvergenceStudy::combinedOnly(const io::Image& image) {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/image_error.h"
 #include "bvh/bvh.h"
 #include "gpu/context.h"
 #include "io/image_io.h"
@@ -25,11 +26,6 @@
 
 namespace obscura::analysis {
 
-// The default emission rays per sample: the primary ray alone. They pay where bright emitters seen
-// directly set the error (the Cornell box: --emission-samples 16 --pt-emission-samples 4) and cost
-// more than they remove where the emitters are small on screen (modern-hall); docs/BENCHMARKS.md,
-// "Emission rays and the split of shading rays".
-inline constexpr std::uint32_t kObscuranceEmissionSamples = 1, kPathEmissionSamples = 1;
 
 // What a convergence study measures and how: `obscura converge`'s settings.
 struct StudySettings {
@@ -48,10 +44,13 @@ struct StudySettings {
   float dMax = 0.0f; // 0: the renderer's default
   float secondaryReflectors = 0.0f; // > 0: one more method, obscurances with secondary reflectors
   std::vector<float> background;    // R,G,B of a sky (render --background); empty: none
-  // Camera rays per sample for the emission the camera sees (render --emission-samples), each
-  // method family with the count that serves it best (docs/BENCHMARKS.md).
-  std::uint32_t emissionSamples = kObscuranceEmissionSamples;
-  std::uint32_t pathEmissionSamples = kPathEmissionSamples;
+  // Camera rays per sample for the emission the camera sees (render --emission-samples auto|K),
+  // for each method family; by default the renderers' (K rays where an emitter's edge crosses the
+  // pixel, lib/emission_samples.glsl).
+  std::uint32_t emissionSamples = gpu::kEdgeEmissionSamples;
+  bool emissionAtEdges = true;
+  std::uint32_t pathEmissionSamples = gpu::kEdgeEmissionSamples;
+  bool pathEmissionAtEdges = true;
   std::string commandLine; // how the study was asked for: written beside each cached reference
 };
 
@@ -98,6 +97,9 @@ public:
   // The converged image of a method, from the cache in the output folder when the same settings
   // made it (the path tracing one from --pt-reference where given).
   io::Image reference(const StudyMethod& m);
+  // How converged reference(m) is: its own error, from the difference of the two halves it is
+  // the mean of (rendered with different seeds); nullptr where not known (a farm's reference).
+  const ImageError* referenceNoise(const std::string& method) const;
   // Obscurance method `name`'s reference composed with the `model` I_a ("global": the paper's,
   // "reached") instead of the Seen one (after reference() of it).
   const io::Image& otherReference(const std::string& model, const std::string& name) const;
@@ -111,6 +113,8 @@ private:
   // the same scene (hash), camera, size, depth and sky.
   io::Image farmReference() const;
   static io::Image combinedOnly(const io::Image& image);
+  static io::Image meanOf(const io::Image& a, const io::Image& b);
+  static ImageError ownNoise(const io::Image& a, const io::Image& b);
   static std::filesystem::path otherPath(std::filesystem::path exr, const std::string& model);
 
   const StudySettings& o_;
@@ -126,6 +130,7 @@ private:
   mutable render::RenderStats statsCopy_;
   std::map<std::string, std::map<std::string, io::Image>> otherReferences_; // model -> method -> image
   io::Image farmReference_; // --pt-reference
+  std::map<std::string, ImageError> referenceNoise_; // method -> its reference's own error
 };
 
 } // namespace obscura::analysis

@@ -35,5 +35,20 @@ TEST(Convergence, ExtrapolatesAtTheMonteCarloRate) {
   EXPECT_FALSE(timeToReach(Curve{}, 1.0, ErrorKind::Noise).valid);
 }
 
+TEST(Convergence, ErrorAtATimeInterpolatesAndExtendsAtTheMonteCarloRate) {
+  const Curve c = monteCarloCurve();
+  const ErrorAt inside = errorAtTime(c, 8.0, ErrorKind::Noise);
+  ASSERT_TRUE(inside.valid);
+  EXPECT_FALSE(inside.extrapolated);
+  EXPECT_NEAR(inside.error, 1.0 / std::sqrt(8.0), 1e-12);
+  EXPECT_NEAR(errorAtTime(c, 8.0, ErrorKind::Noise, Metric::Mae).error, 0.5 / std::sqrt(8.0), 1e-12);
+  EXPECT_NEAR(errorAtTime(c, 16.0, ErrorKind::Noise).error, 0.25, 1e-12); // on a point
+  const ErrorAt before = errorAtTime(c, 0.25, ErrorKind::Noise), after = errorAtTime(c, 256.0, ErrorKind::Noise);
+  EXPECT_TRUE(before.extrapolated && after.extrapolated);
+  EXPECT_NEAR(before.error, 2.0, 1e-12);
+  EXPECT_NEAR(after.error, 1.0 / 16.0, 1e-12);
+  EXPECT_FALSE(errorAtTime(Curve{}, 1.0, ErrorKind::Noise).valid);
+}
+
 } // namespace
 } // namespace obscura::analysis

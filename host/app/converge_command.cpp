@@ -41,8 +41,24 @@ struct ConvergeOptions : analysis::StudySettings {
   DeviceOptions device;
 };
 
-using analysis::kObscuranceEmissionSamples;
-using analysis::kPathEmissionSamples;
+// A measured noise within this factor of its reference's own noise says more about the reference
+// than about the method (measured^2 = own^2 + the reference's^2 for independent errors: at 2x, a
+// quarter of the measured variance is the reference's): such a point is named, not used.
+constexpr double kReferenceFloorFactor = 2.0;
+
+// The reference's own noise in `metric`, 0 where not known.
+double floorOf(const analysis::ImageError* own, analysis::Metric metric) {
+  return own ? analysis::errorOf(*own, metric) : 0.0;
+}
+
+// `curve` without the points whose noise (in `metric`) is within kReferenceFloorFactor of
+// `floor`: what a speed-up may be read from.
+analysis::Curve aboveFloor(const analysis::Curve& curve, double floor, analysis::Metric metric) {
+  analysis::Curve kept{.method = curve.method, .points = {}};
+  for (const auto& p : curve.points)
+    if (analysis::errorOf(p, analysis::ErrorKind::Noise, metric) >= kReferenceFloorFactor * floor) kept.points.push_back(p);
+  return kept;
+}
 
 void runConverge(const ConvergeOptions& o) {
   checkBackground(o.background);
@@ -72,13 +88,32 @@ void runConverge(const ConvergeOptions& o) {
     if (m.pathTrace) return ptReference;
     return m.secondaryReflectors > 0.0f ? reflectorReferences.at(m.name) : obscuranceReference;
   };
+  // How converged each reference is (the difference of its two halves): noise measured against it
+  // cannot fall below that.
+  auto noiseFloor = [&](const analysis::StudyMethod& m) {
+    return study.referenceNoise(m.pathTrace ? pathMethod.name : m.secondaryReflectors > 0.0f ? m.name : best.name);
+  };
+  nlohmann::json referenceNoiseJson = nlohmann::json::object();
+  for (const analysis::StudyMethod* m : {&best, &pathMethod}) {
+    const analysis::ImageError* own = noiseFloor(*m);
+    if (!own) {
+      fmt::print("reference {}: its own noise is not known (a single image); speed-ups are read without a floor\n",
+                 m->name);
+      continue;
+    }
+    fmt::print("reference {}: own noise (from its two halves) RMSE {:.5f}, trimmed RMSE {:.5f}, MAE {:.5f}; noise "
+               "within {:g}x of it is not measured\n",
+               m->name, own->rmse, own->rmseTrimmed, own->mae, kReferenceFloorFactor);
+    referenceNoiseJson[m->name == best.name ? "obscurance" : "pathtrace"] = {
+        {"rmse", own->rmse}, {"rmse_trimmed", own->rmseTrimmed}, {"mae", own->mae}};
+  }
 
   std::vector<analysis::Curve> curves;
   std::map<std::string, io::Image> atBudget; // each method's image at its budget
   const fs::path csvPath = fs::path(o.outputDir) / (study.stem() + ".convergence.csv");
   std::ofstream csv(csvPath);
   csv << "method,spp,rays_per_pixel,gpu_ms,rmse_noise,relmse_noise,mae_noise,rmse_trimmed_noise,"
-         "rmse_vs_pathtrace,relmse_vs_pathtrace,mae_vs_pathtrace,rmse_trimmed_vs_pathtrace\n";
+         "rmse_vs_pathtrace,relmse_vs_pathtrace,mae_vs_pathtrace,rmse_trimmed_vs_pathtrace,noise_at_reference_floor\n";
   for (const auto& m : methods) {
     analysis::Curve curve{.method = m.name, .points = {}};
     std::uint32_t maxSpp = m.pathTrace ? o.pathMaxSpp : o.obscuranceMaxSpp;
@@ -89,12 +124,19 @@ void runConverge(const ConvergeOptions& o) {
                            .total = analysis::imageError(r.image, ptReference)};
       if (spp == m.budgetSpp) atBudget[m.name] = r.image;
       curve.points.push_back(p);
-      csv << fmt::format("{},{},{:.2f},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", m.name, spp,
+      // Which measures of its noise are within kReferenceFloorFactor of the reference's own.
+      std::string atFloor;
+      for (const auto& [key, metric] : {std::pair{"rmse", analysis::Metric::Rmse},
+                                        std::pair{"trimmed", analysis::Metric::RmseTrimmed}, std::pair{"mae", analysis::Metric::Mae}})
+        if (analysis::errorOf(p, analysis::ErrorKind::Noise, metric) < kReferenceFloorFactor * floorOf(noiseFloor(m), metric))
+          atFloor += atFloor.empty() ? key : std::string("+") + key;
+      csv << fmt::format("{},{},{:.2f},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", m.name, spp,
                          p.raysPerPixel, p.gpuMs, p.noise.rmse, p.noise.relMse, p.noise.mae, p.noise.rmseTrimmed,
-                         p.total.rmse, p.total.relMse, p.total.mae, p.total.rmseTrimmed);
+                         p.total.rmse, p.total.relMse, p.total.mae, p.total.rmseTrimmed, atFloor);
       fmt::print("{:20s} spp {:4d}  {:7.1f} rays/px  {:9.1f} ms  noise RMSE {:.5f} (trimmed {:.5f}, MAE {:.5f})  "
-                 "vs PT RMSE {:.5f}\n",
-                 m.name, spp, p.raysPerPixel, p.gpuMs, p.noise.rmse, p.noise.rmseTrimmed, p.noise.mae, p.total.rmse);
+                 "vs PT RMSE {:.5f}{}\n",
+                 m.name, spp, p.raysPerPixel, p.gpuMs, p.noise.rmse, p.noise.rmseTrimmed, p.noise.mae, p.total.rmse,
+                 atFloor.empty() ? "" : "  [at the reference's floor: " + atFloor + "]");
       std::fflush(stdout);
     }
     curves.push_back(curve);
@@ -103,7 +145,8 @@ void runConverge(const ConvergeOptions& o) {
 
   const analysis::Curve& pt = curves.back();
   nlohmann::json summary = {{"scene", o.scenePath}, {"width", study.width()}, {"height", study.height()},
-                            {"device", context.info().name}, {"command", o.commandLine}};
+                            {"device", context.info().name}, {"command", o.commandLine},
+                            {"reference_noise", referenceNoiseJson}, {"reference_floor_factor", kReferenceFloorFactor}};
   auto errorJson = [](const analysis::ImageError& e) {
     return nlohmann::json{{"rmse", e.rmse}, {"relmse", e.relMse}, {"mae", e.mae}, {"rmse_trimmed", e.rmseTrimmed},
                           {"mean_ratio", e.meanRatio}};
@@ -154,7 +197,26 @@ void runConverge(const ConvergeOptions& o) {
     for (const auto& [key, metric] : metrics) {
       const double noise = analysis::errorOf(*point, analysis::ErrorKind::Noise, metric);
       const double total = analysis::errorOf(*point, analysis::ErrorKind::AgainstReference, metric);
-      const analysis::TimeAt equalNoise = analysis::timeToReach(pt, noise, analysis::ErrorKind::Noise, metric);
+      const double floor = floorOf(noiseFloor(m), metric), ptFloor = floorOf(noiseFloor(pathMethod), metric);
+      if (noise < kReferenceFloorFactor * floor) {
+        // A flat curve is named, not read: the reference is not converged enough to tell.
+        fmt::print("  {:13s} noise {:.5f} is within {:g}x of its reference's own noise {:.5f}: no speed-up is read "
+                   "(render a more converged reference: --reference-factor)\n",
+                   key, noise, kReferenceFloorFactor, floor);
+        entry[key] = {{"noise", noise}, {"at_reference_floor", true}, {"reference_noise", floor},
+                      {"total_error", total}};
+        continue;
+      }
+      // Path tracing's curve where it is above its own reference's floor (beyond, extrapolated).
+      const analysis::Curve ptAbove = aboveFloor(pt, ptFloor, metric);
+      if (ptAbove.points.empty()) {
+        fmt::print("  {:13s} path tracing's noise is at its reference's own noise at every point: no speed-up is read "
+                   "(--pt-reference-spp)\n",
+                   key);
+        entry[key] = {{"noise", noise}, {"pathtrace_at_reference_floor", true}, {"total_error", total}};
+        continue;
+      }
+      const analysis::TimeAt equalNoise = analysis::timeToReach(ptAbove, noise, analysis::ErrorKind::Noise, metric);
       const analysis::TimeAt equalTotal = analysis::timeToReach(pt, total, analysis::ErrorKind::AgainstReference, metric);
       const double speedUp = equalNoise.valid ? equalNoise.ms / point->gpuMs : 0.0;
       fmt::print("  {:13s} noise {:.5f}: path tracing reaches it in {:9.1f} ms{} -> equal-noise speed-up {:.2f}x; "
@@ -165,6 +227,23 @@ void runConverge(const ConvergeOptions& o) {
                     {"equal_noise_extrapolated", equalNoise.extrapolated}, {"equal_noise_speedup", speedUp},
                     {"total_error", total}, {"pathtrace_ms_to_equal_total_error", equalTotal.ms},
                     {"equal_total_extrapolated", equalTotal.extrapolated}};
+    }
+    // A denoised frame against the same rays undenoised at the same GPU time (its curve read there):
+    // what the denoiser's time buys, in RMSE against the converged reference (noise and bias alike).
+    if (m.denoise) {
+      const std::string plain = m.name.substr(0, m.name.rfind("-denoised"));
+      for (std::size_t j = 0; j + 1 < methods.size(); ++j) {
+        if (methods[j].name != plain) continue;
+        const analysis::ErrorAt undenoised =
+            analysis::errorAtTime(curves[j], point->gpuMs, analysis::ErrorKind::Noise, analysis::Metric::Rmse);
+        const double denoised = point->noise.rmse;
+        fmt::print("  at equal time ({:.1f} ms), {} undenoised has RMSE {:.5f}{}: the denoised frame's {:.5f} is {}\n",
+                   point->gpuMs, plain, undenoised.error, undenoised.extrapolated ? " (extrap.)" : "", denoised,
+                   denoised <= undenoised.error ? "lower" : "HIGHER (the denoiser loses)");
+        entry["undenoised_at_equal_time"] = {{"method", plain}, {"rmse", undenoised.error},
+                                             {"extrapolated", undenoised.extrapolated},
+                                             {"denoised_wins", denoised <= undenoised.error}};
+      }
     }
     summary["methods"][m.name] = entry;
   }
@@ -190,8 +269,8 @@ void runConverge(const ConvergeOptions& o) {
   std::ofstream(jsonPath) << summary.dump(2) << "\n";
 
   const fs::path plotPath = fs::path(o.outputDir) / (study.stem() + ".convergence.png");
-  std::string plot = fmt::format("/usr/bin/python3 {}/tools/plot_convergence.py '{}' '{}' '{}'", OBSCURA_SOURCE_DIR,
-                                 csvPath.string(), plotPath.string(), study.stem());
+  std::string plot = fmt::format("/usr/bin/python3 {}/tools/plot_convergence.py '{}' '{}' '{}' '{}'", OBSCURA_SOURCE_DIR,
+                                 csvPath.string(), plotPath.string(), study.stem(), jsonPath.string());
   if (std::system(plot.c_str()) != 0)
     throw InputError(fmt::format("{}: the plot failed (python3-matplotlib installed? see tools/setup.sh)", plotPath.string()));
   fmt::print("wrote {}, {}, {}\n", csvPath.string(), plotPath.string(), jsonPath.string());
@@ -221,13 +300,10 @@ void addConvergeCommand(CLI::App& app) {
   cmd->add_option("--background", o->background, "R,G,B: a constant sky for both methods (as render --background)")
       ->delimiter(',')
       ->expected(3);
-  cmd->add_option("--emission-samples", o->emissionSamples,
-                  fmt::format("obscurance methods: camera rays per sample for the emission the camera sees (render "
-                              "--emission-samples; default {})", kObscuranceEmissionSamples))
-      ->check(CLI::Range(1u, gpu::kMaxEmissionSamples));
-  cmd->add_option("--pt-emission-samples", o->pathEmissionSamples,
-                  fmt::format("path tracing: the same (default {})", kPathEmissionSamples))
-      ->check(CLI::Range(1u, gpu::kMaxEmissionSamples));
+  addEmissionSamplesOption(*cmd, "--emission-samples", o->emissionSamples, o->emissionAtEdges,
+                           "the obscurance methods, as render's");
+  addEmissionSamplesOption(*cmd, "--pt-emission-samples", o->pathEmissionSamples, o->pathEmissionAtEdges,
+                           "path tracing");
   cmd->add_option("--secondary-reflectors", o->secondaryReflectors,
                   "T: study obscurances with secondary reflectors marked at T x mean direct irradiance too "
                   "(method obscurance-reflectors, with its own reference and bias floor)")

@@ -57,14 +57,15 @@ RenderedFrame pathTrace(const RenderOptions& o, const scene::Scene& scene, const
   render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
                                .camera = settings.camera, .maxDepth = settings.maxDepth,
                                .lightSampling = settings.lightSampling,
-                               .emissionSamples = settings.emissionSamples};
+                               .emissionSamples = settings.emissionSamples,
+                               .emissionAtEdges = settings.emissionAtEdges};
   render::PathTracer tracer(context, scene, bvh, pt);
   tracer.render(progress);
   RenderedFrame frame;
   frame.image = tracer.image();
   frame.stats = tracer.stats();
   frame.method = {{"method", nameString(render::kMethodNames, o.method)}, {"max_depth", pt.maxDepth},
-                  {"emission_samples", pt.emissionSamples}};
+                  {"emission_samples", pt.emissionSamples}, {"emission_at_edges", pt.emissionAtEdges}};
   return frame;
 }
 
@@ -161,7 +162,8 @@ RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh
                   {"secondary_reflector_triangles", renderer.secondaryReflectors()},
                   {"i_a", {ia.x, ia.y, ia.z}}, {"i_a_global", {iaGlobal.x, iaGlobal.y, iaGlobal.z}},
                   {"shadow_rays_per_hit", settings.shadowRays}, {"obscurance_rays_per_hit", settings.obscuranceRays},
-                  {"emission_samples", settings.emissionSamples}, {"r_ave", {rAve.x, rAve.y, rAve.z}},
+                  {"emission_samples", settings.emissionSamples}, {"emission_at_edges", settings.emissionAtEdges},
+                  {"r_ave", {rAve.x, rAve.y, rAve.z}},
                   {"ambient_intensity", {ia.x, ia.y, ia.z}}, {"lights", renderer.lights().names},
                   {"bands", renderer.layout().bandCount()}, {"denoise", denoiseJson}};
   return frame;

@@ -1,5 +1,6 @@
 #include "app/render_options.h"
 
+#include <charconv>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -36,11 +37,8 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
       ->check(CLI::Range(1u, 16384u));
   cmd.add_option("--height", o.height, "image height in pixels")->check(CLI::Range(1u, 16384u));
   cmd.add_option("--spp", o.spp, "primary samples per pixel")->check(CLI::Range(1u, 1u << 20));
-  cmd.add_option("--emission-samples", o.obscurance.emissionSamples,
-                 "K: camera rays per sample for the emission the camera sees (both methods; default 1, the sample's "
-                 "own ray). K > 1 traces K cheap rays of their own (no shading), which sharpens the edges of bright "
-                 "emitters seen directly")
-      ->check(CLI::Range(1u, gpu::kMaxEmissionSamples));
+  addEmissionSamplesOption(cmd, "--emission-samples", o.obscurance.emissionSamples, o.obscurance.emissionAtEdges,
+                           "both methods");
   cmd.add_option("--seed", o.seed, "random seed (same seed, same image)");
   cmd.add_option("--camera", o.camera, "index of the glTF camera to use (default: the first)")
       ->check(CLI::NonNegativeNumber);
@@ -93,6 +91,36 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--light-groups", o.lightGroups,
                  "lights edited as one: node (one per emissive mesh node, default), material (one per emissive "
                  "material), or a JSON file {\"group\": [\"node\", ...]}");
+}
+
+void addEmissionSamplesOption(CLI::App& cmd, const std::string& name, std::uint32_t& samples, bool& atEdges,
+                              const std::string& what) {
+  cmd.add_option_function<std::string>(
+         name,
+         [name, &samples, &atEdges](const std::string& value) {
+           // auto, auto:K (K rays at the edges) or K (everywhere).
+           const bool edges = value.starts_with("auto");
+           if (value == "auto") {
+             samples = gpu::kEdgeEmissionSamples;
+             atEdges = true;
+             return;
+           }
+           const std::string count = edges ? (value.starts_with("auto:") ? value.substr(5) : std::string()) : value;
+           std::uint32_t k = 0;
+           const char* end = count.data() + count.size();
+           const auto [last, error] = std::from_chars(count.data(), end, k);
+           if (count.empty() || error != std::errc() || last != end || k < 1 || k > gpu::kMaxEmissionSamples)
+             throw CLI::ValidationError(name, fmt::format("'{}' is neither auto, auto:K nor K, with K a count in 1..{}",
+                                                          value, gpu::kMaxEmissionSamples));
+           samples = k;
+           atEdges = edges;
+         },
+         fmt::format("auto|auto:K|K: camera rays per sample for the emission the camera sees ({}). auto (default): "
+                     "{} rays in the pixels an emitter's edge crosses (found by probing each pixel's corners once), "
+                     "where a bright emitter's covered fraction sets the error, and the sample's own ray elsewhere; "
+                     "auto:K: K rays there; K: K rays of their own (no shading) in every pixel, 1 = the sample's own ray",
+                     what, gpu::kEdgeEmissionSamples))
+      ->type_name("auto|auto:K|K");
 }
 
 void applyBackground(const RenderOptions& o, LoadedScene& loaded) {

@@ -45,6 +45,13 @@ struct RenderOptions {
 
 // Registers the shared options on `cmd` (not the scene or the output, which each command names).
 void addRenderOptions(CLI::App& cmd, RenderOptions& o);
+
+// --emission-samples auto|auto:K|K (and converge's --pt-emission-samples): `auto` (the default)
+// sets gpu::kEdgeEmissionSamples rays where an emitter's edge crosses the pixel and the primary ray
+// elsewhere, auto:K K rays there; a number K, K rays in every pixel (1: the primary ray alone).
+// `what` names the renderer.
+void addEmissionSamplesOption(CLI::App& cmd, const std::string& name, std::uint32_t& samples, bool& atEdges,
+                              const std::string& what);
 // InputError for option values CLI11's checks cannot see (a non-finite --dmax).
 void checkRenderOptions(const RenderOptions& o);
 // The camera `index` of the scene (-1: the first, or the default camera when it has none).

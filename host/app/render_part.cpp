@@ -61,6 +61,7 @@ nlohmann::json jobIdentity(const RenderOptions& o) {
       {"camera", o.camera}, {"scene", farm::sceneHash(o.scenePath)},
       {"light_groups", fs::is_regular_file(o.lightGroups) ? "file:" + sha256OfFile(o.lightGroups) : o.lightGroups},
       {"background", o.background}, {"emission_samples", o.obscurance.emissionSamples},
+      {"emission_at_edges", o.obscurance.emissionAtEdges},
       {"max_depth", o.obscurance.maxDepth}, {"light_sampling", nameString(render::kLightSamplingNames, o.obscurance.lightSampling)}};
   if (o.method == render::Method::Obscurance) {
     job["shadow_rays"] = o.obscurance.shadowRays;
@@ -112,6 +113,7 @@ void renderPart(RenderOptions& o) {
                                  .camera = camera, .maxDepth = settings.maxDepth,
                                  .lightSampling = settings.lightSampling,
                                  .emissionSamples = settings.emissionSamples,
+                                 .emissionAtEdges = settings.emissionAtEdges,
                                  .firstSample = part.samples.begin, .rows = part.rows};
     render::PathTracer tracer(context, loaded.scene, loaded.bvh, pt);
     tracer.reset();

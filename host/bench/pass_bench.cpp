@@ -27,6 +27,7 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
   settings.systematic = true;
   settings.colourBleeding = false;
   settings.maxDepth = 1; // the primary hit only: no specular pass
+  settings.emissionSamples = 1; // the camera rays Embree's frame traces too, no emitter-edge rays
   settings.primaryAovs = false;
   settings.editableGeometry = false;
   settings.ambient = render::AmbientModel::Global; // no light rays for the reach (not timed, not needed)

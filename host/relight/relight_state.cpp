@@ -90,7 +90,7 @@ nlohmann::json stateJson(const render::ObscuranceRenderer& renderer, const std::
                     {"dmax", renderer.dMax()}, {"rho", static_cast<int>(s.rho)}, {"systematic", s.systematic},
                     {"colour_bleeding", s.colourBleeding}, {"max_depth", s.maxDepth},
                     {"vertex_rays_by_throughput", s.vertexRaysByThroughput},
-                    {"emission_samples", s.emissionSamples}}},
+                    {"emission_samples", s.emissionSamples}, {"emission_at_edges", s.emissionAtEdges}}},
       {"average_reflectance", vec3Json(renderer.ambient().averageReflectance)},
       {"lights", nlohmann::json::array()}};
   for (std::size_t i = 0; i < lights.size(); ++i)

@@ -285,7 +285,7 @@ ShadeSample ObscuranceRenderer::shadeSample(std::uint32_t sample) const {
 PrimaryPass::Dispatch ObscuranceRenderer::primaryDispatch(std::uint32_t sample) const {
   return {.sample = settings_.firstSample + sample, .firstSample = settings_.firstSample, .seed = settings_.seed,
           .lights = static_cast<std::uint32_t>(lights_.size()), .aovs = settings_.primaryAovs,
-          .emissionSamples = settings_.emissionSamples};
+          .emissionSamples = settings_.emissionSamples, .emissionAtEdges = settings_.emissionAtEdges};
 }
 
 void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progress) {
@@ -305,16 +305,12 @@ void ObscuranceRenderer::iterate(std::uint32_t samples, const ProgressFn& progre
       }
     });
     timestamps_.collect();
-    done.primaryRays += layout.pixels() * (last - done.samples) * cameraRaysPerSample();
+    done.primaryRays += layout.pixels() * (last - done.samples); // the emission rays: kStatusEmissionRays
     done.samples = last;
     done.gbufferSample = last - 1;
     wallSeconds_ = wallBefore + secondsSince(start);
     if (progress) progress(done.samples - (end - samples), samples, secondsSince(start));
   }
-}
-
-std::uint64_t ObscuranceRenderer::cameraRaysPerSample() const {
-  return settings_.emissionSamples > 1 ? 1u + settings_.emissionSamples : 1u;
 }
 
 void ObscuranceRenderer::recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t s, SampleMode mode,
@@ -471,7 +467,7 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
        .changedBoxPadding = changedBoxPadding(scene_->bounds), .specular = runSpecular_},
       {.changed = changed, .everyPixel = all, .tracedLight = tracedLight,
        .probe = GeometryRetrace::probing(settings_.dirtyTest, runSpecular_, keptAll)});
-  progress().primaryRays += r.pixels * progress().samples * cameraRaysPerSample();
+  progress().primaryRays += r.pixels * progress().samples;
   // The retraced pixels' (and the probed candidates') G-buffer now holds the last sample; the
   // others' still hold theirs.
   if ((r.probed || r.pixels > 0) && progress().gbufferSample + 1 != progress().samples) progress().gbufferSample = FrameProgress::kNoSample;
@@ -835,7 +831,7 @@ RenderStats ObscuranceRenderer::stats() const {
     if (!timestamps_.totalsMs().contains(name)) return;
     st.passes[name] = {.gpuMs = timestamps_.totalsMs().at(name), .rays = rays};
   };
-  pass("primary", progress().primaryRays);
+  pass("primary", progress().primaryRays + status[gpu::kStatusEmissionRays]);
   pass("shadow", status[gpu::kStatusShadowRays]);
   pass("obscurance", status[gpu::kStatusObscuranceRays]);
   pass("specular", status[gpu::kStatusSpecularRays]);

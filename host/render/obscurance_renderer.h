@@ -87,8 +87,11 @@ struct ObscuranceSettings {
   RowRange rows;
   // Camera rays per primary sample for the emission the camera sees (M_s), 1..64: above 1, that
   // many cheap rays of their own (a closest hit, no shading) estimate it instead of the primary
-  // ray, which sharpens the edges of bright emitters seen directly (lib/emission_samples.glsl).
-  std::uint32_t emissionSamples = 1;
+  // ray, which sharpens the edges of bright emitters seen directly (lib/emission_samples.glsl);
+  // with `emissionAtEdges` (the default, --emission-samples auto) only in the pixels an emitter's
+  // edge crosses, found by probing each pixel's corners at its first sample.
+  std::uint32_t emissionSamples = gpu::kEdgeEmissionSamples;
+  bool emissionAtEdges = true;
   std::uint32_t seed = 1;
   scene::Camera camera;
   std::uint32_t shadowRays = 5;      // N_s per hit
@@ -368,8 +371,6 @@ private:
   // the sample already.
   void recordSample(const vk::raii::CommandBuffer& cmd, std::uint32_t sample, SampleMode mode,
                     bool tracePrimary = true) override;
-  // Camera rays a summing primary pass traces per pixel and sample: its own, and the emission rays.
-  std::uint64_t cameraRaysPerSample() const;
 
   gpu::CommandStream stream_;
   gpu::Timestamps timestamps_;

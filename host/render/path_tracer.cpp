@@ -67,12 +67,15 @@ PathTracer::PathTracer(const gpu::Context& context, const scene::Scene& scene, c
   for (std::uint32_t b = 0; b < layout_.bandCount(); ++b) {
     radiance_.emplace_back(context, layout_.bandPixels(b) * kAccumulator,
                            Usage::eStorageBuffer | Usage::eTransferDst, fmt::format("pathtrace.radiance[{}]", b));
+    edges_.emplace_back(context, std::max<std::uint64_t>(4, layout_.bandPixels(b) * 4), Usage::eStorageBuffer,
+                        fmt::format("pathtrace.emitter_edges[{}]", b));
     sceneBuffers_.bindTo(kernel_, b, &status_.buffer());
     kernel_.bind(gpu::kBindingPathRadiance, radiance_.back(), b);
     kernel_.bind(gpu::kBindingPathLights, lightBuffer_, b);
     kernel_.bind(gpu::kBindingPathEmitters, emitterBuffer_, b);
     kernel_.bind(gpu::kBindingPathLightTree, treeBuffer_, b);
     kernel_.bind(gpu::kBindingPathScales, scaleBuffer_, b);
+    kernel_.bind(gpu::kBindingPathEmitterEdges, edges_.back(), b);
   }
   reset();
 }
@@ -110,7 +113,9 @@ void PathTracer::iterate(std::uint32_t samples, const ProgressFn& progress) {
                      .lightCount = lightCount, .maxDepth = settings_.maxDepth, .rrDepth = settings_.rrDepth,
                      .strategy = static_cast<std::uint32_t>(settings_.strategy), .firstRow = 0u, .rows = 0u,
                      .lightSampling = static_cast<std::uint32_t>(settings_.lightSampling),
-                     .emissionSamples = settings_.emissionSamples};
+                     .emissionSamples = settings_.emissionSamples,
+                     .emissionAtEdges = settings_.emissionAtEdges ? 1u : 0u, .firstSample = settings_.firstSample,
+                     .unused0 = 0u, .unused1 = 0u};
   push.camera.right.w = sceneScale(scene_->bounds); // the ray-origin offset's scale (ray.glsl)
   const std::uint32_t end = samples_ + samples;
   while (samples_ < end) {
@@ -186,6 +191,7 @@ RenderStats PathTracer::stats() const {
   std::uint64_t bytes = sceneBuffers_.bytes() + lightBuffer_.buffer().size() + emitterBuffer_.buffer().size() +
                         scaleBuffer_.size() + status_.buffer().size();
   for (const auto& r : radiance_) bytes += r.size();
+  for (const auto& e : edges_) bytes += e.size();
   st.deviceBytes = bytes;
   if (const auto n = nonFiniteSamples(); n > 0)
     st.notes.push_back(fmt::format("path tracing dropped {} non-finite samples (NaN or inf radiance)", n));

@@ -39,8 +39,10 @@ struct PathTraceSettings {
   std::uint32_t rrDepth = 3;       // Russian roulette after this many vertices (>= maxDepth: never)
   PathStrategy strategy = PathStrategy::Mis;
   LightSampling lightSampling = LightSampling::Spatial; // next-event estimation's light sampling
-  // Camera rays per path for the emission the camera sees, 1..64 (as ObscuranceSettings's).
-  std::uint32_t emissionSamples = 1;
+  // Camera rays per path for the emission the camera sees, 1..64, and whether only where an
+  // emitter's edge crosses the pixel (as ObscuranceSettings's).
+  std::uint32_t emissionSamples = gpu::kEdgeEmissionSamples;
+  bool emissionAtEdges = true;
   // A farm's part (host/farm/): paths from sample `firstSample` of the frame's sequence on, for
   // the rows `rows` of the width x height image only (as ObscuranceSettings's).
   std::uint32_t firstSample = 0;
@@ -86,6 +88,7 @@ private:
   gpu::Buffer treeBuffer_, scaleBuffer_;
   FrameLayout layout_;
   std::vector<gpu::Buffer> radiance_; // per band
+  std::vector<gpu::Buffer> edges_;    // per band: which pixels an emitter's edge crosses (pathtrace.comp)
   StatusCounters status_;
   gpu::Kernel kernel_;
   gpu::CommandStream stream_;

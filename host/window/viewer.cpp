@@ -96,6 +96,9 @@ void Viewer::restart(bool preview, bool cameraOnly) {
   if (preview) {
     s.shadowRays = std::min(s.shadowRays, 1u);
     s.obscuranceRays = std::min(s.obscuranceRays, 1u);
+    // The emitter edges' probes (four camera rays a pixel) would cost more than the preview's own
+    // rays; the frame after it, which starts the accumulation, traces them.
+    s.emissionSamples = 1;
   }
   session_->renderer().configure(s);
   pathTracer_.reset(); // made again with the new camera when shown

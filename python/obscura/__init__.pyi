@@ -83,7 +83,7 @@ def render(
     denoise: bool = False,
     shadow_rays: Optional[int] = None,
     obs_rays: Optional[int] = None,
-    emission_samples: Optional[int] = None,
+    emission_samples: Optional[Union[int, Literal["auto"]]] = None,
     max_depth: Optional[int] = None,
     rho: Optional[Literal["sqrt", "exp", "ao"]] = None,
     tau: Optional[float] = None,

@@ -295,11 +295,18 @@ OBS_CONST uint kPrimaryFlagGBufferOnly = 1u;
 OBS_CONST uint kPrimaryFlagNoAovs = 2u;
 // Only pixels the dirty mask marks run (a geometry edit retraces them); the others keep their sums.
 OBS_CONST uint kPrimaryFlagDirtyOnly = 4u;
+// The emission rays only where an emitter's edge crosses the pixel (lib/emission_samples.glsl:
+// the pixel's corners, probed at its first sample, see different lights); elsewhere the primary ray.
+OBS_CONST uint kPrimaryFlagEmissionAtEdges = 8u;
 // The flags' bits from here up: --emission-samples K (K > 1: M_s from K camera rays of their own
 // per sample, lib/emission_samples.glsl; 0 or 1: from the primary ray).
 OBS_CONST uint kPrimaryEmissionSamplesShift = 8u;
 // The largest K: K traversals per sample share the loop limiter's budget (LAVAPIPE.md).
 OBS_CONST uint kMaxEmissionSamples = 64u;
+// The emission rays' K where they go to emitter edges only (--emission-samples auto, the default):
+// the edge pixels are few, so K can be large; 16 cut the Cornell box's edge RMSE 4.9x
+// (docs/BENCHMARKS.md, "Emission rays and the split of shading rays").
+OBS_CONST uint kEdgeEmissionSamples = 16u;
 
 // ---- Push constants of the bench/trace kernel.
 // Rays each invocation of trace.comp traces through one refilling loop (shaders/lib/bvh_stream.glsl):
@@ -348,6 +355,8 @@ OBS_CONST uint kStatusObscuranceRays = 2;  // obscurance rays traced
 OBS_CONST uint kStatusSpecularRays = 3;    // rays traced along specular paths
 OBS_CONST uint kStatusPathRays = 4;        // rays traced by the path tracer
 OBS_CONST uint kStatusDirtyPixels = 5;     // pixels dirty.comp marked for retracing
+OBS_CONST uint kStatusEmissionRays = 6;    // camera rays traced for the seen emission alone (the
+                                           // emitter-edge probes and the emission rays)
 OBS_CONST uint kStatusWords = 8;
 
 // ---- Shading passes (shadow.comp, obscurance.comp): push constants.
@@ -540,7 +549,10 @@ OBS_CONST uint kBindingPrimaryDirty = 11;        // uint[pixel]: 1 = retrace (kP
 OBS_CONST uint kBindingPrimarySampleCounts = 12; // uint[pixel]: the samples in the pixel's sums
                                                  // (restarts at its sample 0, as the sums do);
                                                  // compose and resolve divide by it
-OBS_CONST uint kPrimaryBindingCount = 13;
+OBS_CONST uint kBindingPrimaryEmitterEdges = 13; // uint[pixel]: 1 = an emitter's edge crosses the
+                                                 // pixel (kPrimaryFlagEmissionAtEdges; written at
+                                                 // its first sample)
+OBS_CONST uint kPrimaryBindingCount = 14;
 
 // Header of the specular queue: an indirect dispatch (groups x, y, z) and the entry count.
 OBS_CONST uint kQueueGroupsX = 0;
@@ -568,7 +580,11 @@ struct PathPush {
   uint rows;
   uint lightSampling; // kLightSampling*
   uint emissionSamples; // K > 1: the camera ray's emission from K rays of their own
-};                    // 112 bytes
+  uint emissionAtEdges; // 112: 1 = those K rays only where an emitter's edge crosses the pixel
+  uint firstSample;     // the sample the accumulation started at (its edge probes run there)
+  uint unused0;
+  uint unused1;
+};                    // 128 bytes
 OBS_CONST uint kPathStrategyMis = 0u;       // MIS of light and BSDF sampling (the reference)
 OBS_CONST uint kPathStrategyLightOnly = 1u; // area lights by light sampling only (tests)
 OBS_CONST uint kPathStrategyBsdfOnly = 2u;  // area lights by BSDF sampling only (tests)
@@ -577,7 +593,8 @@ OBS_CONST uint kBindingPathLights = 7u;     // as kBindingLights (lib/light_bind
 OBS_CONST uint kBindingPathEmitters = 8u;   // as kBindingEmitters
 OBS_CONST uint kBindingPathScales = 9u;     // vec4[lights]: E_s, each light's emission scale
 OBS_CONST uint kBindingPathLightTree = 10u; // GpuLightNode[] (= kBindingLightTree's contents)
-OBS_CONST uint kPathBindingCount = 11u;
+OBS_CONST uint kBindingPathEmitterEdges = 11u; // uint[pixels]: as kBindingPrimaryEmitterEdges
+OBS_CONST uint kPathBindingCount = 12u;
 
 // ---- compose.comp: per pixel, AOV slots written (averaged over samples).
 OBS_CONST uint kComposeCombined = 0;   // C = sum_s E_s (D_s + M_s) + I_a A (+ specular)

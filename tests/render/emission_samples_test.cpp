@@ -87,13 +87,38 @@ EdgeError edgeError(const io::Image& image, const std::string& layer, glm::vec3 
   return e;
 }
 
-render::ObscuranceSettings obscuranceSettings(std::uint32_t emissionSamples) {
+render::ObscuranceSettings obscuranceSettings(std::uint32_t emissionSamples, bool atEdges = false) {
   render::ObscuranceSettings s;
   s.width = s.height = kSize;
   s.spp = 4;
   s.emissionSamples = emissionSamples;
+  s.emissionAtEdges = atEdges;
   s.camera = downCamera();
   return s;
+}
+
+// The pixels an edge crosses (their coverage is neither 0 nor 1 for some light).
+std::uint64_t edgePixels() {
+  std::uint64_t n = 0;
+  for (int y = 0; y < static_cast<int>(kSize); ++y)
+    for (int x = 0; x < static_cast<int>(kSize); ++x) {
+      const Coverage c = coverage(x, y);
+      n += (c.a > 0.0 && c.a < 1.0) || (c.b > 0.0 && c.b < 1.0 - c.a);
+    }
+  return n;
+}
+
+// The largest difference of two images' `layer`, relative to max(1, value).
+double largestDifference(const io::Image& x, const io::Image& y, const std::string& layer) {
+  double largest = 0.0;
+  const int cx = x.channelIndex(layer + ".R"), cy = y.channelIndex(layer + ".R");
+  for (int j = 0; j < x.height; ++j)
+    for (int i = 0; i < x.width; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const double a = x.at(i, j, cx + k), b = y.at(i, j, cy + k);
+        largest = std::max(largest, std::abs(a - b) / std::max(1.0, std::abs(b)));
+      }
+  return largest;
 }
 
 class EmissionSamples : public GpuTest {};
@@ -142,15 +167,70 @@ TEST_F(EmissionSamples, ObscuranceSeenEmissionMatchesTheEdgesCoverageAndStaysPer
 TEST_F(EmissionSamples, PathTracedCameraEmissionMatchesTheEdgesCoverage) {
   const scene::Scene s = twoEmitters();
   const bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-  render::PathTraceSettings settings{.width = kSize, .height = kSize, .spp = 4, .seed = 1, .camera = downCamera()};
+  render::PathTraceSettings settings{.width = kSize, .height = kSize, .spp = 4, .seed = 1, .camera = downCamera(),
+                                     .emissionSamples = 1};
   const PathTraceResult primaryOnly = renderPathTraced(context(), s, tree, settings);
   settings.emissionSamples = 16;
+  settings.emissionAtEdges = false;
   const PathTraceResult sampled = renderPathTraced(context(), s, tree, settings);
   EXPECT_EQ(sampled.stats.truncatedTraversals, 0u);
   const EdgeError before = edgeError(primaryOnly.image, "combined", kLightA, kLightB);
   const EdgeError after = edgeError(sampled.image, "combined", kLightA, kLightB);
   EXPECT_LT(after.rms, 0.2 * before.rms) << "before " << before.rms << ", after " << after.rms;
   EXPECT_LT(after.largest, 0.06 * 5.0);
+}
+
+// --emission-samples auto: the K rays only in the pixels whose corners see different lights. On
+// straight edges that is every pixel an edge crosses, so the image is the one K rays everywhere
+// give (the other pixels see one uniform emitter, or none, exactly with one ray), for the rays
+// counted: one camera ray per pixel and sample, four corner probes per pixel, K per edge pixel
+// and sample.
+TEST_F(EmissionSamples, AtEdgesOnlyGivesTheImageOfRaysEverywhereForTheEdgePixelsRays) {
+  const scene::Scene s = twoEmitters();
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+  render::ObscuranceRenderer everywhere(context(), s, tree, obscuranceSettings(16, false));
+  everywhere.render();
+  render::ObscuranceRenderer atEdges(context(), s, tree, obscuranceSettings(16, true));
+  atEdges.render();
+  EXPECT_LT(largestDifference(atEdges.image(), everywhere.image(), "emission"), 1e-5);
+  EXPECT_LT(largestDifference(atEdges.image(), everywhere.image(), "combined"), 1e-5);
+  const std::uint64_t pixels = kSize * kSize, spp = 4;
+  EXPECT_EQ(edgePixels(), kSize + (kSize - 9)) << "column 8 and row 5 right of it";
+  EXPECT_EQ(atEdges.stats().passes.at("primary").rays, pixels * spp + 4 * pixels + 16 * spp * edgePixels());
+  EXPECT_EQ(everywhere.stats().passes.at("primary").rays, pixels * spp * (1 + 16));
+
+  render::PathTraceSettings settings{.width = kSize, .height = kSize, .spp = 4, .seed = 1, .camera = downCamera(),
+                                     .emissionSamples = 16, .emissionAtEdges = false};
+  const PathTraceResult pathEverywhere = renderPathTraced(context(), s, tree, settings);
+  settings.emissionAtEdges = true;
+  const PathTraceResult pathAtEdges = renderPathTraced(context(), s, tree, settings);
+  EXPECT_LT(largestDifference(pathAtEdges.image, pathEverywhere.image, "combined"), 1e-5);
+  EXPECT_LT(pathAtEdges.stats.passes.at("pathtrace").rays, pathEverywhere.stats.passes.at("pathtrace").rays);
+}
+
+// An emitter inside one pixel, clear of its corners: no probe sees it, so that pixel keeps the
+// primary ray's estimate, unbiased as ever: the image is the one the primary rays alone give.
+TEST_F(EmissionSamples, AtEdgesOnlyKeepsThePrimaryRayWhereNoCornerSeesTheEmitter) {
+  SceneBuilder b;
+  auto lamp = b.lambertian(glm::vec3(0.0f), kLightA);
+  auto floor = b.lambertian(glm::vec3(0.0f), glm::vec3(0.0f));
+  const float x0 = planeCoordinate(3.3f), x1 = planeCoordinate(3.7f);
+  b.quad({-2, -0.01f, -2}, {0, 0, 4}, {4, 0, 0}, floor, "floor");
+  b.quad({x0, 0, x0}, {0, 0, x1 - x0}, {x1 - x0, 0, 0}, lamp, "speck"); // pixel (3, 3)'s middle
+  const scene::Scene s = b.build();
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+  render::ObscuranceSettings settings = obscuranceSettings(1, false);
+  settings.spp = 16;
+  render::ObscuranceRenderer primaryOnly(context(), s, tree, settings);
+  primaryOnly.render();
+  settings.emissionSamples = 16;
+  settings.emissionAtEdges = true;
+  render::ObscuranceRenderer atEdges(context(), s, tree, settings);
+  atEdges.render();
+  const io::Image seen = primaryOnly.image();
+  EXPECT_GT(seen.at(3, 3, seen.channelIndex("emission.R")), 0.0f) << "some primary ray saw the speck";
+  EXPECT_EQ(largestDifference(atEdges.image(), seen, "emission"), 0.0);
+  EXPECT_EQ(atEdges.stats().passes.at("primary").rays, std::uint64_t{kSize} * kSize * (16 + 4)) << "probes only";
 }
 
 TEST_F(EmissionSamples, CountsOutsideOneToSixtyFourAreRefused) {

@@ -29,7 +29,7 @@ static_assert(sizeof(GpuCamera) == 64);
 static_assert(sizeof(GBufferTexel) == 64 && offsetof(GBufferTexel, albedo) == 48);
 static_assert(sizeof(PrimaryPush) == 112 && offsetof(PrimaryPush, firstSample) == 96 && sizeof(PrimaryPush) <= 128);
 static_assert(sizeof(TracePush) == 16);
-static_assert(sizeof(PathPush) == 112 && offsetof(PathPush, firstRow) == 96 && sizeof(PathPush) <= 128);
+static_assert(sizeof(PathPush) == 128 && offsetof(PathPush, firstRow) == 96 && offsetof(PathPush, firstSample) == 116);
 static_assert(sizeof(ShadePush) == 112 && offsetof(ShadePush, averageReflectance) == 48 && offsetof(ShadePush, pathDepth) == 60 &&
               offsetof(ShadePush, firstRow) == 80 && offsetof(ShadePush, kappa) == 96 && sizeof(ComposePush) == 32 &&
               offsetof(ComposePush, specular) == 28);

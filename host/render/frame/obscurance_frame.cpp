@@ -128,6 +128,7 @@ ObscuranceFrame::ObscuranceFrame(const gpu::Context& context, std::uint32_t widt
     b.dirty = gpu::Buffer(context, (2 * px + gpu::kQueueHeader + gpu::kDirtyBoxWords + 8 * slots) * 4, kStorage | Usage::eIndirectBuffer,
                           "frame.dirty" + tag);
     b.sampleCounts = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.sample_counts" + tag);
+    b.emitterEdges = gpu::Buffer(context, atLeastOne(px * 4), kStorage, "frame.emitter_edges" + tag);
     b.pathHits = gpu::Buffer(context, specular ? atLeastOne(px * contents_.keptRaySamples * kPathHitBytesPerSample) : kVec4,
                              kStorage, "frame.path_hits" + tag);
     b.shadowRays = gpu::Buffer(context, atLeastOne(px * contents_.keptRaySamples * keptShadowRayBytesPerSample(contents.keptShadowRays)),
@@ -143,7 +144,7 @@ std::uint64_t ObscuranceFrame::bytes() const {
     for (const gpu::Buffer* buffer : {&b.gbuffer.buffer(), &b.aovs, &b.basis.buffer(), &b.emissionBasis.buffer(), &b.ambient.buffer(),
                                       &b.specularBasis.buffer(),
                                       &b.specularAmbient.buffer(), &b.queue, &b.specularPaths, &b.composed, &b.display, &b.resolved.buffer(), &b.hitBounds, &b.dirty,
-                                      &b.sampleCounts, &b.pathHits, &b.shadowRays})
+                                      &b.sampleCounts, &b.emitterEdges, &b.pathHits, &b.shadowRays})
       total += buffer->size();
   return total;
 }

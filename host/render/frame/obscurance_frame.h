@@ -71,6 +71,7 @@ public:
                            // pixels with its indirect dispatch (dirty.comp; host_device.h), then
                            // the changed boxes for the probing passes (dirtyBoxesBase)
     gpu::Buffer sampleCounts; // per pixel, the samples its sums hold (primary.comp); compose divides by it
+    gpu::Buffer emitterEdges; // per pixel, 1 = an emitter's edge crosses it (primary.comp's probe at its first sample)
     gpu::Buffer pathHits;     // per kept sample and pixel, its specular path's lobe hits (lib/kept_rays.glsl)
     gpu::Buffer shadowRays;   // per kept sample and pixel, the shadow rays at its primary hit and path vertices
   };

@@ -64,6 +64,7 @@ void PrimaryPass::bind(std::uint32_t band, const SceneBuffers& scene, const Obsc
     kernel.bind(gpu::kBindingPrimaryHitBounds, b.hitBounds, band);
     kernel.bind(gpu::kBindingPrimaryDirty, b.dirty, band);
     kernel.bind(gpu::kBindingPrimarySampleCounts, b.sampleCounts, band);
+    kernel.bind(gpu::kBindingPrimaryEmitterEdges, b.emitterEdges, band);
   }
 }
 
@@ -77,6 +78,7 @@ void PrimaryPass::record(const vk::raii::CommandBuffer& cmd, std::uint32_t band,
                               // (a dispatch that sums nothing keeps no AOVs either way)
                               (dispatch.aovs || dispatch.gbufferOnly ? 0u : gpu::kPrimaryFlagNoAovs) |
                               (dispatch.dirtyOnly ? gpu::kPrimaryFlagDirtyOnly : 0u) |
+                              (dispatch.emissionAtEdges ? gpu::kPrimaryFlagEmissionAtEdges : 0u) |
                               (emissionSamples << gpu::kPrimaryEmissionSamplesShift);
   // The camera sees the whole image (a tile's rows are rows of it).
   const gpu::PrimaryPush push{.camera = camera, .width = layout.width, .height = layout.imageHeight,

@@ -46,8 +46,10 @@ public:
     bool aovs = true;
     // Only the pixels of the frame's dirty list (a geometry edit's retrace), dispatched indirectly.
     bool dirtyOnly = false;
-    // --emission-samples K: above 1 (and accumulating), M_s from K camera rays of their own.
+    // --emission-samples K: above 1 (and accumulating), M_s from K camera rays of their own;
+    // `emissionAtEdges` (--emission-samples auto): only where an emitter's edge crosses the pixel.
     std::uint32_t emissionSamples = 1;
+    bool emissionAtEdges = false;
   };
   // Records `dispatch` over band `band` of `frame`, whose whole image `camera` sees.
   void record(const vk::raii::CommandBuffer& cmd, std::uint32_t band, const ObscuranceFrame& frame,
