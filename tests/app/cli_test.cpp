@@ -4,12 +4,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <tuple>
 #include <map>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "app/cli_runner.h"
 #include "gpu_test.h"
@@ -75,6 +78,41 @@ TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   for (const char* png : {"study/cornell-box.obscurance-budget.png", "study/cornell-box.pathtrace-equal-time.png",
                           "study/cornell-box.convergence.png"})
     EXPECT_TRUE(fs::exists(path(png))) << png;
+  // Each reference's own noise (its two halves' difference) is stated, and every curve point within
+  // twice it, in a measure, is marked at the floor in that measure and in no other.
+  EXPECT_CONTAINS(r.output, "own noise (from its two halves)");
+  const nlohmann::json summary = nlohmann::json::parse(text);
+  EXPECT_TRUE(summary.at("methods").at("obscurance-denoised").contains("undenoised_at_equal_time"));
+  const nlohmann::json& floors = summary.at("reference_noise");
+  ASSERT_TRUE(floors.contains("obscurance") && floors.contains("pathtrace")) << floors.dump();
+  std::ifstream rowsAgain(path("study/cornell-box.convergence.csv"));
+  std::getline(rowsAgain, line);
+  EXPECT_CONTAINS(line, "noise_at_reference_floor");
+  int marked = 0; // points at the floor (0 or more: the references have 4x the curves' samples)
+  while (std::getline(rowsAgain, line)) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    if (line.back() == ',') cells.emplace_back();
+    ASSERT_EQ(cells.size(), 13u) << line;
+    if (cells[0] == "obscurance-reflectors") continue; // measured against a reference of its own
+    const nlohmann::json& own = floors.at(cells[0] == "pathtrace" ? "pathtrace" : "obscurance");
+    std::string expected;
+    for (const auto& [key, column, measure] : {std::tuple{"rmse", 4, "rmse"}, std::tuple{"trimmed", 7, "rmse_trimmed"},
+                                               std::tuple{"mae", 6, "mae"}})
+      if (std::stod(cells[column]) < 2.0 * own.at(measure).get<double>())
+        expected += expected.empty() ? key : std::string("+") + key;
+    EXPECT_EQ(cells[12], expected) << line;
+    marked += !expected.empty();
+  }
+  (void)marked;
+  // References no more converged than the curves' last points: the budget's noise is named as the
+  // reference's, no speed-up read from it.
+  const auto flat = runObscura("converge " + cornellBox() + " -o " + path("flat") +
+                               " --width 16 --max-spp 8 --pt-max-spp 8 --reference-factor 1");
+  ASSERT_EQ(flat.exitCode, 0) << flat.output;
+  EXPECT_CONTAINS(flat.output, "of its reference's own noise");
+  EXPECT_CONTAINS(flat.output, "no speed-up is read");
   r = runObscura(args);
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_CONTAINS(r.output, "reference obscurance: cached");
