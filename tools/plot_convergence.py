@@ -40,9 +40,9 @@ def main():
         axes[1].loglog(t, [float(r["rmse_trimmed_noise"]) for r in rows], label=method, **style)
         axes[2].loglog(t, [float(r["rmse_vs_pathtrace"]) for r in rows], label=method, **style)
         for r in rows:  # the paper's budget: 8 primary samples
-            if method == "obscurance" and r["spp"] == "8":
+            if method == "obscurance" and r["spp"] == "8":  # the defaults: 8 + 2 rays per hit
                 for ax, key in ((axes[0], "rmse_noise"), (axes[1], "rmse_trimmed_noise"), (axes[2], "rmse_vs_pathtrace")):
-                    ax.annotate("40+40 rays/px", (float(r["gpu_ms"]), float(r[key])), fontsize=8,
+                    ax.annotate("64+16 rays/px", (float(r["gpu_ms"]), float(r[key])), fontsize=8,
                                 xytext=(6, 6), textcoords="offset points")
     for name, own in floors.items():
         for ax, key in ((axes[0], "rmse"), (axes[1], "rmse_trimmed")):

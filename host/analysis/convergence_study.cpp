@@ -25,23 +25,28 @@ std::string emissionName(std::uint32_t samples, bool atEdges) {
 
 // Each method with its best estimators, the paper's estimator for reproduction, and a real-time
 // budget (one primary sample with 1 + 1 rays per hit). Path tracing comes last.
+const render::ObscuranceSettings kDefaults;
+
 const std::vector<StudyMethod> kMethods = {
-    {"obscurance", false, render::LightSampling::Spatial, kPaperRays, kPaperSpp,
-     "spatial light sampling, 5+5 rays per hit, 8 spp (the paper's budget)"},
-    {"obscurance-paper", false, render::LightSampling::Area, kPaperRays, kPaperSpp,
-     "the paper's light sampling (by power, by area), 5+5 rays per hit, 8 spp"},
-    // The same 10 shading rays per hit, spent where modern-hall's noise is: its direct light
-    // holds 2/3 of the variance at 5 + 5, the obscurance 2 % (docs/BENCHMARKS.md).
-    {"obscurance-split", false, render::LightSampling::Spatial, 8, kPaperSpp,
-     "spatial light sampling, 8 shadow + 2 obscurance rays per hit, 8 spp", 0.0f, false, 2},
+    // What `obscura render` does: its light sampling and its split of the paper's ten rays per hit.
+    {"obscurance", false, render::LightSampling::Spatial, kDefaults.shadowRays, kPaperSpp,
+     "the defaults: spatial light sampling, 8 shadow + 2 obscurance rays per hit, 8 spp", 0.0f, false,
+     kDefaults.obscuranceRays},
+    // The paper's budget as the paper splits it, and with the paper's light sampling too.
+    {"obscurance-5+5", false, render::LightSampling::Spatial, render::kPaperShadowRays, kPaperSpp,
+     "spatial light sampling, 5 + 5 rays per hit, 8 spp (the paper's budget)", 0.0f, false,
+     render::kPaperObscuranceRays},
+    {"obscurance-paper", false, render::LightSampling::Area, render::kPaperShadowRays, kPaperSpp,
+     "the paper's light sampling (by power, by area), 5 + 5 rays per hit, 8 spp", 0.0f, false,
+     render::kPaperObscuranceRays},
     // What scaling a specular path vertex's rays by its throughput (the default) saves and costs.
-    {"obscurance-per-hit-vertices", false, render::LightSampling::Spatial, kPaperRays, kPaperSpp,
-     "as obscurance, 5+5 rays at every specular path vertex too (render --vertex-rays per-hit)", 0.0f, false, 0, 0,
-     false},
+    {"obscurance-per-hit-vertices", false, render::LightSampling::Spatial, kDefaults.shadowRays, kPaperSpp,
+     "as obscurance, its rays at every specular path vertex too (render --vertex-rays per-hit)", 0.0f, false,
+     kDefaults.obscuranceRays, 0, false},
     {"obscurance-realtime", false, render::LightSampling::Spatial, 1, 1, "spatial, 1+1 rays per hit, 1 spp"},
     // The window's frames: the same, denoised (one frame alone, no history), error measured.
-    {"obscurance-denoised", false, render::LightSampling::Spatial, kPaperRays, 1,
-     "spatial, 5+5 rays per hit, denoised (a-trous on demodulated terms), 1 spp", 0.0f, true},
+    {"obscurance-denoised", false, render::LightSampling::Spatial, kDefaults.shadowRays, 1,
+     "as obscurance, 1 spp, denoised (a-trous on demodulated terms)", 0.0f, true, kDefaults.obscuranceRays},
     {"obscurance-realtime-denoised", false, render::LightSampling::Spatial, 1, 1,
      "spatial, 1+1 rays per hit, denoised, 1 spp", 0.0f, true},
     {"pathtrace", true, render::LightSampling::Spatial, 0, 1, "path tracing, NEE with spatial light sampling + MIS"},
@@ -170,8 +175,9 @@ io::Image ConvergenceStudy::reference(const StudyMethod& m) {
   std::filesystem::path txt = exr;
   txt.replace_extension(".txt");
   std::string description = fmt::format("scene={} method={} width={} height={} spp={} (two halves) seed={} "
-                                        "rays_per_hit={} emission_samples={} light_sampling={}{}{}",
+                                        "rays_per_hit={}+{} emission_samples={} light_sampling={}{}{}",
                                         o_.scenePath, m.name, width_, height_, spp, o_.seed + 7919, m.raysPerHit,
+                                        m.obscuranceRays ? m.obscuranceRays : m.raysPerHit,
                                         m.pathTrace ? emissionName(o_.pathEmissionSamples, o_.pathEmissionAtEdges)
                                                     : emissionName(o_.emissionSamples, o_.emissionAtEdges),
                                         nameOf(render::kLightSamplingNames, m.lightSampling),

@@ -69,8 +69,7 @@ struct StudyMethod {
   bool vertexRaysByThroughput = true; // specular path vertices: rays scaled by throughput, or N per hit
 };
 
-// The paper's budget [RTO §4.1]: 8 primary samples x (5 obscurance + 5 shadow rays) per hit.
-inline constexpr std::uint32_t kPaperSpp = 8, kPaperRays = 5;
+using render::kPaperSpp;
 
 // The methods a study runs: every obscurance method with its budget, path tracing last; with
 // --secondary-reflectors the best obscurance method with them too, and with --emission-samples

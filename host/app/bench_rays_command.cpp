@@ -224,10 +224,10 @@ nlohmann::json frameJson(const BenchOptions& o, const FrameRun& f) {
 #endif
 
 void printPasses(const PassesRun& p, double closestMrays, double shadowMrays) {
-  const render::ObscuranceSettings budget; // the paper's budget is the defaults
+  const render::ObscuranceSettings budget;
   fmt::print("passes: the paper's budget at {}x{} ({} spp, {} shadow + {} obscurance rays per hit{}; the image alone, "
              "as render -o out.png makes it), best repeat by GPU time: wall {:.2f} s, GPU {:.0f} ms\n",
-             p.size.x, p.size.y, budget.spp, budget.shadowRays, budget.obscuranceRays,
+             p.size.x, p.size.y, render::kPaperSpp, render::kPaperShadowRays, render::kPaperObscuranceRays,
              budget.vertexRaysByThroughput ? ", at specular path vertices scaled by throughput" : "",
              p.stats.wallSeconds, p.stats.totalGpuMs());
   fmt::print("  {:<12} {:>10} {:>12} {:>9}   {}\n", "pass", "GPU ms", "rays", "Mrays/s",

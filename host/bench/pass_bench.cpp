@@ -72,7 +72,10 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
 
 render::RenderStats renderPaperBudget(const gpu::Context& context, const scene::Scene& scene, const bvh::Bvh& bvh,
                                       const scene::Camera& camera, std::uint32_t width, std::uint32_t height, int repeats) {
-  render::ObscuranceSettings settings; // the paper's budget is the defaults
+  render::ObscuranceSettings settings;
+  settings.spp = render::kPaperSpp;
+  settings.shadowRays = render::kPaperShadowRays;
+  settings.obscuranceRays = render::kPaperObscuranceRays;
   settings.width = width;
   settings.height = height;
   settings.camera = camera;

@@ -64,7 +64,7 @@ TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   std::map<std::string, int> rows;
   while (std::getline(csv, line)) ++rows[line.substr(0, line.find(','))];
   const std::map<std::string, int> expected = {
-      {"obscurance", 4}, {"obscurance-primary-emission", 4}, {"obscurance-paper", 4}, {"obscurance-split", 4},
+      {"obscurance", 4}, {"obscurance-primary-emission", 4}, {"obscurance-paper", 4}, {"obscurance-5+5", 4},
       {"obscurance-per-hit-vertices", 4}, {"obscurance-realtime", 4}, {"obscurance-reflectors", 4},
       {"obscurance-denoised", 4}, {"obscurance-realtime-denoised", 4}, {"pathtrace", 4}}; // 1, 2, 4, 8 spp
   EXPECT_EQ(rows, expected);

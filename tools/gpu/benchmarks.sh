@@ -79,13 +79,13 @@ step() { # name command...: runs it under a time limit, everything into log.txt
   step bench-sponza-64x4 "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --traversal binary \
     --trace-shape 64x4 --verify "$check"
   step render-hall "$obscura" render "$hall_scene" --width "${hall[0]}" \
-    --height "${hall[1]}" --spp 8 -o "$out/modern-hall.png" --metrics "$out/modern-hall.metrics.json"
+    --height "${hall[1]}" --spp 8 --shadow-rays 5 --obs-rays 5 -o "$out/modern-hall.png" --metrics "$out/modern-hall.metrics.json"
   step render-hall-wide "$obscura" render "$hall_scene" --width "${hall[0]}" \
-    --height "${hall[1]}" --spp 8 -o "$work/modern-hall-wide.png" --metrics "$work/modern-hall-wide.metrics.json" \
+    --height "${hall[1]}" --spp 8 --shadow-rays 5 --obs-rays 5 -o "$work/modern-hall-wide.png" --metrics "$work/modern-hall-wide.metrics.json" \
     --traversal wide
   cat "$work/modern-hall-wide.metrics.json"; echo
   step render-sponza "$obscura" render "$sponza_scene" --width "${sponza[0]}" --height "${sponza[1]}" \
-    --spp 8 --background 2,2,2 -o "$out/sponza.png" --metrics "$out/sponza.metrics.json"
+    --spp 8 --shadow-rays 5 --obs-rays 5 --background 2,2,2 -o "$out/sponza.png" --metrics "$out/sponza.metrics.json"
   step view-offscreen "$obscura" view "$hall_scene" --offscreen --width "${view[0]}" --height "${view[1]}" --spp 1 \
     --script "$tools/view_benchmark_script.json" --log "$out/view.jsonl" --screenshot "$out/view.png"
   python3 "$tools/../view_log_summary.py" "$out/view.jsonl"
