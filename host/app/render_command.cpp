@@ -141,6 +141,7 @@ void addRenderCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render", "Render a glTF scene headless to EXR (all AOVs) or PNG");
   cmd->add_option("scene", options->scenePath, "glTF 2.0 scene (.gltf or .glb)")->required();
   cmd->add_option("-o,--output", options->output, "output image, .exr (AOV layers) or .png (tonemapped)")->required();
+  useStillImageDefaults(*options);
   addRenderOptions(*cmd, *options);
   addFrameOptions(*cmd, *options);
   cmd->add_option("--metrics", options->metrics, "write device, scene, BVH and per-pass figures as JSON");

@@ -72,9 +72,14 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
                  "how shadow rays pick lights (both methods): spatial (default: by importance at the point, "
                  "triangles by solid angle, MIS on glossy lobes) or area (the paper's: by power, uniform by area)");
   addNamedOption(cmd, "--ambient", o.obscurance.ambient, render::kAmbientModelNames,
-                 "which surfaces share a light's flux in I_a: reached (default: those its light reaches, directly or "
-                 "after one bounce), seen (reached, with the first bounce fitted to what the light's landing points send to "
-                 "the surfaces the camera sees) or global (the paper's: the whole scene)");
+                 fmt::format("which surfaces share a light's flux in I_a: reached (those its light reaches, directly or "
+                             "after one bounce), seen (reached, with the first bounce fitted to what the light's landing "
+                             "points send to the surfaces the camera sees: the least biased for one camera) or global "
+                             "(the paper's: the whole scene). Default here: {}",
+                             o.obscurance.ambient == render::AmbientModel::Seen
+                                 ? "seen (a still image)"
+                                 : "reached (the camera moves or the scene is edited, and the seen fit belongs to one "
+                                   "camera and scene; a still render uses seen)"));
   addNamedOption(cmd, "--dirty-test", o.obscurance.dirtyTest, render::kDirtyTestNames,
                  "which pixels a geometry edit (relight --edits: move, remove, insert) retraces: bounds (those whose "
                  "rays' bounding boxes and shafts may meet the object's old or new place), probe (of those, the ones "
@@ -124,6 +129,8 @@ void addEmissionSamplesOption(CLI::App& cmd, const std::string& name, std::uint3
                      what, gpu::kEdgeEmissionSamples))
       ->type_name("auto|auto:K|K");
 }
+
+void useStillImageDefaults(RenderOptions& o) { o.obscurance.ambient = render::AmbientModel::Seen; }
 
 void applyBackground(const RenderOptions& o, LoadedScene& loaded) {
   if (o.background.empty()) return;

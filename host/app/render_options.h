@@ -46,6 +46,12 @@ struct RenderOptions {
 // Registers the shared options on `cmd` (not the scene or the output, which each command names).
 void addRenderOptions(CLI::App& cmd, RenderOptions& o);
 
+// The defaults of a still image (`obscura render`, Python's obscura.render), set before
+// addRenderOptions: the seen I_a, the least biased for one camera (converge measures with it).
+// The window and edit sessions keep ObscuranceSettings' reached I_a: they move the camera or edit
+// the scene, and the seen fit belongs to one camera and one scene.
+void useStillImageDefaults(RenderOptions& o);
+
 // --emission-samples auto|auto:K|K (and converge's --pt-emission-samples): `auto` (the default)
 // sets gpu::kEdgeEmissionSamples rays where an emitter's edge crosses the pixel and the primary ray
 // elsewhere, auto:K K rays there; a number K, K rays in every pixel (1: the primary ray alone).

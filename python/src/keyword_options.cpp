@@ -11,6 +11,7 @@ namespace obscura::python {
 app::RenderOptions renderOptions(const std::vector<std::string>& arguments, OptionSet set, const std::string& caller) {
   app::RenderOptions o;
   CLI::App cli{caller};
+  if (set == OptionSet::Frame) app::useStillImageDefaults(o); // as `obscura render`
   app::addRenderOptions(cli, o);
   if (set == OptionSet::Frame) app::addFrameOptions(cli, o);
   else cli.add_option("--exposure", o.exposure, "exposure of the display image in stops");

@@ -54,7 +54,9 @@ protected:
 TEST_F(CliView, ScreenshotEqualsTheHeadlessRenderOfTheSameSettings) {
   const auto shown = view("--spp 4 --frames 4 --no-denoise --no-panel --screenshot " + path("view.png"));
   ASSERT_EQ(shown.exitCode, 0) << shown.output;
-  const auto rendered = runObscura("render " + cornellBox() + " --width 48 --height 48 --spp 4 -o " + path("render.png"));
+  // The window composes with the reached I_a (its camera moves), a still render with the seen one.
+  const auto rendered = runObscura("render " + cornellBox() + " --width 48 --height 48 --spp 4 --ambient reached -o " +
+                                   path("render.png"));
   ASSERT_EQ(rendered.exitCode, 0) << rendered.output;
   // Same seeds, same samples: the window composes with the light-mix pass, which agrees with the
   // render's compose pass to 2 display levels (LightMix.* tests).
@@ -67,10 +69,11 @@ TEST_F(CliView, DenoisedScreenshotEqualsTheHeadlessDenoisedRender) {
   const auto shown = view("--spp 4 --frames 4 --no-panel --screenshot " + path("view.png") + " --log " +
                           path("frames.jsonl"));
   ASSERT_EQ(shown.exitCode, 0) << shown.output;
-  const auto denoised = runObscura("render " + cornellBox() + " --width 48 --height 48 --spp 4 --denoise -o " +
-                                   path("denoised.png"));
+  const auto denoised = runObscura("render " + cornellBox() + " --width 48 --height 48 --spp 4 --ambient reached "
+                                   "--denoise -o " + path("denoised.png"));
   ASSERT_EQ(denoised.exitCode, 0) << denoised.output;
-  const auto raw = runObscura("render " + cornellBox() + " --width 48 --height 48 --spp 4 -o " + path("raw.png"));
+  const auto raw = runObscura("render " + cornellBox() + " --width 48 --height 48 --spp 4 --ambient reached -o " +
+                              path("raw.png"));
   ASSERT_EQ(raw.exitCode, 0) << raw.output;
   const io::Image view = io::readImage(path("view.png"));
   EXPECT_LE(maxLevelDifference(view, io::readImage(path("denoised.png"))), 1.0f);
