@@ -106,18 +106,13 @@ void main() {
   StepBudget budget = newStepBudget();
   uint rays = 1u;
   RayHit hit = traceWithBudget(budget, origin, direction, 0.0, 1.0 / 0.0, false);
-  // --emission-samples auto: the K rays only where an emitter's edge crosses the pixel, probed at
-  // its first sample as primary.comp does.
+  // --emission-samples auto: the K rays only where an emitter's edge crosses the pixel, as
+  // primary.comp decides it (lightCount 0: nothing emits with power).
   if (ownEmissionRays && pc.emissionAtEdges != 0u) {
-    if (lightCount == 0u) { // nothing emits with power: no edge to find
-      ownEmissionRays = false;
-    } else if (pc.sampleIndex == pc.firstSample) {
-      ownEmissionRays = emitterEdgeCrossesPixel(budget, pc.camera, p, vec2(size), lightCount);
-      emitterEdges[pixel] = ownEmissionRays ? 1u : 0u;
-      rays += kEdgeProbeRays;
-    } else {
-      ownEmissionRays = emitterEdges[pixel] != 0u;
-    }
+    uint probeRays;
+    ownEmissionRays = emissionRaysAtEdge(budget, pc.camera, p, vec2(size), lightCount, pixel,
+                                         pc.sampleIndex == pc.firstSample, probeRays);
+    rays += probeRays;
   }
 
   vec3 L = vec3(0.0);

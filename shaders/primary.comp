@@ -12,7 +12,6 @@
 #include "lib/camera.glsl"
 #include "lib/accumulate.glsl"
 #include "lib/band.glsl"
-#include "lib/emission_samples.glsl"
 
 layout(local_size_x = kWorkgroupSizeX, local_size_y = kWorkgroupSizeY) in;
 layout(push_constant) uniform Push { PrimaryPush pc; };
@@ -24,6 +23,7 @@ layout(std430, set = 0, binding = kBindingPrimaryHitBounds) buffer HitBounds { v
 layout(std430, set = 0, binding = kBindingPrimaryDirty) readonly buffer DirtyMask { uint dirty[]; };
 layout(std430, set = 0, binding = kBindingPrimarySampleCounts) buffer SampleCounts { uint sampleCounts[]; };
 layout(std430, set = 0, binding = kBindingPrimaryEmitterEdges) buffer EmitterEdges { uint emitterEdges[]; };
+#include "lib/emission_samples.glsl"
 
 // Kernel variants (PrimaryPass picks one per dispatch from its flags): the code a dispatch never
 // takes is left out, because on lavapipe it still costs (registers are allocated over the whole
@@ -134,18 +134,9 @@ void main() {
     for (uint s = 0u; s < lightCount; ++s) OBS_ACCUMULATE_FIRST(emissionBasis, s * bp.count + pixel, vec4(0.0))
   bool ownRays = kEmissionRays && emissionSamples > 1u;
   uint emissionRays = 0u; // traced for the seen emission alone (the status word counts them)
-  if (ownRays && (pc.flags & kPrimaryFlagEmissionAtEdges) != 0u) {
-    // Only where an emitter's edge crosses the pixel: probed at its first sample, kept after.
-    if (lightCount == 0u) { // no light: no edge to find
-      ownRays = false;
-    } else if (first) {
-      ownRays = emitterEdgeCrossesPixel(budget, pc.camera, p, vec2(size), lightCount);
-      emitterEdges[pixel] = ownRays ? 1u : 0u;
-      emissionRays += kEdgeProbeRays;
-    } else {
-      ownRays = emitterEdges[pixel] != 0u;
-    }
-  }
+  // Only where an emitter's edge crosses the pixel (--emission-samples auto).
+  if (ownRays && (pc.flags & kPrimaryFlagEmissionAtEdges) != 0u)
+    ownRays = emissionRaysAtEdge(budget, pc.camera, p, vec2(size), lightCount, pixel, first, emissionRays);
   const uint rays = ownRays ? emissionSamples : 1u;
   if (ownRays) emissionRays += rays;
   if (emissionRays > 0u) atomicAdd(status[kStatusEmissionRays], emissionRays);

@@ -54,11 +54,7 @@ namespace {
 
 RenderedFrame pathTrace(const RenderOptions& o, const scene::Scene& scene, const bvh::Bvh& bvh, const gpu::Context& context,
                         const render::ObscuranceSettings& settings, const render::ProgressFn& progress) {
-  render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
-                               .camera = settings.camera, .maxDepth = settings.maxDepth,
-                               .lightSampling = settings.lightSampling,
-                               .emissionSamples = settings.emissionSamples,
-                               .emissionAtEdges = settings.emissionAtEdges};
+  const render::PathTraceSettings pt = pathTraceSettings(settings);
   render::PathTracer tracer(context, scene, bvh, pt);
   tracer.render(progress);
   RenderedFrame frame;

@@ -167,6 +167,13 @@ render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scen
   return settings;
 }
 
+render::PathTraceSettings pathTraceSettings(const render::ObscuranceSettings& settings) {
+  return {.width = settings.width, .height = settings.height, .spp = settings.spp, .seed = settings.seed,
+          .camera = settings.camera, .maxDepth = settings.maxDepth, .lightSampling = settings.lightSampling,
+          .emissionSamples = settings.emissionSamples, .emissionAtEdges = settings.emissionAtEdges,
+          .firstSample = settings.firstSample, .rows = settings.rows};
+}
+
 void warnIfUnlit(const LoadedScene& loaded) {
   const render::LightSet lights = render::buildLightSet(loaded.scene);
   if (lights.anySampled()) return;

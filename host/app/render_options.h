@@ -11,6 +11,7 @@
 #include "app/scene_setup.h"
 #include "render/method.h"
 #include "render/obscurance_renderer.h"
+#include "render/path_tracer.h"
 #include "scene/scene.h"
 
 namespace obscura::app {
@@ -66,6 +67,9 @@ scene::Camera chooseCamera(const scene::Scene& scene, int index);
 void chooseSize(RenderOptions& o, const scene::Camera& camera);
 // The obscurance renderer's settings from the options, for `camera` at the chosen size.
 render::ObscuranceSettings obscuranceSettings(const RenderOptions& o, const scene::Camera& camera);
+// The path tracer's settings for the image `settings` makes (--method pathtrace): its size, rows,
+// samples, seed, camera, depth, light sampling and camera rays for the seen emission.
+render::PathTraceSettings pathTraceSettings(const render::ObscuranceSettings& settings);
 // Gives the loaded scene the --background sky (after loadScene, before the lights are built).
 void applyBackground(const RenderOptions& o, LoadedScene& loaded);
 // InputError unless --background's R, G, B are finite and >= 0.

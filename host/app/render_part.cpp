@@ -109,12 +109,7 @@ void renderPart(RenderOptions& o) {
   settings.rows = part.rows;
   render::RenderStats stats;
   if (o.method == render::Method::PathTrace) {
-    render::PathTraceSettings pt{.width = o.width, .height = o.height, .spp = o.spp, .seed = o.seed,
-                                 .camera = camera, .maxDepth = settings.maxDepth,
-                                 .lightSampling = settings.lightSampling,
-                                 .emissionSamples = settings.emissionSamples,
-                                 .emissionAtEdges = settings.emissionAtEdges,
-                                 .firstSample = part.samples.begin, .rows = part.rows};
+    const render::PathTraceSettings pt = pathTraceSettings(settings); // the part's rows and samples
     render::PathTracer tracer(context, loaded.scene, loaded.bvh, pt);
     tracer.reset();
     tracer.iterate(part.samples.count());

@@ -13,7 +13,8 @@
 // Most pixels see no emitter's edge, and there the K rays buy nothing: with --emission-samples
 // auto (the default) only the pixels an edge crosses trace them (emitterEdgeCrossesPixel), the
 // rest keep the primary ray's estimate.
-// Requires scene_bindings.glsl, bvh.glsl, surface.glsl, material.glsl, camera.glsl.
+// Requires scene_bindings.glsl, bvh.glsl, surface.glsl, material.glsl, camera.glsl, and the
+// includer's `uint emitterEdges[]` buffer (one word per pixel) declared before it.
 #ifndef OBSCURA_EMISSION_SAMPLES_GLSL
 #define OBSCURA_EMISSION_SAMPLES_GLSL
 
@@ -85,6 +86,20 @@ bool emitterEdgeCrossesPixel(inout StepBudget budget, GpuCamera camera, uvec2 p,
     seen = light;
   }
   return differ;
+}
+
+// --emission-samples auto: do pixel `p`'s samples take the emission rays? Probed at its first
+// sample (`first`) and kept in emitterEdges[pixel] for the later ones; `probeRays` counts the rays
+// the answer traced (none but at the first sample, none without a light: no edge to find).
+bool emissionRaysAtEdge(inout StepBudget budget, GpuCamera camera, uvec2 p, vec2 size, uint lightCount, uint pixel,
+                        bool first, out uint probeRays) {
+  probeRays = 0u;
+  if (lightCount == 0u) return false;
+  if (!first) return emitterEdges[pixel] != 0u;
+  const bool edge = emitterEdgeCrossesPixel(budget, camera, p, size, lightCount);
+  emitterEdges[pixel] = edge ? 1u : 0u;
+  probeRays = kEdgeProbeRays;
+  return edge;
 }
 
 #endif
