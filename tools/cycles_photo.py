@@ -60,6 +60,11 @@ def gltf_without_emission(path):
         if "uri" in im and not im["uri"].startswith("data:"):
             im["uri"] = os.path.join(folder, im["uri"])
     gltf.pop("extensions", None)  # no KHR_lights_punctual: the lamp is the only light
+    for node in gltf.get("nodes", []):
+        node.get("extensions", {}).pop("KHR_lights_punctual", None)
+    for key in ("extensionsUsed", "extensionsRequired"):
+        if key in gltf:
+            gltf[key] = [e for e in gltf[key] if e != "KHR_lights_punctual"]
     out = tempfile.NamedTemporaryFile("w", suffix=".gltf", delete=False)
     json.dump(gltf, out)
     out.close()
@@ -76,42 +81,50 @@ def base_colour(material):
 
 
 def make_lambertian(material):
+    """The material as a Lambertian diffuser of its base colour, or of whatever feeds the base
+    colour (a texture, a texture times a factor) where the importer linked one."""
     colour = base_colour(material)
     material.use_nodes = True
     nodes = material.node_tree.nodes
-    nodes.clear()
+    links = material.node_tree.links
+    principled = next((n for n in nodes if n.type == "BSDF_PRINCIPLED"), None)
+    source = None
+    if principled is not None and principled.inputs["Base Color"].is_linked:
+        source = principled.inputs["Base Color"].links[0].from_socket
+    for node in [n for n in nodes if n.type in ("OUTPUT_MATERIAL", "BSDF_PRINCIPLED")]:
+        nodes.remove(node)
     diffuse = nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = colour
     diffuse.inputs["Roughness"].default_value = 0.0  # Lambertian (Oren-Nayar sigma 0)
+    if source is not None:
+        links.new(source, diffuse.inputs["Color"])
     output = nodes.new("ShaderNodeOutputMaterial")
-    material.node_tree.links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])
+    links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])
 
 
-def main():
-    a = parse_args()
+def setup_scene(scene_path, camera_index, power, radius, bounces, threads, spp, seed):
+    """The room imported without its emission, Lambertian, with its glTF camera, one point lamp
+    (returned, at the origin) and the recipe's render settings."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    stripped = gltf_without_emission(a.scene)
+    stripped = gltf_without_emission(scene_path)
     try:
         bpy.ops.import_scene.gltf(filepath=stripped)
     finally:
         os.unlink(stripped)
     cameras = [o for o in scene.objects if o.type == "CAMERA"]
     if not cameras:
-        sys.exit(f"{a.scene}: no camera")
+        sys.exit(f"{scene_path}: no camera")
     cameras.sort(key=lambda o: o.name)
-    scene.camera = cameras[min(a.camera, len(cameras) - 1)]
+    scene.camera = cameras[min(camera_index, len(cameras) - 1)]
     for material in bpy.data.materials:
         make_lambertian(material)
     # Objects without a material: the glTF default (white 1.0) is what the glTF means.
-    # glTF (x, y, z) with Y up is Blender (x, -z, y) with Z up (the importer's convention).
-    x, y, z = a.lamp
     light = bpy.data.lights.new("lamp", type="POINT")
-    light.energy = a.power
-    light.shadow_soft_size = a.radius
+    light.energy = power
+    light.shadow_soft_size = radius
     light.color = (1.0, 1.0, 1.0)
     lamp = bpy.data.objects.new("lamp", light)
-    lamp.location = (x, -z, y)
     lamp.visible_camera = False
     scene.collection.objects.link(lamp)
 
@@ -124,29 +137,27 @@ def main():
     scene.render.engine = "CYCLES"
     c = scene.cycles
     c.device = "CPU"
-    c.samples = a.spp
+    c.samples = spp
     c.use_adaptive_sampling = False
     c.use_denoising = False
-    c.seed = a.seed
+    c.seed = seed
     c.pixel_filter_type = "BOX"
     c.filter_width = 1.0
-    c.max_bounces = a.bounces
-    c.diffuse_bounces = a.bounces
-    c.glossy_bounces = a.bounces
-    c.transmission_bounces = a.bounces
+    c.max_bounces = bounces
+    c.diffuse_bounces = bounces
+    c.glossy_bounces = bounces
+    c.transmission_bounces = bounces
     c.volume_bounces = 0
-    c.transparent_max_bounces = a.bounces
-    c.min_light_bounces = a.bounces  # no Russian roulette before the limit
-    c.min_transparent_bounces = a.bounces
+    c.transparent_max_bounces = bounces
+    c.min_light_bounces = bounces  # no Russian roulette before the limit
+    c.min_transparent_bounces = bounces
     c.sample_clamp_direct = 0.0
     c.sample_clamp_indirect = 0.0
     c.caustics_reflective = True
     c.caustics_refractive = True
     c.blur_glossy = 0.0
     scene.render.threads_mode = "FIXED"
-    scene.render.threads = a.threads
-    scene.render.resolution_x = a.size
-    scene.render.resolution_y = a.size
+    scene.render.threads = threads
     scene.render.resolution_percentage = 100
     scene.render.film_transparent = False
     scene.view_settings.view_transform = "Standard"
@@ -154,14 +165,32 @@ def main():
     scene.view_settings.gamma = 1.0
     scene.view_settings.look = "None"
 
-    view_layer = scene.view_layers[0]
-    view_layer.use_pass_diffuse_color = bool(a.albedo)
     scene.use_nodes = True
     tree = scene.node_tree
     tree.nodes.clear()
     layers = tree.nodes.new("CompositorNodeRLayers")
     composite = tree.nodes.new("CompositorNodeComposite")
     tree.links.new(layers.outputs["Image"], composite.inputs["Image"])
+    settings = scene.render.image_settings
+    settings.file_format = "OPEN_EXR"
+    settings.color_depth = "16"
+    settings.exr_codec = "ZIP"
+    settings.color_mode = "RGB"
+    scene.render.use_file_extension = False
+    return scene, lamp
+
+
+def main():
+    a = parse_args()
+    scene, lamp = setup_scene(a.scene, a.camera, a.power, a.radius, a.bounces, a.threads, a.spp, a.seed)
+    # glTF (x, y, z) with Y up is Blender (x, -z, y) with Z up (the importer's convention).
+    x, y, z = a.lamp
+    lamp.location = (x, -z, y)
+    scene.render.resolution_x = a.size
+    scene.render.resolution_y = a.size
+    tree = scene.node_tree
+    layers = next(n for n in tree.nodes if n.type == "R_LAYERS")
+    scene.view_layers[0].use_pass_diffuse_color = bool(a.albedo)
     if a.albedo:
         out = tree.nodes.new("CompositorNodeOutputFile")
         out.base_path = os.path.dirname(os.path.abspath(a.albedo))
@@ -171,18 +200,12 @@ def main():
         out.format.color_mode = "RGB"
         out.file_slots[0].path = os.path.basename(a.albedo) + "_"
         tree.links.new(layers.outputs["DiffCol"], out.inputs[0])
-
-    settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR"
-    settings.color_depth = "16"
-    settings.exr_codec = "ZIP"
-    settings.color_mode = "RGB"
     scene.render.filepath = os.path.abspath(a.output)
-    scene.render.use_file_extension = False
     bpy.ops.render.render(write_still=True)
     if a.albedo:  # the file output node appends the frame number
         written = os.path.join(os.path.dirname(os.path.abspath(a.albedo)), os.path.basename(a.albedo) + "_0001")
         os.replace(written, os.path.abspath(a.albedo))
 
 
-main()
+if __name__ == "__main__":
+    main()

@@ -79,19 +79,22 @@ nlohmann::json regionJson(const recover::RegionError& e) { return {{"rmse", e.rm
 // RMSE against the answer key per light region (recovery_accuracy.h).
 nlohmann::json accuracyJson(const recover::Recovery& r, const std::vector<glm::vec3>& truth) {
   const auto a = recover::recoveryAccuracy(r.reflectance, truth, recover::lightRegions(r.visibility, r.object));
-  return {{"lit", regionJson(a.lit)}, {"penumbra", regionJson(a.penumbra)}, {"shadow", regionJson(a.shadow)},
-          {"all", regionJson(a.all)}};
+  return {{"lit", regionJson(a.lit)},       {"penumbra", regionJson(a.penumbra)}, {"shadow", regionJson(a.shadow)},
+          {"direct", regionJson(a.direct)}, {"all", regionJson(a.all)}};
 }
 
 void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const recover::PhotoSet& photos,
                   const nlohmann::json& accuracy) {
   const fs::path dir(o.output);
-  io::Image out = rgbImage(r.width, r.height, {"R", "G", "B", "confidence.K", "filled.id", "object.id"});
+  io::Image out = rgbImage(r.width, r.height,
+                           {"R", "G", "B", "confidence.K", "filled.id", "object.id", "indirect.shots", "variance.rel"});
   for (std::size_t p = 0; p < r.reflectance.size(); ++p) {
     put(out, p, 0, r.reflectance[p]);
     put(out, p, 3, r.confidence[p]);
     put(out, p, 4, float(r.filled[p]));
     put(out, p, 5, float(r.object[p]));
+    put(out, p, 6, r.indirectShots[p]);
+    put(out, p, 7, r.relativeVariance[p]);
   }
   io::writeExr((dir / "reflectance.exr").string(), out);
   if (o.png) {
@@ -141,7 +144,10 @@ void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const rec
                                  {"width", r.width},
                                  {"height", r.height},
                                  {"indirect", nameString(recover::kIndirectModelNames, o.recovery.indirect)},
+                                 {"merge", nameString(recover::kMergeModelNames, o.recovery.merge)},
                                  {"surface_pixels", surface},
+                                 {"lit_pixels", r.litPixels},
+                                 {"indirect_only_pixels", r.indirectOnlyPixels},
                                  {"filled_from_visibility", r.filledFromVisibility},
                                  {"filled_from_object_mean", r.filledFromObject},
                                  {"gather_rays_seen", r.gatherSeen},
@@ -184,9 +190,11 @@ void runRecover(RecoverOptions& o) {
   nlohmann::json accuracy;
   if (!truth.empty()) {
     accuracy = accuracyJson(r, truth);
-    fmt::print(stderr, "recover: RMSE against {}: lit {:.4f}, penumbra {:.4f}, shadow {:.4f}, all {:.4f}\n", o.truth,
-               accuracy["lit"]["rmse"].get<double>(), accuracy["penumbra"]["rmse"].get<double>(),
-               accuracy["shadow"]["rmse"].get<double>(), accuracy["all"]["rmse"].get<double>());
+    fmt::print(stderr,
+               "recover: RMSE against {}: lit {:.4f}, penumbra {:.4f}, shadow {:.4f}; lit in some photo {:.4f}, all {:.4f}\n",
+               o.truth, accuracy["lit"]["rmse"].get<double>(), accuracy["penumbra"]["rmse"].get<double>(),
+               accuracy["shadow"]["rmse"].get<double>(), accuracy["direct"]["rmse"].get<double>(),
+               accuracy["all"]["rmse"].get<double>());
   }
   writeOutputs(o, r, photos, accuracy);
   const auto stateStart = std::chrono::steady_clock::now();
@@ -195,10 +203,10 @@ void runRecover(RecoverOptions& o) {
   fmt::print(stderr, "recover: relighting state (lights shot0..shot{}) in {:.1f} s -> {}/state\n",
              photos.shots.size() - 1,
              std::chrono::duration<double>(std::chrono::steady_clock::now() - stateStart).count(), o.output);
-  fmt::print(stderr, "recover: {} photos, {}x{}, {} iterations; {} pixels filled from visibility, {} from their object's "
-                     "mean; {:.1f} s -> {}\n",
-             photos.shots.size(), r.width, r.height, r.iterations.size() - 1, r.filledFromVisibility, r.filledFromObject,
-             r.seconds, o.output);
+  fmt::print(stderr, "recover: {} photos, {}x{}, {} iterations; {} pixels from lit estimates, {} from indirect light "
+                     "only; {} filled from visibility, {} from their object's mean; {:.1f} s -> {}\n",
+             photos.shots.size(), r.width, r.height, r.iterations.size() - 1, r.litPixels, r.indirectOnlyPixels,
+             r.filledFromVisibility, r.filledFromObject, r.seconds, o.output);
 }
 
 } // namespace
@@ -232,6 +240,19 @@ void addRecoverCommand(CLI::App& app) {
       ->check(CLI::Range(0.0f, 1.0f));
   cmd->add_option("--eps2", o->recovery.filters.outlierDistance, "outlier test: distance from the median that rejects")
       ->check(CLI::Range(0.0f, 100.0f));
+  cmd->add_option("--hidden-bounces", o->recovery.hiddenBounces,
+                  "gather: path vertices through surfaces the camera does not see before the mean indirect light "
+                  "stands in (0: at once)")
+      ->check(CLI::Range(0u, recover::kMaxHiddenBounces));
+  addNamedOption(*cmd, "--merge", o->recovery.merge, recover::kMergeModelNames,
+                 "how the photos' estimates merge: weighted (by their expected error, pixels no lamp lights recovered "
+                 "from their indirect light, smoothed along surfaces by their noise) or paper (IVR eq. 3)");
+  cmd->add_option("--indirect-uncertainty", o->recovery.weighted.indirectUncertainty,
+                  "weighted: relative error assumed of the modelled indirect light")
+      ->check(CLI::Range(0.001f, 10.0f));
+  cmd->add_option("--smoothing-radius", o->recovery.weighted.smoothingRadius,
+                  "weighted: window radius of the smoothing along surfaces (0: none)")
+      ->check(CLI::Range(0, 32));
   cmd->add_flag("--no-min-filter", o->noMin, "skip the 5x5 min filter");
   cmd->add_flag("--no-lower-smoothing", o->noLowerSmoothing, "skip the 5x5 lowering smoothing");
   cmd->add_flag("--no-outlier", o->noOutlier, "skip the outlier test");

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <glm/gtc/constants.hpp>
 
@@ -57,23 +58,86 @@ std::int64_t projectToPixel(const scene::Camera& camera, int width, int height, 
 
 PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const scene::Camera& camera,
                          const PixelGeometry& pixels, const std::vector<Shot>& shots, std::uint32_t raysPerPixel,
-                         std::uint32_t seed, int smoothRadius)
-    : geometry_(&pixels), smoothRadius_(smoothRadius), pixels_(pixels.position.size()), shots_(shots.size()), raysPerPixel_(raysPerPixel) {
+                         std::uint32_t seed, int smoothRadius, std::uint32_t hiddenBounces)
+    : geometry_(&pixels), smoothRadius_(smoothRadius), pixels_(pixels.position.size()), shots_(shots.size()),
+      raysPerPixel_(raysPerPixel), hiddenBounces_(hiddenBounces) {
+  if (hiddenBounces > kMaxHiddenBounces) throw std::invalid_argument("PhotoGather: hiddenBounces above kMaxHiddenBounces");
   const std::vector<std::uint32_t> objectOf = triangleObjects(room);
   const float scale = render::sceneScale(room.bounds);
   const float offset = 1e-4f * scale;       // ray origins off the surface
   const float samePlane = 2e-3f * scale;    // a seen pixel's point within this of the hit's plane
   seenStart_.reserve(pixels_ + 1);
-  hiddenStart_.reserve(pixels_ + 1);
-  // The pixels a chunk at a time, each chunk's rays traced together (one dispatch on a device):
-  // its gather rays, then the shadow rays from its hidden hits to every shot's lamp.
-  const std::size_t pixelsPerChunk = std::max<std::size_t>(1, kRaysPerBatch / std::max(raysPerPixel, 1u));
-  std::vector<bvh::Ray> gatherRays, shadowRays;
+  hiddenStart_.reserve(pixels_);
+  hiddenEnd_.reserve(pixels_);
+
+  // A hit: the pixel that shows it, or (-1) its object, point and normal facing the ray.
+  struct Classified {
+    std::int64_t seenPixel = -1;
+    std::uint32_t object = 0;
+    glm::vec3 lit{0.0f}, normal{0.0f}; // the point just off the surface on the ray's side
+  };
+  const auto classify = [&](const bvh::Hit& hit, const glm::vec3& dir) {
+    Classified c;
+    const glm::uvec3 tri = room.triangles[hit.primitive];
+    const glm::vec3 a = room.positions[tri.x];
+    const glm::vec3 q = a + hit.u * (room.positions[tri.y] - a) + hit.v * (room.positions[tri.z] - a);
+    glm::vec3 nq = glm::normalize(glm::cross(room.positions[tri.y] - a, room.positions[tri.z] - a));
+    if (glm::dot(nq, dir) > 0.0f) nq = -nq; // the side facing the ray reflects towards its origin
+    c.object = objectOf[hit.primitive];
+    const std::int64_t v = projectToPixel(camera, pixels.width, pixels.height, q);
+    if (v >= 0) {
+      const auto vi = static_cast<std::size_t>(v);
+      // The camera sees Q's side if that pixel shows the same object on the same plane, from
+      // the same side (its normal faces the camera, so it must agree with nq).
+      if (pixels.object[vi] == static_cast<std::int32_t>(c.object) &&
+          std::abs(glm::dot(pixels.position[vi] - q, nq)) < samePlane && glm::dot(pixels.normal[vi], nq) > 0.9f) {
+        c.seenPixel = v;
+        return c;
+      }
+    }
+    c.lit = q + offset * nq;
+    c.normal = nq;
+    return c;
+  };
+  // The shadow rays from a hidden point to every shot's lamp, their results written to
+  // direct[at + i] after the batch is traced.
   struct PendingDirect {
-    std::size_t at;  // in hiddenDirect_
+    std::vector<float>* direct;
+    std::size_t at;
     float unblocked; // the lamp's light there if nothing is in the way
   };
   std::vector<PendingDirect> pending;
+  std::vector<bvh::Ray> shadowRays;
+  const auto queueDirect = [&](const Classified& c, std::vector<float>& direct) {
+    for (const Shot& shot : shots) {
+      const glm::vec3 toLamp = shot.position - c.lit;
+      const float d2 = glm::dot(toLamp, toLamp);
+      const float cosine = glm::dot(c.normal, toLamp) / std::sqrt(d2);
+      if (cosine > 0.0f) {
+        pending.push_back({&direct, direct.size(), shot.intensity * cosine / (glm::pi<float>() * d2)});
+        shadowRays.push_back({c.lit, toLamp, 0.0f, 1.0f - 1e-4f});
+      }
+      direct.push_back(0.0f);
+    }
+  };
+  const auto cosineRay = [](const glm::vec3& origin, const glm::vec3& n, float u1, float u2) {
+    glm::vec3 t, b;
+    frame(n, t, b);
+    const float r = std::sqrt(u1), phi = 2.0f * glm::pi<float>() * u2;
+    return bvh::Ray{origin,
+                    r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(std::max(0.0f, 1.0f - u1)) * n};
+  };
+
+  // The pixels a chunk at a time, each chunk's rays traced together (one dispatch on a device):
+  // its gather rays; the paths on from its hidden hits, a ray per vertex and depth; then the shadow
+  // rays from all of them to every shot's lamp.
+  const std::size_t pixelsPerChunk = std::max<std::size_t>(1, kRaysPerBatch / std::max(raysPerPixel, 1u));
+  std::vector<bvh::Ray> gatherRays, bounceRays;
+  struct Active {
+    std::uint32_t vertex;
+    glm::vec3 lit, normal;
+  };
+  std::vector<Active> active;
   for (std::size_t first = 0; first < pixels_; first += pixelsPerChunk) {
     const std::size_t last = std::min(pixels_, first + pixelsPerChunk);
     gatherRays.clear();
@@ -81,78 +145,91 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
       if (pixels.object[p] < 0) continue;
       const glm::vec3 n = pixels.normal[p];
       const glm::vec3 origin = pixels.position[p] + offset * n;
-      glm::vec3 t, b;
-      frame(n, t, b);
       // Stratified in the first dimension, van der Corput in the second, shifted per pixel.
       const std::uint32_t h = hash(static_cast<std::uint32_t>(p) ^ hash(seed));
       const float shift1 = unit(h), shift2 = unit(hash(h));
       for (std::uint32_t k = 0; k < raysPerPixel; ++k) {
         const float u1 = std::fmod((float(k) + 0.5f) / float(raysPerPixel) + shift1, 1.0f);
         const float u2 = std::fmod(radicalInverse2(k) + shift2, 1.0f);
-        const float r = std::sqrt(u1), phi = 2.0f * glm::pi<float>() * u2;
-        gatherRays.push_back(
-            {origin, r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(std::max(0.0f, 1.0f - u1)) * n});
+        gatherRays.push_back(cosineRay(origin, n, u1, u2));
       }
     }
     const std::vector<bvh::Hit> hits = rays.closest(gatherRays);
     shadowRays.clear();
     pending.clear();
+    bounceRays.clear();
     std::size_t ray = 0;
     for (std::size_t p = first; p < last; ++p) {
       seenStart_.push_back(static_cast<std::uint32_t>(seen_.size()));
       hiddenStart_.push_back(static_cast<std::uint32_t>(hiddenObject_.size()));
-      if (pixels.object[p] < 0) continue;
+      if (pixels.object[p] < 0) {
+        hiddenEnd_.push_back(hiddenStart_.back());
+        continue;
+      }
       rays_ += raysPerPixel;
       for (std::uint32_t k = 0; k < raysPerPixel; ++k, ++ray) {
         const bvh::Hit& hit = hits[ray];
         if (!hit.hit()) continue; // leaves the scene: black
-        const glm::vec3 dir = gatherRays[ray].direction;
-        const glm::uvec3 tri = room.triangles[hit.primitive];
-        const glm::vec3 a = room.positions[tri.x];
-        const glm::vec3 q = a + hit.u * (room.positions[tri.y] - a) + hit.v * (room.positions[tri.z] - a);
-        glm::vec3 nq = glm::normalize(glm::cross(room.positions[tri.y] - a, room.positions[tri.z] - a));
-        if (glm::dot(nq, dir) > 0.0f) nq = -nq; // the side facing P reflects towards it
-        const auto object = static_cast<std::int32_t>(objectOf[hit.primitive]);
-        const std::int64_t v = projectToPixel(camera, pixels.width, pixels.height, q);
-        if (v >= 0) {
-          const auto vi = static_cast<std::size_t>(v);
-          // The camera sees Q's side if that pixel shows the same object on the same plane, from
-          // the same side (its normal faces the camera, so it must agree with nq).
-          if (pixels.object[vi] == object && std::abs(glm::dot(pixels.position[vi] - q, nq)) < samePlane &&
-              glm::dot(pixels.normal[vi], nq) > 0.9f) {
-            seen_.push_back(static_cast<std::uint32_t>(vi));
-            continue;
-          }
+        const Classified c = classify(hit, gatherRays[ray].direction);
+        if (c.seenPixel >= 0) {
+          seen_.push_back(static_cast<std::uint32_t>(c.seenPixel));
+          continue;
         }
-        hiddenObject_.push_back(static_cast<std::uint32_t>(object));
-        const glm::vec3 lit = q + offset * nq;
-        for (const Shot& shot : shots) {
-          const glm::vec3 toLamp = shot.position - lit;
-          const float d2 = glm::dot(toLamp, toLamp);
-          const float cosine = glm::dot(nq, toLamp) / std::sqrt(d2);
-          if (cosine > 0.0f) {
-            pending.push_back({hiddenDirect_.size(), shot.intensity * cosine / (glm::pi<float>() * d2)});
-            shadowRays.push_back({lit, toLamp, 0.0f, 1.0f - 1e-4f});
-          }
-          hiddenDirect_.push_back(0.0f);
-        }
+        active.push_back({static_cast<std::uint32_t>(hiddenObject_.size()), c.lit, c.normal});
+        hiddenObject_.push_back(c.object);
+        next_.push_back(kTruncated);
+        queueDirect(c, hiddenDirect_);
+        ++firstHidden_;
       }
+      hiddenEnd_.push_back(static_cast<std::uint32_t>(hiddenObject_.size()));
     }
+    // Each hidden vertex's own indirect light: one more cosine-distributed ray, up to
+    // hiddenBounces_ vertices deep. It ends at a surface the camera sees (the photograph), or
+    // leaves the room (black), or is cut at the last depth (the mean b).
+    for (std::uint32_t depth = 0; depth < hiddenBounces_ && !active.empty(); ++depth) {
+      bounceRays.clear();
+      for (const Active& a : active) {
+        const std::uint32_t hb = hash(a.vertex ^ hash(seed + 1u + depth));
+        bounceRays.push_back(cosineRay(a.lit, a.normal, unit(hb), unit(hash(hb))));
+      }
+      const std::vector<bvh::Hit> bounces = rays.closest(bounceRays);
+      std::vector<Active> deeper;
+      for (std::size_t k = 0; k < bounces.size(); ++k) {
+        const std::uint32_t v = active[k].vertex;
+        if (!bounces[k].hit()) {
+          next_[v] = kEscaped;
+          continue;
+        }
+        const Classified c = classify(bounces[k], bounceRays[k].direction);
+        if (c.seenPixel >= 0) {
+          next_[v] = kSeenFlag | static_cast<std::uint32_t>(c.seenPixel);
+          continue;
+        }
+        const auto u = static_cast<std::uint32_t>(hiddenObject_.size());
+        next_[v] = u;
+        hiddenObject_.push_back(c.object);
+        next_.push_back(kTruncated);
+        queueDirect(c, hiddenDirect_);
+        deeper.push_back({u, c.lit, c.normal});
+      }
+      active = std::move(deeper);
+    }
+    active.clear();
+    // The vectors the pending entries point into are not resized from here on.
     const std::vector<float> blocked = rays.blockedAt(shadowRays);
     for (std::size_t i = 0; i < pending.size(); ++i)
-      if (std::isinf(blocked[i])) hiddenDirect_[pending[i].at] = pending[i].unblocked;
+      if (std::isinf(blocked[i])) (*pending[i].direct)[pending[i].at] = pending[i].unblocked;
   }
   seenStart_.push_back(static_cast<std::uint32_t>(seen_.size()));
-  hiddenStart_.push_back(static_cast<std::uint32_t>(hiddenObject_.size()));
 }
 
 PhotoGather PhotoGather::onDevice(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
                                   const scene::Camera& camera, const PixelGeometry& pixels,
                                   const std::vector<Shot>& shots, std::uint32_t raysPerPixel, std::uint32_t seed,
-                                  int smoothRadius) {
+                                  int smoothRadius, std::uint32_t hiddenBounces) {
   const render::SceneBuffers buffers(context, room, bvh);
   render::GpuRayBatch rays(context, buffers, render::TraceShape::forDevice(context, buffers.traversal()));
-  return PhotoGather(room, rays, camera, pixels, shots, raysPerPixel, seed, smoothRadius);
+  return PhotoGather(room, rays, camera, pixels, shots, raysPerPixel, seed, smoothRadius, hiddenBounces);
 }
 
 std::vector<std::vector<glm::vec3>> PhotoGather::indirect(const std::vector<Shot>& shots,
@@ -176,15 +253,36 @@ std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radianc
   for (std::size_t p = 0; p < pixels_; ++p) {
     glm::vec3 sum(0.0f);
     for (std::uint32_t k = seenStart_[p]; k < seenStart_[p + 1]; ++k) sum += radiance[seen_[k]];
-    for (std::uint32_t k = hiddenStart_[p]; k < hiddenStart_[p + 1]; ++k) {
-      glm::vec3 light = hiddenAmbient;
-      for (std::size_t i = 0; i < shots_; ++i) light += hiddenDirect_[std::size_t(k) * shots_ + i] * lampColour[i];
-      sum += objectReflectance[hiddenObject_[k]] * light;
-    }
+    for (std::uint32_t k = hiddenStart_[p]; k < hiddenEnd_[p]; ++k)
+      sum += hiddenRadiance(k, radiance, lampColour, objectReflectance, hiddenAmbient);
     out[p] = sum * perRay;
   }
   if (smoothRadius_ > 0) out = smoothOnSurfaces(out, *geometry_, smoothRadius_);
   return out;
+}
+
+glm::vec3 PhotoGather::hiddenRadiance(std::uint32_t first, const std::vector<glm::vec3>& radiance,
+                                      const std::vector<glm::vec3>& lampColour,
+                                      const std::vector<glm::vec3>& objectReflectance,
+                                      const glm::vec3& hiddenAmbient) const {
+  // L(v) = R_o(v) (sum_i direct_i(v) lamp_i + L(next)), folded from the path's end.
+  std::uint32_t chain[kMaxHiddenBounces + 1];
+  std::size_t length = 0;
+  std::uint32_t v = first;
+  for (;;) {
+    chain[length++] = v;
+    const std::uint32_t n = next_[v];
+    if (n == kEscaped || n == kTruncated || (n & kSeenFlag) != 0) break;
+    v = n;
+  }
+  const std::uint32_t end = next_[chain[length - 1]];
+  glm::vec3 light = end == kEscaped ? glm::vec3(0.0f) : end == kTruncated ? hiddenAmbient : radiance[end & ~kSeenFlag];
+  for (std::size_t k = length; k-- > 0;) {
+    const std::uint32_t u = chain[k];
+    for (std::size_t i = 0; i < shots_; ++i) light += hiddenDirect_[std::size_t(u) * shots_ + i] * lampColour[i];
+    light *= objectReflectance[hiddenObject_[u]];
+  }
+  return light;
 }
 
 std::vector<glm::vec3> smoothOnSurfaces(const std::vector<glm::vec3>& image, const PixelGeometry& pixels, int radius) {

@@ -6,8 +6,16 @@
 // where Q_k is the first surface a ray meets and L_i(Q) its radiance in photo i. Where the camera
 // sees Q (the pixel Q projects to shows the same object on the same plane), L_i(Q) is the
 // photograph's pixel: measured radiance, with every bounce in it, no model. Elsewhere (hidden
-// from the camera) it is modelled as R_o (F V E_i(Q) + b_i): the current mean reflectance of Q's
-// object, the lamp's direct light (a CPU shadow ray) and the current mean indirect light b_i.
+// from the camera) it is modelled as R_o (F V E_i(Q) + B_i(Q)): the current mean reflectance of
+// Q's object, the lamp's direct light (a shadow ray) and Q's own indirect light B_i(Q), which is
+// the same estimate one vertex on: a path through the surfaces the camera does not see, one
+// cosine-distributed ray per vertex, until it meets a surface the camera sees (the photograph's
+// radiance ends it), leaves the room (black), or reaches `hiddenBounces` vertices past Q (cut
+// there with b_i, the current mean indirect light of the pixels). With hiddenBounces = 0 every
+// hidden Q takes b_i: the first design, which lit hidden surfaces in shadow (under desks, behind
+// objects) as brightly as the room's average and biased B up where most rays are hidden (69-78 %
+// of them in a large room). One path per hidden hit is a noisy estimate, but a pixel averages its
+// tens of hidden hits and the smoothing below pools a window of pixels.
 // Rays that leave the scene see nothing (the photographs' world is black).
 //
 // The rays depend on the geometry only: they are traced once, through a RayBatch (the device's
@@ -25,6 +33,7 @@
 #include <glm/glm.hpp>
 
 #include "bvh/bvh.h"
+#include "core/names.h"
 #include "gpu/context.h"
 #include "recover/photo_set.h"
 #include "render/scene_data/ray_batch.h"
@@ -40,17 +49,24 @@ struct PixelGeometry {
   std::vector<std::int32_t> object;
 };
 
+// The longest path through hidden surfaces (`hiddenBounces`' range), and the default: at a
+// reflectance of ~0.7 the cut vertex carries 0.7^3 = 1/3 of the mean b's weight at the first.
+inline constexpr std::uint32_t kMaxHiddenBounces = 8;
+inline constexpr std::uint32_t kDefaultHiddenBounces = 3;
+
 class PhotoGather {
 public:
   // The pixels' gather rays and their hidden hits' shadow rays through `rays` (about
   // kRaysPerBatch gather rays at a time).
   PhotoGather(const scene::Scene& room, render::RayBatch& rays, const scene::Camera& camera, const PixelGeometry& pixels,
-              const std::vector<Shot>& shots, std::uint32_t raysPerPixel, std::uint32_t seed, int smoothRadius);
+              const std::vector<Shot>& shots, std::uint32_t raysPerPixel, std::uint32_t seed, int smoothRadius,
+              std::uint32_t hiddenBounces = kDefaultHiddenBounces);
   // The same with the rays on `context`'s device, through the renderer's traversal of the room's
   // buffers (uploaded for this and dropped after).
   static PhotoGather onDevice(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
                               const scene::Camera& camera, const PixelGeometry& pixels, const std::vector<Shot>& shots,
-                              std::uint32_t raysPerPixel, std::uint32_t seed, int smoothRadius);
+                              std::uint32_t raysPerPixel, std::uint32_t seed, int smoothRadius,
+                              std::uint32_t hiddenBounces = kDefaultHiddenBounces);
   // Gather rays traced together (a 256 x 256 view's 64 per pixel in 4 batches): few submissions,
   // and the rays and hits of one batch in tens of MiB of host memory.
   static constexpr std::size_t kRaysPerBatch = std::size_t(1) << 20;
@@ -68,21 +84,37 @@ public:
                                 const std::vector<glm::vec3>& objectReflectance, const glm::vec3& hiddenAmbient) const;
   // Fractions of the rays whose hit the camera sees, that are hidden, and that leave the scene.
   double seenFraction() const { return double(seen_.size()) / double(rays_); }
-  double hiddenFraction() const { return double(hiddenObject_.size()) / double(rays_); }
+  double hiddenFraction() const { return double(firstHidden_) / double(rays_); }
   std::uint64_t rays() const { return rays_; }
 
 private:
+  // next_[v]: where the path goes on from hidden vertex v.
+  static constexpr std::uint32_t kEscaped = ~0u;        // the ray left the room
+  static constexpr std::uint32_t kTruncated = ~0u - 1u; // cut at the last depth: the mean b
+  static constexpr std::uint32_t kSeenFlag = 1u << 31;  // | the pixel that shows the next hit
+  // Otherwise the next hidden vertex's index.
+  // The radiance towards its origin of the path from hidden vertex `first`.
+  glm::vec3 hiddenRadiance(std::uint32_t first, const std::vector<glm::vec3>& radiance,
+                           const std::vector<glm::vec3>& lampColour, const std::vector<glm::vec3>& objectReflectance,
+                           const glm::vec3& hiddenAmbient) const;
+
   const PixelGeometry* geometry_;
   int smoothRadius_ = 0;
   std::size_t pixels_ = 0, shots_ = 0;
   std::uint32_t raysPerPixel_ = 0;
   std::uint64_t rays_ = 0;
   // Per pixel p, its seen hits are seen_[seenStart_[p] .. seenStart_[p + 1]) (pixel indices), its
-  // hidden hits hiddenObject_/hiddenDirect_ likewise (hiddenDirect_: shots_ values per hit, the
-  // lamp's unit-reflectance direct light F V I / pi at the hit, without the lamp's colour).
+  // hidden hits hiddenObject_/hiddenDirect_ [hiddenStart_[p] .. hiddenEnd_[p]) (hiddenDirect_:
+  // shots_ values per vertex, the lamp's unit-reflectance direct light F V I / pi there, without
+  // the lamp's colour). Deeper path vertices follow each chunk's pixels, outside every range.
   std::vector<std::uint32_t> seenStart_, seen_;
-  std::vector<std::uint32_t> hiddenStart_, hiddenObject_;
+  std::vector<std::uint32_t> hiddenStart_, hiddenEnd_, hiddenObject_;
   std::vector<float> hiddenDirect_;
+  // The hidden vertices' paths (the first vertices are the pixels' ranges above; deeper ones
+  // follow each chunk's), and how many first vertices there are.
+  std::uint32_t hiddenBounces_ = kDefaultHiddenBounces;
+  std::vector<std::uint32_t> next_;
+  std::uint64_t firstHidden_ = 0;
 };
 
 // `image` averaged over the (2 radius + 1)^2 window's pixels that see the same object as the

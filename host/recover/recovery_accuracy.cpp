@@ -29,15 +29,16 @@ RecoveryAccuracy recoveryAccuracy(const std::vector<glm::vec3>& recovered, const
     std::size_t pixels = 0;
     void add(double e) { squares += e; ++pixels; }
     RegionError error() const { return {pixels > 0 ? std::sqrt(squares / (3.0 * double(pixels))) : 0.0, pixels}; }
-  } lit, penumbra, shadow, all;
+  } lit, penumbra, shadow, all, direct;
   for (std::size_t p = 0; p < regions.size(); ++p) {
     if (regions[p] == LightRegion::None) continue;
     const glm::vec3 d = recovered[p] - truth[p];
     const double e = glm::dot(d, d);
     all.add(e);
     (regions[p] == LightRegion::Lit ? lit : regions[p] == LightRegion::Penumbra ? penumbra : shadow).add(e);
+    if (regions[p] != LightRegion::Shadow) direct.add(e);
   }
-  return {lit.error(), penumbra.error(), shadow.error(), all.error()};
+  return {lit.error(), penumbra.error(), shadow.error(), all.error(), direct.error()};
 }
 
 } // namespace obscura::recover

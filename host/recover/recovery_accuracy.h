@@ -23,6 +23,7 @@ struct RegionError {
 
 struct RecoveryAccuracy {
   RegionError lit, penumbra, shadow, all;
+  RegionError direct; // lit or penumbra: some photo lights the pixel directly
 };
 
 enum class LightRegion : unsigned char { None, Lit, Penumbra, Shadow };

@@ -1,6 +1,7 @@
 // reflectance_recovery.cpp — see reflectance_recovery.h.
 #include "recover/reflectance_recovery.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -75,6 +76,37 @@ std::vector<std::vector<glm::vec3>> estimatesWith(const PhotoSet& photos, const 
   for (std::size_t i = 0; i < photos.shots.size(); ++i)
     r.push_back(estimateReflectance(photos.shots[i].radiance, lighting.direct[i], indirect[i]));
   return r;
+}
+
+// The estimates merged as `options.merge` says; the paper's mean in WeightedMerge's terms
+// (relative variance 1 / sum K_i, no indirect-only estimate, no smoothing).
+WeightedMerge mergeShots(const PhotoSet& photos, const Lighting& lighting,
+                         const std::vector<std::vector<glm::vec3>>& indirect,
+                         const std::vector<std::vector<glm::vec3>>& estimates,
+                         const std::vector<ConfidenceImage>& confidences, const RecoveryOptions& options) {
+  if (options.merge == MergeModel::Weighted) {
+    std::vector<std::vector<glm::vec3>> radiance;
+    for (const auto& shot : photos.shots) radiance.push_back(shot.radiance);
+    return weightedMerge(radiance, lighting.direct, indirect, estimates, confidences, lighting.visibility,
+                         lighting.geometry, options.weighted);
+  }
+  const Merged paper = mergeEstimates(estimates, confidences);
+  WeightedMerge out;
+  out.reflectance = paper.reflectance;
+  out.directConfidence = paper.confidence;
+  out.indirectShots.assign(paper.confidence.size(), 0.0f);
+  out.relativeVariance.assign(paper.confidence.size(), 0.0f);
+  for (std::size_t p = 0; p < paper.confidence.size(); ++p)
+    if (paper.confidence[p] > 0.0f) out.relativeVariance[p] = 1.0f / paper.confidence[p];
+  return out;
+}
+
+// The merged estimates' inverse variances: the weights of the object means and the change.
+std::vector<float> inverseVariance(const WeightedMerge& m) {
+  std::vector<float> w(m.relativeVariance.size(), 0.0f);
+  for (std::size_t p = 0; p < w.size(); ++p)
+    if (m.relativeVariance[p] > 0.0f) w[p] = 1.0f / m.relativeVariance[p];
+  return w;
 }
 
 } // namespace
@@ -225,8 +257,9 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.estimates = estimatesWith(photos, lighting, ambient);
   out.indirect = ambient;
   out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters);
-  Merged merged = mergeEstimates(out.estimates, out.confidences);
-  out.iterations.push_back({0, secondsSince(stepStart), 0.0, objectMeans(merged.reflectance, merged.confidence, lighting.geometry.object, objects)});
+  WeightedMerge merged = mergeShots(photos, lighting, ambient, out.estimates, out.confidences, options);
+  out.iterations.push_back({0, secondsSince(stepStart), 0.0,
+                            objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects)});
   if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
 
   std::unique_ptr<PhotoGather> gather;
@@ -234,7 +267,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
     stepStart = Clock::now();
     gather = std::make_unique<PhotoGather>(PhotoGather::onDevice(context, room, bvh, camera, lighting.geometry,
                                                                  photos.shots, options.gatherRays, options.seed,
-                                                                 options.gatherSmoothing));
+                                                                 options.gatherSmoothing, options.hiddenBounces));
     out.gatherSeen = gather->seenFraction();
     out.gatherHidden = gather->hiddenFraction();
     if (log)
@@ -256,11 +289,11 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       }
       out.estimates = estimatesWith(photos, lighting, out.indirect);
       out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters);
-      Merged next = mergeEstimates(out.estimates, out.confidences);
+      WeightedMerge next = mergeShots(photos, lighting, out.indirect, out.estimates, out.confidences, options);
       double sum = 0.0;
       std::size_t n = 0;
       for (std::size_t p = 0; p < next.reflectance.size(); ++p)
-        if (next.confidence[p] > 0.0f && merged.confidence[p] > 0.0f) {
+        if (next.relativeVariance[p] > 0.0f && merged.relativeVariance[p] > 0.0f) {
           const glm::vec3 d = next.reflectance[p] - merged.reflectance[p];
           sum += glm::dot(d, d) / 3.0;
           ++n;
@@ -268,7 +301,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       merged = std::move(next);
       const double change = n > 0 ? std::sqrt(sum / double(n)) : 0.0;
       out.iterations.push_back({it, secondsSince(stepStart), change,
-                                objectMeans(merged.reflectance, merged.confidence, lighting.geometry.object, objects)});
+                                objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects)});
       if (log) log(fmt::format("recover: iteration {}: RMS change of R {:.5f}, {:.1f} s", it, change, secondsSince(stepStart)));
     }
   }
@@ -283,15 +316,23 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.direct = lighting.direct;
   out.object = lighting.geometry.object;
   out.reflectance = merged.reflectance;
-  out.confidence = merged.confidence;
+  out.confidence = merged.directConfidence;
+  out.indirectShots = merged.indirectShots;
+  out.relativeVariance = merged.relativeVariance;
   out.filled.assign(merged.reflectance.size(), 0);
   const std::vector<glm::vec3> means = out.iterations.back().objectReflectance;
   for (std::size_t p = 0; p < out.reflectance.size(); ++p) {
-    if (out.confidence[p] > 0.0f || out.object[p] < 0) continue;
+    if (out.object[p] < 0) continue;
+    if (out.confidence[p] > 0.0f) ++out.litPixels;
+    else if (out.relativeVariance[p] > 0.0f) ++out.indirectOnlyPixels;
+    if (out.relativeVariance[p] > 0.0f) continue;
     glm::vec3 sum(0.0f);
     float weight = 0.0f;
     for (std::size_t i = 0; i < out.estimates.size(); ++i) {
-      sum += fillWeights[i].k[p] * out.estimates[i][p];
+      // An estimate above 1 is the lighting model's failure, not a surface (weighted_merge.h).
+      const glm::vec3& r = out.estimates[i][p];
+      if (options.merge == MergeModel::Weighted && std::max({r.x, r.y, r.z}) > 1.0f) continue;
+      sum += fillWeights[i].k[p] * r;
       weight += fillWeights[i].k[p];
     }
     if (weight > 0.0f) {

@@ -30,6 +30,7 @@
 #include "recover/confidence_filters.h"
 #include "recover/photo_gather.h"
 #include "recover/photo_set.h"
+#include "recover/weighted_merge.h"
 #include "render/scene_data/ambient.h"
 #include "scene/scene.h"
 
@@ -38,6 +39,13 @@ namespace obscura::recover {
 enum class IndirectModel { Constant, Obscurance, Gather };
 inline constexpr NameTable<IndirectModel, 3> kIndirectModelNames{
     {{"gather", IndirectModel::Gather}, {"obscurance", IndirectModel::Obscurance}, {"constant", IndirectModel::Constant}}};
+
+// How the per-photo estimates become one: the paper's confidence-weighted mean of the lit
+// estimates (IVR eq. 3), or weighted by their expected error with the unlit pixels recovered from
+// their indirect light (weighted_merge.h).
+enum class MergeModel { Weighted, Paper };
+inline constexpr NameTable<MergeModel, 2> kMergeModelNames{
+    {{"weighted", MergeModel::Weighted}, {"paper", MergeModel::Paper}}};
 
 // The I_a models recovery offers (--ambient): not Seen, whose first bounce is fitted to a
 // render's camera view rather than to the photographs.
@@ -51,12 +59,16 @@ struct RecoveryOptions {
   std::uint32_t seed = 1;
   float dMax = 0.0f;                 // 0 = the renderer's default
   IndirectModel indirect = IndirectModel::Gather;
-  std::uint32_t iterations = 3;      // estimates after the Constant start
-  std::uint32_t gatherRays = 64;     // Gather: rays per pixel
+  std::uint32_t iterations = 6;      // estimates after the Constant start (paths through hidden
+                                     // surfaces carry the object means further: slower to settle)
+  std::uint32_t gatherRays = 32;     // Gather: rays per pixel (each hidden hit goes on as a path)
   int gatherSmoothing = 3;           // Gather: window radius of the surface-aware smoothing of B
+  std::uint32_t hiddenBounces = kDefaultHiddenBounces; // Gather: path vertices through surfaces the camera does not see
   float constantReflectance = 0.5f;  // Constant: k
   render::AmbientModel ambient = render::AmbientModel::Reached; // of kRecoveryAmbientNames
   FilterOptions filters;
+  MergeModel merge = MergeModel::Weighted;
+  WeightedMergeOptions weighted;
 };
 
 // One render's lighting per photo, per unit reflectance, and what the pixels see.
@@ -78,7 +90,9 @@ struct IterationReport {
 struct Recovery {
   int width = 0, height = 0;
   std::vector<glm::vec3> reflectance;            // merged and filled
-  std::vector<float> confidence;                 // sum of the filtered K_i (0: filled)
+  std::vector<float> confidence;                 // sum of the filtered K_i of the lit estimates
+  std::vector<float> indirectShots;              // how many indirect-only estimates the pixel has (weighted merge)
+  std::vector<float> relativeVariance;           // of the merged R (weighted merge; 1 / sum K_i for the paper's)
   std::vector<std::uint8_t> filled;              // 0 merged, 1 filled from visibility, 2 from the object's mean
   std::vector<std::vector<glm::vec3>> estimates; // [shot] R_i
   std::vector<ConfidenceImage> visibility;       // [shot] V_i
@@ -90,6 +104,7 @@ struct Recovery {
   double gatherSeen = 0.0, gatherHidden = 0.0; // Gather: fractions of its rays (photo_gather.h)
   std::vector<IterationReport> iterations;
   std::size_t filledFromVisibility = 0, filledFromObject = 0;
+  std::size_t litPixels = 0, indirectOnlyPixels = 0; // merged from a lit estimate / from indirect-only ones alone
   double seconds = 0.0;
 };
 

@@ -2,12 +2,14 @@
 // six Blender Cycles renders of the Cornell box, one lamp each (shared/photos/cornell-box), with
 // the true reflectance (albedo.exr) as the answer key. RMSE per light region (recovery_accuracy.h).
 //
-// Measured at these settings (lavapipe, spp 4, 64 gather rays, seed 1; docs/BENCHMARKS.md):
-//   gather      lit 0.0168  penumbra 0.052  shadow 0.0036  all 0.0241
+// Measured at these settings (lavapipe, spp 4, 32 gather rays, 3 hidden bounces, the weighted
+// merge, seed 1; docs/BENCHMARKS.md):
+//   gather      lit 0.0091  penumbra 0.042  shadow 0.0046  all 0.0169
+//   the first design (paper's merge, hidden surfaces at the mean B)    lit 0.0168  all 0.0241
 //   constant    lit 0.132                                  all 0.140
-//   no 5x5 min filter (the others on)                      all 0.045
-// The goals (lit <= 0.02, all <= 0.04) are asserted as such: lit has a margin of 0.003 over
-// what we measure, 10 times the spread over seeds 1-4 (lit 0.0167 .. 0.0170, all 0.0241 .. 0.0250).
+// The goals (lit <= 0.02, all <= 0.04) are asserted as such.
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "recover_cornell_fixture.h"
@@ -23,11 +25,11 @@ TEST_F(RecoverCornell, GatheredIndirectLightMeetsTheGoalsAndConverges) {
   EXPECT_LE(a.all.rmse, 0.04) << "all pixels";
   EXPECT_LE(a.shadow.rmse, 0.04) << "shadow (filled) pixels";
   EXPECT_GT(a.lit.pixels, a.all.pixels / 2); // most of the image is lit by some lamp
-  // The iteration converges: each RMS change at most a third of the one before (measured
-  // 0.130, 0.0143, 0.00098), the last below 0.005.
-  ASSERT_EQ(r.iterations.size(), 4u);
+  // The iteration converges: each RMS change at most a third of the one before until it is
+  // below 1e-4 (measured 0.181, 0.0162, 0.0011, 0.00004, 0, 0), the last below 0.005.
+  ASSERT_EQ(r.iterations.size(), 7u);
   for (std::size_t i = 2; i < r.iterations.size(); ++i)
-    EXPECT_LT(r.iterations[i].rmsChange, r.iterations[i - 1].rmsChange / 3.0) << "iteration " << i;
+    EXPECT_LE(r.iterations[i].rmsChange, std::max(r.iterations[i - 1].rmsChange / 3.0, 1e-4)) << "iteration " << i;
   EXPECT_LT(r.iterations.back().rmsChange, 0.005);
   // The white objects' means come out white (0.725, 0.71, 0.68) to 3 %, the red wall red.
   for (std::size_t o = 0; o < r.objectNames.size(); ++o) {
@@ -46,13 +48,30 @@ TEST_F(RecoverCornell, GatheredIndirectLightBeatsThePapersConstantAmbient) {
   EXPECT_LT(g.all.rmse, 0.5 * c.all.rmse);
 }
 
+TEST_F(RecoverCornell, PathsThroughHiddenSurfacesAndTheWeightedMergeHalveTheFirstDesignsLitError) {
+  RecoveryOptions first = options();
+  first.merge = MergeModel::Paper;
+  first.hiddenBounces = 0;
+  first.gatherRays = 64;
+  first.iterations = 3;
+  const RecoveryAccuracy before = accuracy(recover(first, *photos_));
+  const RecoveryAccuracy after = accuracy(standardRecovery());
+  // Measured 0.0168 -> 0.0091 (lit), 0.0241 -> 0.0169 (all).
+  EXPECT_LT(after.lit.rmse, 0.65 * before.lit.rmse);
+  EXPECT_LT(after.all.rmse, 0.8 * before.all.rmse);
+}
+
 TEST_F(RecoverCornell, MinFilterKeepsShadowedEstimatesOutOfTheMerge) {
   // Without the 5x5 min filter the smoothing filters spread confidence into pixels no lamp
   // lights, whose estimates C / B are noisy (measured all 0.045 against 0.024).
-  RecoveryOptions noMin = options();
+  // The paper's merge: the weighted one gives an estimate near a shadow edge a weight by its
+  // error instead (without the min filter it measured all 0.0179 against 0.0203 with it).
+  RecoveryOptions paper = options();
+  paper.merge = MergeModel::Paper;
+  RecoveryOptions noMin = paper;
   noMin.filters.minFilter = false;
   const RecoveryAccuracy without = accuracy(recover(noMin, *photos_));
-  const RecoveryAccuracy with = accuracy(standardRecovery());
+  const RecoveryAccuracy with = accuracy(recover(paper, *photos_));
   EXPECT_LT(with.all.rmse, 0.8 * without.all.rmse);
 }
 
@@ -76,12 +95,20 @@ TEST_F(RecoverCornell, OutlierTestRemovesALampFixtureSeenInOnePhoto) {
     }
     return std::sqrt(sum / double(patch.size()));
   };
-  RecoveryOptions noOutlier = options();
+  // The paper's merge: the outlier test is what removes the fixture.
+  RecoveryOptions paper = options();
+  paper.merge = MergeModel::Paper;
+  RecoveryOptions noOutlier = paper;
   noOutlier.filters.outlier = false;
   const double without = patchError(recover(noOutlier, photos));
-  const double with = patchError(recover(options(), photos));
+  const double with = patchError(recover(paper, photos));
   EXPECT_GT(without, 0.3); // the fixture shows
   EXPECT_LT(with, 0.05);   // the fixture is gone
+  // The weighted merge removes it without the outlier test too: the fixture's estimates
+  // (R ~ 5 / light) are above 1, which no diffuse surface reflects.
+  RecoveryOptions weightedOnly = options();
+  weightedOnly.filters.outlier = false;
+  EXPECT_LT(patchError(recover(weightedOnly, photos)), 0.05);
 }
 
 } // namespace

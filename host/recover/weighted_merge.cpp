@@ -1,0 +1,175 @@
+// weighted_merge.cpp — see weighted_merge.h.
+#include "recover/weighted_merge.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace obscura::recover {
+namespace {
+
+float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+bool sameSurface(const PixelGeometry& g, std::size_t p, std::size_t q) {
+  return g.object[q] == g.object[p] && glm::dot(g.normal[q], g.normal[p]) >= 0.95f;
+}
+
+// Calls visit(q) for every pixel q of p's clipped (2 radius + 1)^2 window on p's surface.
+template <class Visit>
+void forSurfaceWindow(const PixelGeometry& g, int x, int y, int radius, Visit visit) {
+  const std::size_t p = std::size_t(y) * g.width + x;
+  for (int wy = std::max(0, y - radius); wy <= std::min(g.height - 1, y + radius); ++wy)
+    for (int wx = std::max(0, x - radius); wx <= std::min(g.width - 1, x + radius); ++wx) {
+      const std::size_t q = std::size_t(wy) * g.width + wx;
+      if (sameSurface(g, p, q)) visit(q);
+    }
+}
+
+// Whether V_i is 0 over p's whole clipped window.
+bool inShadow(const ConfidenceImage& v, int x, int y, int radius) {
+  for (int wy = std::max(0, y - radius); wy <= std::min(v.height - 1, y + radius); ++wy)
+    for (int wx = std::max(0, x - radius); wx <= std::min(v.width - 1, x + radius); ++wx)
+      if (v.at(wx, wy) > 0.0f) return false;
+  return true;
+}
+
+// Whether at least two thirds of p's clipped 3x3 window (itself included) see its surface: inside
+// a surface or on its straight edge (6 of 9), not a sliver one pixel wide (a face seen edge-on),
+// whose mean point and normal mix two faces and whose gathered light is then another place's.
+bool onSurfacePatch(const PixelGeometry& g, int x, int y) {
+  int support = 0;
+  forSurfaceWindow(g, x, y, 1, [&](std::size_t) { ++support; });
+  const int window = (std::min(g.width - 1, x + 1) - std::max(0, x - 1) + 1) *
+                     (std::min(g.height - 1, y + 1) - std::max(0, y - 1) + 1);
+  return 3 * support >= 2 * window;
+}
+
+} // namespace
+
+std::vector<float> photoNoise(const std::vector<glm::vec3>& photo, const PixelGeometry& pixels) {
+  const std::size_t n = photo.size();
+  // e^2 with Var(e) = sigma^2 (1 + 1/m) for m neighbours: scaled by m / (m + 1). -1: no neighbour.
+  std::vector<float> residual(n, -1.0f);
+  for (int y = 0; y < pixels.height; ++y)
+    for (int x = 0; x < pixels.width; ++x) {
+      const std::size_t p = std::size_t(y) * pixels.width + x;
+      if (pixels.object[p] < 0) continue;
+      double sum = 0.0;
+      int m = 0;
+      forSurfaceWindow(pixels, x, y, 1, [&](std::size_t q) {
+        if (q == p) return;
+        sum += luminance(photo[q]);
+        ++m;
+      });
+      if (m == 0) continue;
+      const double e = luminance(photo[p]) - sum / m;
+      residual[p] = static_cast<float>(e * e * m / (m + 1));
+    }
+  std::vector<float> variance(n, 0.0f);
+  for (int y = 0; y < pixels.height; ++y)
+    for (int x = 0; x < pixels.width; ++x) {
+      const std::size_t p = std::size_t(y) * pixels.width + x;
+      if (pixels.object[p] < 0) continue;
+      double sum = 0.0;
+      int m = 0;
+      forSurfaceWindow(pixels, x, y, 2, [&](std::size_t q) {
+        if (residual[q] < 0.0f) return;
+        sum += residual[q];
+        ++m;
+      });
+      // An isolated pixel (a sliver of its surface): a 10 % noise, a cautious guess.
+      const float l = luminance(photo[p]);
+      variance[p] = m > 0 ? static_cast<float>(sum / m) : 0.01f * l * l;
+    }
+  return variance;
+}
+
+WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
+                            const std::vector<std::vector<glm::vec3>>& direct,
+                            const std::vector<std::vector<glm::vec3>>& indirect,
+                            const std::vector<std::vector<glm::vec3>>& estimates,
+                            const std::vector<ConfidenceImage>& confidences,
+                            const std::vector<ConfidenceImage>& visibility, const PixelGeometry& pixels,
+                            const WeightedMergeOptions& options) {
+  const std::size_t shots = photos.size();
+  if (direct.size() != shots || indirect.size() != shots || estimates.size() != shots || confidences.size() != shots ||
+      visibility.size() != shots)
+    throw std::logic_error("weightedMerge: one photo, lighting, estimate and confidence per shot");
+  const std::size_t n = pixels.object.size();
+  WeightedMerge out;
+  out.reflectance.assign(n, glm::vec3(0.0f));
+  out.relativeVariance.assign(n, 0.0f);
+  out.directConfidence.assign(n, 0.0f);
+  out.indirectShots.assign(n, 0.0f);
+  out.weights.assign(shots, std::vector<float>(n, 0.0f));
+  const float eB2 = options.indirectUncertainty * options.indirectUncertainty;
+  std::vector<double> weightSum(n, 0.0);
+  std::vector<glm::dvec3> sum(n, glm::dvec3(0.0));
+  for (std::size_t i = 0; i < shots; ++i) {
+    const std::vector<float> noise = photoNoise(photos[i], pixels);
+    for (int y = 0; y < pixels.height; ++y)
+      for (int x = 0; x < pixels.width; ++x) {
+        const std::size_t p = std::size_t(y) * pixels.width + x;
+        if (pixels.object[p] < 0) continue;
+        const float c = luminance(photos[i][p]), d = luminance(direct[i][p]), b = luminance(indirect[i][p]);
+        if (!(c > 0.0f) || !(d + b > 0.0f)) continue;
+        // No diffuse surface reflects more than it receives: an estimate above 1 (beyond its
+        // photograph's noise) says the lighting model is wrong at this pixel, not the surface.
+        const glm::vec3 r = estimates[i][p];
+        if (std::max({r.x, r.y, r.z}) > 1.0f + 3.0f * std::sqrt(noise[p]) / c) continue;
+        const float bShare = b / (d + b);
+        // The floor: half-float photographs and float lighting, 0.1 % at best.
+        const float v = noise[p] / (c * c) + eB2 * bShare * bShare + 1e-6f;
+        float k = confidences[i].k[p];
+        if (k > 0.0f) {
+          out.directConfidence[p] += k;
+        } else if (b > 0.0f && inShadow(visibility[i], x, y, options.shadowRadius) && onSurfacePatch(pixels, x, y)) {
+          k = 1.0f;
+          out.indirectShots[p] += 1.0f;
+        }
+        if (k <= 0.0f) continue;
+        const float w = k / v;
+        out.weights[i][p] = w;
+        weightSum[p] += w;
+        sum[p] += double(w) * glm::dvec3(estimates[i][p]);
+      }
+  }
+  for (std::size_t p = 0; p < n; ++p)
+    if (weightSum[p] > 0.0) {
+      out.reflectance[p] = glm::min(glm::vec3(sum[p] / weightSum[p]), glm::vec3(1.0f));
+      out.relativeVariance[p] = static_cast<float>(1.0 / weightSum[p]);
+    }
+  if (options.smoothingRadius > 0)
+    out.reflectance = smoothByNoise(out.reflectance, out.relativeVariance, pixels, options.smoothingRadius,
+                                    options.agreement);
+  return out;
+}
+
+std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,
+                                     const PixelGeometry& pixels, int radius, float agreement) {
+  std::vector<glm::vec3> out = reflectance;
+  const float a2 = agreement * agreement;
+  for (int y = 0; y < pixels.height; ++y)
+    for (int x = 0; x < pixels.width; ++x) {
+      const std::size_t p = std::size_t(y) * pixels.width + x;
+      if (pixels.object[p] < 0 || variance[p] <= 0.0f) continue;
+      const glm::vec3 rp = reflectance[p];
+      const glm::vec3 sp = variance[p] * rp * rp; // per channel sigma^2
+      glm::dvec3 sum(0.0);
+      double weight = 0.0;
+      forSurfaceWindow(pixels, x, y, radius, [&](std::size_t q) {
+        if (variance[q] <= 0.0f) return;
+        const glm::vec3 rq = reflectance[q];
+        const glm::vec3 d = rq - rp, s = sp + variance[q] * rq * rq;
+        for (int c = 0; c < 3; ++c)
+          if (d[c] * d[c] > a2 * s[c]) return;
+        // Relative variances weigh: absolute ones would favour the darker of two noisy pixels.
+        const double w = 1.0 / variance[q];
+        sum += w * glm::dvec3(rq);
+        weight += w;
+      });
+      out[p] = glm::vec3(sum / weight);
+    }
+  return out;
+}
+
+} // namespace obscura::recover

@@ -1,0 +1,76 @@
+// weighted_merge.h — the per-photo reflectance estimates merged by their expected error, with
+// the pixels no lamp lights recovered from their indirect light (OURS, extending IVR eq. 3's
+// confidence-weighted mean, which leaves pixels in every lamp's shadow to fills):
+//
+//   R = sum_i w_i R_i / sum_i w_i,    w_i = K_i / v_i,    R_i = C_i / (D_i + B_i)   (IVR eq. 2)
+//
+// v_i is R_i's relative variance by first-order error propagation:
+//
+//   v_i = (sigma_i / C_i)^2 + (e_B B_i / (D_i + B_i))^2
+//
+//   sigma_i  the photograph's noise at the pixel, estimated from the photograph itself
+//            (photoNoise: the spread of the pixel about its neighbours on the same surface);
+//   e_B      the relative uncertainty of the modelled indirect light B (options below). The
+//            direct light D is traced exactly (a point lamp, exact visibility), so a directly lit
+//            estimate is as good as its photograph; one lit only indirectly is as good as B.
+//
+// K_i is the paper's filtered confidence where lamp i lights the pixel (confidence_filters.h).
+// Where the pixel and its whole (2 r + 1)^2 window lie in lamp i's shadow (V_i = 0 there, the
+// same window the min filter distrusts at shadow edges), R_i = C_i / B_i is an indirect-only
+// estimate and gets K_i = 1: its v_i >= e_B^2 keeps its weight far below a lit one's, so it
+// decides only pixels that no lamp lights. An estimate above 1 (beyond 3 sigma of its photo's
+// noise) is left out: no diffuse surface reflects more than it receives, so the lighting model
+// is what is wrong there (a pixel that mixes surfaces, a hotspot the point lamp misses). A sliver of a surface (less than two thirds of its
+// 3x3 window on it: a face seen edge-on) gets none: its mean point and normal mix two faces.
+//
+// The merged R is then smoothed along surfaces by its noise (smoothByNoise): each pixel averages
+// the pixels of its window that see the same object with the same normal and whose R agrees with
+// its own within `agreement` standard deviations (a sigma filter, Lee 1983), weighted by their
+// inverse variances. A flat wall's noise averages out; a texture edge, larger than the noise,
+// stays sharp.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "recover/confidence_filters.h"
+#include "recover/photo_gather.h"
+
+namespace obscura::recover {
+
+struct WeightedMergeOptions {
+  float indirectUncertainty = 0.25f; // e_B: relative error of the modelled indirect light
+  int shadowRadius = 2;              // the window an indirect-only estimate must be in shadow over
+  int smoothingRadius = 3;           // smoothByNoise's window radius (0: no smoothing)
+  float agreement = 2.5f;            // smoothByNoise: standard deviations within which pixels pool
+};
+
+// sigma^2 per pixel of a photograph (luminance), from the squared differences between each pixel
+// and the mean of its same-surface 3x3 neighbours, averaged over its same-surface 5x5 window.
+// A texture's own variation counts as noise here: it lowers every photo's weight alike.
+std::vector<float> photoNoise(const std::vector<glm::vec3>& photo, const PixelGeometry& pixels);
+
+struct WeightedMerge {
+  std::vector<glm::vec3> reflectance;       // merged (smoothed when asked); 0 where nothing informs
+  std::vector<float> relativeVariance;      // of the merged R (1 / sum w_i); 0 where nothing informs
+  std::vector<float> directConfidence;      // sum of the paper's K_i over the lit estimates
+  std::vector<float> indirectShots;         // how many indirect-only estimates the pixel has
+  std::vector<std::vector<float>> weights;  // [shot][pixel] w_i (direct or indirect-only)
+};
+
+// `photos[i]` the photographs, `direct[i]` / `indirect[i]` D_i and B_i per unit reflectance,
+// `estimates[i]` R_i, `confidences[i]` the paper's filtered K_i, `visibility[i]` the raw V_i.
+WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
+                            const std::vector<std::vector<glm::vec3>>& direct,
+                            const std::vector<std::vector<glm::vec3>>& indirect,
+                            const std::vector<std::vector<glm::vec3>>& estimates,
+                            const std::vector<ConfidenceImage>& confidences,
+                            const std::vector<ConfidenceImage>& visibility, const PixelGeometry& pixels,
+                            const WeightedMergeOptions& options);
+
+// The sigma filter above on `reflectance` with relative variances `variance`.
+std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,
+                                     const PixelGeometry& pixels, int radius, float agreement);
+
+} // namespace obscura::recover
