@@ -38,7 +38,7 @@ glm::vec3 pixel3(const io::Image& image, std::size_t p, int first) {
 glm::vec3 renderable(const glm::vec3& r) { return glm::clamp(r, glm::vec3(0.02f), glm::vec3(0.95f)); }
 
 render::ObscuranceSettings recoverySettings(const PhotoSet& photos, const scene::Camera& camera,
-                                            const RecoveryOptions& options) {
+                                            const RecoveryOptions& options, bool forState) {
   render::ObscuranceSettings settings;
   settings.width = static_cast<std::uint32_t>(photos.width);
   settings.height = static_cast<std::uint32_t>(photos.height);
@@ -46,6 +46,9 @@ render::ObscuranceSettings recoverySettings(const PhotoSet& photos, const scene:
   settings.seed = options.seed;
   settings.camera = camera;
   settings.obscuranceRays = options.obscuranceRays;
+  // The gather brings its own B: the lighting render's obscurance term would go unused, so it
+  // takes the fewest rays the renderer allows (the relighting state's render keeps them all).
+  if (options.indirect == IndirectModel::Gather && !forState) settings.obscuranceRays = 1;
   settings.dMax = options.dMax;
   settings.shadowSampling = render::ShadowSampling::PerLight; // each lamp alone, one exact ray to a point
   settings.ambient = options.ambient;
@@ -59,11 +62,12 @@ struct RoomRender {
   std::unique_ptr<render::ObscuranceRenderer> renderer;
 
   RoomRender(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh, const scene::Camera& camera,
-             const PhotoSet& photos, const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options) {
+             const PhotoSet& photos, const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options,
+             bool forState = false) {
     std::vector<glm::vec3> materials;
     for (const auto& r : objectReflectance) materials.push_back(renderable(r));
     scene = recoveryScene(room, photos.shots, materials);
-    renderer = std::make_unique<render::ObscuranceRenderer>(context, scene, bvh, recoverySettings(photos, camera, options));
+    renderer = std::make_unique<render::ObscuranceRenderer>(context, scene, bvh, recoverySettings(photos, camera, options, forState));
     renderer->render();
     if (renderer->stats().truncatedTraversals > 0)
       throw DeviceError("traversals ran out of steps (kMaxTraversalSteps); the lighting would be wrong");
@@ -220,7 +224,8 @@ Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, co
 void saveRecoveredState(const std::string& dir, const gpu::Context& context, const scene::Scene& room,
                         const bvh::Bvh& bvh, const scene::Camera& camera, const PhotoSet& photos,
                         const Recovery& recovery, const RecoveryOptions& options) {
-  const RoomRender roomRender(context, room, bvh, camera, photos, recovery.iterations.back().objectReflectance, options);
+  const RoomRender roomRender(context, room, bvh, camera, photos, recovery.iterations.back().objectReflectance, options,
+                              /*forState=*/true);
   const render::ObscuranceRenderer& renderer = *roomRender.renderer;
   render::Transport transport = renderer.transport();
   const io::Image aov = renderer.image();

@@ -54,14 +54,15 @@ inline constexpr NameTable<render::AmbientModel, 2> kRecoveryAmbientNames{
      {nameOf(render::kAmbientModelNames, render::AmbientModel::Global), render::AmbientModel::Global}}};
 
 struct RecoveryOptions {
-  std::uint32_t spp = 16;            // primary samples per pixel (and shadow/obscurance rays with them)
+  std::uint32_t spp = 8;             // primary samples per pixel (and shadow/obscurance rays with them)
   std::uint32_t obscuranceRays = 8;  // per sample
   std::uint32_t seed = 1;
   float dMax = 0.0f;                 // 0 = the renderer's default
   IndirectModel indirect = IndirectModel::Gather;
   std::uint32_t iterations = 6;      // estimates after the Constant start (paths through hidden
                                      // surfaces carry the object means further: slower to settle)
-  std::uint32_t gatherRays = 32;     // Gather: rays per pixel (each hidden hit goes on as a path)
+  std::uint32_t gatherRays = 16;     // Gather: rays per pixel (each hidden hit goes on as a path;
+                                     // the smoothing pools a 7x7 window's)
   int gatherSmoothing = 3;           // Gather: window radius of the surface-aware smoothing of B
   std::uint32_t hiddenBounces = kDefaultHiddenBounces; // Gather: path vertices through surfaces the camera does not see
   float constantReflectance = 0.5f;  // Constant: k
