@@ -2,7 +2,8 @@
 # recover_rooms.sh — reflectance recovery on every photo set against its answer key: the Cornell
 # box (../shared/photos/cornell-box) and the rooms made by tools/cycles_photo_set.py
 # (tests/data/photos/*), at the defaults and, with --first-design, also as the first design did
-# it (the paper's merge, hidden surfaces at the mean indirect light, 64 gather rays, 3 iterations).
+# it (the paper's merge, hidden surfaces at the mean indirect light, 64 gather rays, 3 iterations,
+# spp 16).
 # Prints recover's RMSE line and tools/recovery_report.py's table (issue 36's goals) per set.
 #
 #   tools/recover_rooms.sh [BUILD_DIR] [--first-design]
@@ -34,6 +35,6 @@ for s in "${sets[@]}"; do
   truth=$(dirname "$photos")/$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['albedo']['image'])" "$photos")
   run "$name" "$scene" "$photos" "$truth"
   if [ "$first" = "--first-design" ]; then
-    run "$name-first" "$scene" "$photos" "$truth" --merge paper --hidden-bounces 0 --gather-rays 64 --iterations 3
+    run "$name-first" "$scene" "$photos" "$truth" --merge paper --hidden-bounces 0 --gather-rays 64 --iterations 3 --spp 16
   fi
 done
