@@ -112,13 +112,15 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
         if (pixels.object[p] < 0) continue;
         const float c = luminance(photos[i][p]), d = luminance(direct[i][p]), b = luminance(indirect[i][p]);
         if (!(c > 0.0f) || !(d + b > 0.0f)) continue;
-        // No diffuse surface reflects more than it receives: an estimate above 1 (beyond its
-        // photograph's noise) says the lighting model is wrong at this pixel, not the surface.
-        const glm::vec3 r = estimates[i][p];
-        if (std::max({r.x, r.y, r.z}) > 1.0f + 3.0f * std::sqrt(noise[p]) / c) continue;
         const float bShare = b / (d + b);
         // The floor: half-float photographs and float lighting, 0.1 % at best.
         const float v = noise[p] / (c * c) + eB2 * bShare * bShare + 1e-6f;
+        // No diffuse surface reflects more than it receives: an estimate above 1 by more than
+        // three of its own standard deviations says the lighting model is wrong at this pixel,
+        // not the surface. (Within them it stays: cutting a noisy estimate's upper tail alone
+        // would bias what is kept low; the merged R is clamped to 1 instead.)
+        const glm::vec3 r = estimates[i][p];
+        if (std::max({r.x, r.y, r.z}) > 1.0f + 3.0f * std::sqrt(v)) continue;
         float k = confidences[i].k[p];
         if (k > 0.0f) {
           out.directConfidence[p] += k;

@@ -1,0 +1,67 @@
+// recover_classroom_test.cpp — reflectance recovery on a larger room than the Cornell box: six
+// Blender Cycles photographs of shared/scenes/classroom (tests/data/photos/classroom, made by
+// tools/cycles_photo_set.py), where 78 % of the gather's rays meet surfaces the camera does not
+// see, chairs and desks are a few pixels wide and a quarter of the pixels no lamp lights.
+//
+// Measured at the defaults (spp 8, 16 gather rays, 3 hidden bounces, the weighted merge; seeds
+// 1, 2, 3; docs/BENCHMARKS.md "Recovery beyond the Cornell box"):
+//   lit 0.0392 / 0.0399 / 0.0389   lit in some photo 0.0947 / 0.0941 / 0.0944   all 0.1010 / 0.0994 / 0.1001
+//   the walls' mean ratio to the truth 0.98; the first design: all 0.2196 (outliers up to R = 45).
+// The bounds below are the measured figures plus 10 %, ten times the seed-to-seed spread; they
+// are not issue 36's goals (all 0.04, lit in some photo 0.02), which this room does not meet yet.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "app/scene_setup.h"
+#include "gpu_test.h"
+#include "recover/photo_set.h"
+#include "recover/recovery_accuracy.h"
+#include "recover/reflectance_recovery.h"
+
+namespace obscura::test {
+namespace {
+using namespace obscura::recover;
+
+class RecoverClassroom : public GpuTest {};
+
+TEST_F(RecoverClassroom, ALargerRoomIsRecoveredToItsMeasuredAccuracyWithEveryReflectanceInRange) {
+  const app::LoadedScene room = app::loadScene(sharedScene("classroom/classroom.gltf"));
+  const PhotoSet photos = readPhotoSet(repoPath("tests/data/photos/classroom/lights.json"));
+  int w = 0, h = 0;
+  const std::vector<glm::vec3> truth = readRadiance(repoPath("tests/data/photos/classroom/albedo.exr"), 1.0f, w, h);
+  ASSERT_EQ(w, photos.width);
+  ASSERT_EQ(h, photos.height);
+  const Recovery r =
+      recoverReflectance(context(), room.scene, room.bvh, room.scene.cameras.at(0), photos, RecoveryOptions{});
+  const RecoveryAccuracy a = recoveryAccuracy(r.reflectance, truth, lightRegions(r.visibility, r.object));
+  EXPECT_LE(a.lit.rmse, 0.044);
+  EXPECT_LE(a.direct.rmse, 0.104);
+  EXPECT_LE(a.all.rmse, 0.111);
+  // A quarter of the pixels no lamp lights; the merge recovers some of them from their indirect
+  // light (measured 3,318), and the fills are counted.
+  EXPECT_GT(r.indirectOnlyPixels, 2000u);
+  EXPECT_EQ(r.litPixels + r.indirectOnlyPixels + r.filledFromVisibility + r.filledFromObject, a.all.pixels);
+  // Every reflectance is a reflectance: finite, in [0, 1] (the first design had 24 pixels at 3 to 45).
+  for (const glm::vec3& v : r.reflectance) {
+    ASSERT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z));
+    ASSERT_GE(std::min({v.x, v.y, v.z}), 0.0f);
+    ASSERT_LE(std::max({v.x, v.y, v.z}), 1.0f);
+  }
+  // The largest object (walls and ceiling, 43 % of the surface pixels): its mean within 3 % of
+  // the truth's (measured 0.98).
+  std::vector<std::size_t> count(room.scene.objects.size(), 0);
+  for (std::int32_t o : r.object)
+    if (o >= 0) ++count[static_cast<std::size_t>(o)];
+  const auto walls = static_cast<std::int32_t>(std::max_element(count.begin(), count.end()) - count.begin());
+  double recovered = 0.0, expected = 0.0;
+  for (std::size_t p = 0; p < r.object.size(); ++p)
+    if (r.object[p] == walls) {
+      recovered += r.reflectance[p].x + r.reflectance[p].y + r.reflectance[p].z;
+      expected += truth[p].x + truth[p].y + truth[p].z;
+    }
+  EXPECT_NEAR(recovered / expected, 1.0, 0.03);
+}
+
+} // namespace
+} // namespace obscura::test
