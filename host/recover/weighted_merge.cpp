@@ -24,6 +24,16 @@ void forSurfaceWindow(const PixelGeometry& g, int x, int y, int radius, Visit vi
     }
 }
 
+// Calls visit(x, y, p) for every pixel p = (x, y) that sees a surface.
+template <class Visit>
+void forSurfacePixels(const PixelGeometry& g, Visit visit) {
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      const std::size_t p = std::size_t(y) * g.width + x;
+      if (g.object[p] >= 0) visit(x, y, p);
+    }
+}
+
 // Whether V_i is 0 over p's whole clipped window.
 bool inShadow(const ConfidenceImage& v, int x, int y, int radius) {
   for (int wy = std::max(0, y - radius); wy <= std::min(v.height - 1, y + radius); ++wy)
@@ -49,37 +59,31 @@ std::vector<float> photoNoise(const std::vector<glm::vec3>& photo, const PixelGe
   const std::size_t n = photo.size();
   // e^2 with Var(e) = sigma^2 (1 + 1/m) for m neighbours: scaled by m / (m + 1). -1: no neighbour.
   std::vector<float> residual(n, -1.0f);
-  for (int y = 0; y < pixels.height; ++y)
-    for (int x = 0; x < pixels.width; ++x) {
-      const std::size_t p = std::size_t(y) * pixels.width + x;
-      if (pixels.object[p] < 0) continue;
-      double sum = 0.0;
-      int m = 0;
-      forSurfaceWindow(pixels, x, y, 1, [&](std::size_t q) {
-        if (q == p) return;
-        sum += luminance(photo[q]);
-        ++m;
-      });
-      if (m == 0) continue;
-      const double e = luminance(photo[p]) - sum / m;
-      residual[p] = static_cast<float>(e * e * m / (m + 1));
-    }
+  forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
+    double sum = 0.0;
+    int m = 0;
+    forSurfaceWindow(pixels, x, y, 1, [&](std::size_t q) {
+      if (q == p) return;
+      sum += luminance(photo[q]);
+      ++m;
+    });
+    if (m == 0) return;
+    const double e = luminance(photo[p]) - sum / m;
+    residual[p] = static_cast<float>(e * e * m / (m + 1));
+  });
   std::vector<float> variance(n, 0.0f);
-  for (int y = 0; y < pixels.height; ++y)
-    for (int x = 0; x < pixels.width; ++x) {
-      const std::size_t p = std::size_t(y) * pixels.width + x;
-      if (pixels.object[p] < 0) continue;
-      double sum = 0.0;
-      int m = 0;
-      forSurfaceWindow(pixels, x, y, 2, [&](std::size_t q) {
-        if (residual[q] < 0.0f) return;
-        sum += residual[q];
-        ++m;
-      });
-      // An isolated pixel (a sliver of its surface): a 10 % noise, a cautious guess.
-      const float l = luminance(photo[p]);
-      variance[p] = m > 0 ? static_cast<float>(sum / m) : 0.01f * l * l;
-    }
+  forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
+    double sum = 0.0;
+    int m = 0;
+    forSurfaceWindow(pixels, x, y, 2, [&](std::size_t q) {
+      if (residual[q] < 0.0f) return;
+      sum += residual[q];
+      ++m;
+    });
+    // An isolated pixel (a sliver of its surface): a 10 % noise, a cautious guess.
+    const float l = luminance(photo[p]);
+    variance[p] = m > 0 ? static_cast<float>(sum / m) : 0.01f * l * l;
+  });
   return variance;
 }
 
@@ -106,34 +110,31 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
   std::vector<glm::dvec3> sum(n, glm::dvec3(0.0));
   for (std::size_t i = 0; i < shots; ++i) {
     const std::vector<float> noise = photoNoise(photos[i], pixels);
-    for (int y = 0; y < pixels.height; ++y)
-      for (int x = 0; x < pixels.width; ++x) {
-        const std::size_t p = std::size_t(y) * pixels.width + x;
-        if (pixels.object[p] < 0) continue;
-        const float c = luminance(photos[i][p]), d = luminance(direct[i][p]), b = luminance(indirect[i][p]);
-        if (!(c > 0.0f) || !(d + b > 0.0f)) continue;
-        const float bShare = b / (d + b);
-        // The floor: half-float photographs and float lighting, 0.1 % at best.
-        const float v = noise[p] / (c * c) + eB2 * bShare * bShare + 1e-6f;
-        // No diffuse surface reflects more than it receives: an estimate above 1 by more than
-        // three of its own standard deviations says the lighting model is wrong at this pixel,
-        // not the surface. (Within them it stays: cutting a noisy estimate's upper tail alone
-        // would bias what is kept low; the merged R is clamped to 1 instead.)
-        const glm::vec3 r = estimates[i][p];
-        if (std::max({r.x, r.y, r.z}) > 1.0f + 3.0f * std::sqrt(v)) continue;
-        float k = confidences[i].k[p];
-        if (k > 0.0f) {
-          out.directConfidence[p] += k;
-        } else if (b > 0.0f && inShadow(visibility[i], x, y, options.shadowRadius) && onSurfacePatch(pixels, x, y)) {
-          k = 1.0f;
-          out.indirectShots[p] += 1.0f;
-        }
-        if (k <= 0.0f) continue;
-        const float w = k / v;
-        out.weights[i][p] = w;
-        weightSum[p] += w;
-        sum[p] += double(w) * glm::dvec3(estimates[i][p]);
+    forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
+      const float c = luminance(photos[i][p]), d = luminance(direct[i][p]), b = luminance(indirect[i][p]);
+      if (!(c > 0.0f) || !(d + b > 0.0f)) return;
+      const float bShare = b / (d + b);
+      // The floor: half-float photographs and float lighting, 0.1 % at best.
+      const float v = noise[p] / (c * c) + eB2 * bShare * bShare + 1e-6f;
+      // No diffuse surface reflects more than it receives: an estimate above 1 by more than
+      // three of its own standard deviations says the lighting model is wrong at this pixel,
+      // not the surface. (Within them it stays: cutting a noisy estimate's upper tail alone
+      // would bias what is kept low; the merged R is clamped to 1 instead.)
+      const glm::vec3 r = estimates[i][p];
+      if (std::max({r.x, r.y, r.z}) > 1.0f + 3.0f * std::sqrt(v)) return;
+      float k = confidences[i].k[p];
+      if (k > 0.0f) {
+        out.directConfidence[p] += k;
+      } else if (b > 0.0f && inShadow(visibility[i], x, y, options.shadowRadius) && onSurfacePatch(pixels, x, y)) {
+        k = 1.0f;
+        out.indirectShots[p] += 1.0f;
       }
+      if (k <= 0.0f) return;
+      const float w = k / v;
+      out.weights[i][p] = w;
+      weightSum[p] += w;
+      sum[p] += double(w) * glm::dvec3(estimates[i][p]);
+    });
   }
   for (std::size_t p = 0; p < n; ++p)
     if (weightSum[p] > 0.0) {
@@ -150,27 +151,25 @@ std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, 
                                      const PixelGeometry& pixels, int radius, float agreement) {
   std::vector<glm::vec3> out = reflectance;
   const float a2 = agreement * agreement;
-  for (int y = 0; y < pixels.height; ++y)
-    for (int x = 0; x < pixels.width; ++x) {
-      const std::size_t p = std::size_t(y) * pixels.width + x;
-      if (pixels.object[p] < 0 || variance[p] <= 0.0f) continue;
-      const glm::vec3 rp = reflectance[p];
-      const glm::vec3 sp = variance[p] * rp * rp; // per channel sigma^2
-      glm::dvec3 sum(0.0);
-      double weight = 0.0;
-      forSurfaceWindow(pixels, x, y, radius, [&](std::size_t q) {
-        if (variance[q] <= 0.0f) return;
-        const glm::vec3 rq = reflectance[q];
-        const glm::vec3 d = rq - rp, s = sp + variance[q] * rq * rq;
-        for (int c = 0; c < 3; ++c)
-          if (d[c] * d[c] > a2 * s[c]) return;
-        // Relative variances weigh: absolute ones would favour the darker of two noisy pixels.
-        const double w = 1.0 / variance[q];
-        sum += w * glm::dvec3(rq);
-        weight += w;
-      });
-      out[p] = glm::vec3(sum / weight);
-    }
+  forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
+    if (variance[p] <= 0.0f) return;
+    const glm::vec3 rp = reflectance[p];
+    const glm::vec3 sp = variance[p] * rp * rp; // per channel sigma^2
+    glm::dvec3 sum(0.0);
+    double weight = 0.0;
+    forSurfaceWindow(pixels, x, y, radius, [&](std::size_t q) {
+      if (variance[q] <= 0.0f) return;
+      const glm::vec3 rq = reflectance[q];
+      const glm::vec3 d = rq - rp, s = sp + variance[q] * rq * rq;
+      for (int c = 0; c < 3; ++c)
+        if (d[c] * d[c] > a2 * s[c]) return;
+      // Relative variances weigh: absolute ones would favour the darker of two noisy pixels.
+      const double w = 1.0 / variance[q];
+      sum += w * glm::dvec3(rq);
+      weight += w;
+    });
+    out[p] = glm::vec3(sum / weight);
+  });
   return out;
 }
 
