@@ -56,7 +56,7 @@ inline constexpr std::uint32_t kDefaultHiddenBounces = 3;
 
 class PhotoGather {
 public:
-  // The pixels' gather rays and their hidden hits' shadow rays through `rays` (about
+  // The pixels' gather rays, their hidden hits' paths and shadow rays through `rays` (about
   // kRaysPerBatch gather rays at a time).
   PhotoGather(const scene::Scene& room, render::RayBatch& rays, const scene::Camera& camera, const PixelGeometry& pixels,
               const std::vector<Shot>& shots, std::uint32_t raysPerPixel, std::uint32_t seed, int smoothRadius,
