@@ -270,6 +270,15 @@ public:
   const FrameLayout& layout() const { return frame_.layout(); }
   // The frame's buffers, for passes outside the renderer that read them (the denoiser).
   const ObscuranceFrame& frame() const { return frame_; }
+  // What a pass outside the renderer that traces its scene binds (the denoiser's edge rays): the
+  // scene's buffers and what its kernels are specialised for (both change with geometry edits),
+  // the lights' render-time emission scales (which make M_s unit) and the E_s compose uses.
+  const SceneBuffers& sceneBuffers() const { return sceneBuffers_; }
+  const SceneSpecialisation& sceneKernels() const { return sceneKernels_; }
+  const gpu::Buffer& lightScales() const { return lightBuffers_.scales; }
+  const gpu::Buffer& composeEmissions() const { return emissionBuffer_; }
+  // The camera the primary pass sees the scene with: gpuCamera with the background light's slot.
+  gpu::GpuCamera primaryCamera() const;
   bool specular() const { return runSpecular_; }
   // Per-pass GPU ms and rays since the last reset, wall time, memory, truncations, notes.
   RenderStats stats() const;
@@ -335,7 +344,6 @@ private:
   // Whether the frame keeps sample `sample`'s rays: for a pass that writes them, or (`replaying`)
   // for one that follows them, only while they are the current scene's.
   bool keptRays(std::uint32_t sample, bool replaying) const;
-  gpu::GpuCamera primaryCamera() const; // with the background's slot
   std::vector<glm::vec4> downloadBand(const gpu::Buffer& buffer) const;
 
   const gpu::Context* context_;

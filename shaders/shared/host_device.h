@@ -810,12 +810,29 @@ OBS_CONST uint kBindingAtrousGuide = 1; // texels: guide
 OBS_CONST uint kBindingAtrousIn = 2;    // texels: illum
 OBS_CONST uint kBindingAtrousOut = 3;   // uvec4[2 x pixel] out: illum
 OBS_CONST uint kAtrousBindingCount = 4;
-// denoise_remodulate.comp: x albedo + specular + emission -> linear combined (tonemap.comp's input)
+// denoise_remodulate.comp: x albedo + specular + emission -> linear remodulated (denoise_edges.comp's input)
 OBS_CONST uint kBindingRemodulateGuide = 1;    // texels: guide
 OBS_CONST uint kBindingRemodulateIllum = 2;    // texels: illum
 OBS_CONST uint kBindingRemodulateEmission = 3; // vec4[pixel]
-OBS_CONST uint kBindingRemodulateOut = 4;      // vec4[pixel] out: combined
+OBS_CONST uint kBindingRemodulateOut = 4;      // vec4[pixel] out: remodulated, w = samples
 OBS_CONST uint kRemodulateBindingCount = 5;
+// denoise_edges.comp: the pixels an edge crosses, resolved from camera rays of their own (set 0:
+// the scene's bindings first, as every tracing pass)
+OBS_CONST uint kBindingEdgesParams = kBindingPassFirst;          // DenoiseParams
+OBS_CONST uint kBindingEdgesGuide = kBindingPassFirst + 1;       // uvec4[pixel]: guide
+OBS_CONST uint kBindingEdgesRemodulated = kBindingPassFirst + 2; // vec4[pixel]: remodulate's, w = samples
+OBS_CONST uint kBindingEdgesEmission = kBindingPassFirst + 3;    // vec4[pixel]: the seen emission
+OBS_CONST uint kBindingEdgesLightScales = kBindingPassFirst + 4; // vec4[light]: render-time emission scales
+OBS_CONST uint kBindingEdgesEmissions = kBindingPassFirst + 5;   // vec4[light]: the E_s compose used
+OBS_CONST uint kBindingEdgesOut = kBindingPassFirst + 6;         // vec4[pixel] out: combined
+OBS_CONST uint kEdgesBindingCount = kBindingPassFirst + 7;
+
+struct DenoiseEdgesPush {
+  uint geometryRays; // camera rays per pixel a geometric edge crosses (0: the pass copies)
+  uint emitterRays;  // per pixel whose seen emission differs from a neighbour's
+  uint lightCount;   // the lights' slots (the sky's is camera.up.w when it is one of them)
+  uint unused;
+};                   // 16 bytes
 
 // ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,
 // then its Kahan compensation), so accumulation buffers hold kAccumulatorVec4s vec4 per entry.

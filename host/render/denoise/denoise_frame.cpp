@@ -35,6 +35,7 @@ DenoiseFrame::DenoiseFrame(const gpu::Context& context, std::uint32_t w, std::ui
   noisy = texels(kIllum, "denoise.noisy");
   carry = gpu::Buffer(context, px * kIllum, kStorage, "denoise.carry");
   emission = gpu::Buffer(context, px * 16, kStorage, "denoise.emission");
+  remodulated = gpu::Buffer(context, px * 16, kStorage, "denoise.remodulated");
   combined = gpu::Buffer(context, px * 16, kStorage, "denoise.combined");
   display = gpu::Buffer(context, px * 4, kStorage, "denoise.display");
 }

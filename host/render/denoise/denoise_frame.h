@@ -29,7 +29,8 @@ struct DenoiseFrame {
   gpu::TexelBuffer integrated[2];    // [parity]: the temporal pass's output, this frame's and the history's
   gpu::TexelBuffer filtered[2];      // a-trous ping-pong
   gpu::Buffer emission;              // vec4: seen emission, added back unfiltered
-  gpu::Buffer combined;              // vec4: the denoised linear image
+  gpu::Buffer remodulated;           // vec4: the filtered terms remodulated, + emission; w = samples
+  gpu::Buffer combined;              // vec4: the denoised linear image (edges resolved)
   gpu::Buffer display;               // uint: RGBA8
 
   std::uint64_t pixels() const { return std::uint64_t(width) * height; }

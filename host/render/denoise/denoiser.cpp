@@ -10,6 +10,7 @@
 #include "gpu/timestamps.h"
 #include "render/denoise/atrous_pass.h"
 #include "render/denoise/denoise_frame.h"
+#include "render/denoise/edge_pass.h"
 #include "render/denoise/gather_pass.h"
 #include "render/denoise/remodulate_pass.h"
 #include "render/denoise/reproject_pass.h"
@@ -37,7 +38,8 @@ bool sameCamera(const scene::Camera& a, const scene::Camera& b) {
 struct Denoiser::Impl {
   Impl(const gpu::Context& c, const ObscuranceRenderer& renderer)
       : context(&c), source(&renderer.frame()), frame(c, renderer.layout().width, renderer.layout().height),
-        gather(c, renderer.layout().bandCount()), reproject(c), temporal(c), atrous(c), remodulate(c), tonemap(c, 1),
+        gather(c, renderer.layout().bandCount()), reproject(c), temporal(c), atrous(c), remodulate(c),
+        edges(c, renderer.sceneKernels()), tonemap(c, 1),
         stream(c), timestamps(c) {
     for (std::uint32_t copy = 0; copy < 2; ++copy) {
       for (std::uint32_t b = 0; b < renderer.layout().bandCount(); ++b) gather.bind(b, copy, *source, frame);
@@ -57,6 +59,7 @@ struct Denoiser::Impl {
   TemporalPass temporal;
   AtrousPass atrous;
   RemodulatePass remodulate;
+  EdgePass edges;
   TonemapPass tonemap;
   gpu::CommandStream stream;
   gpu::Timestamps timestamps;
@@ -75,6 +78,9 @@ Denoiser::Denoiser(const gpu::Context& context, const ObscuranceRenderer& render
     throw std::invalid_argument("Denoiser: the renderer must keep its primary and composed AOVs (the normal, depth "
                                 "and albedo guides, the direct and ambient terms)");
   if (settings.iterations > 16) throw std::invalid_argument("Denoiser: at most 16 a-trous iterations");
+  if (settings.geometryEdgeRays > gpu::kMaxEmissionSamples || settings.emitterEdgeRays > gpu::kMaxEmissionSamples)
+    throw std::invalid_argument(fmt::format("Denoiser: at most {} edge rays a pixel (they share the loop limiter's budget)",
+                                            gpu::kMaxEmissionSamples));
   impl_ = std::make_unique<Impl>(context, renderer);
 }
 
@@ -96,7 +102,7 @@ void Denoiser::denoise(const ObscuranceRenderer& renderer, float exposureStops) 
   const bool clearCarry = !settings_.temporal || d.carryStale;
 
   const gpu::DenoiseParams params{
-      .camera = gpuCamera(camera, layout.width, layout.height),
+      .camera = renderer.primaryCamera(), // the sky's slot in up.w for the edge rays
       .previous = gpuCamera(d.haveHistory ? d.previousCamera : camera, layout.width, layout.height),
       .frame = glm::uvec4(layout.width, layout.height, settings_.maxHistorySamples, renderer.specular() ? 1u : 0u),
       .weights = glm::vec4(kSigmaPlane, kSigmaAlbedo, settings_.luminanceSigma, 0.0f)};
@@ -104,6 +110,7 @@ void Denoiser::denoise(const ObscuranceRenderer& renderer, float exposureStops) 
 
   const std::map<std::string, double> before = d.timestamps.totalsMs();
   const std::uint32_t parity = d.parity;
+  d.edges.bind(renderer, d.frame, parity);
   d.stream.submit([&](const vk::raii::CommandBuffer& cmd) {
     d.timestamps.reset(cmd);
     d.timestamps.begin(cmd, "denoise.gather");
@@ -130,6 +137,11 @@ void Denoiser::denoise(const ObscuranceRenderer& renderer, float exposureStops) 
     d.timestamps.begin(cmd, "denoise.remodulate");
     d.remodulate.record(cmd, parity, filterSourceAfter(settings_.iterations), d.frame);
     d.timestamps.end(cmd, "denoise.remodulate");
+    gpu::computeBarrier(cmd);
+    d.timestamps.begin(cmd, "denoise.edges");
+    d.edges.record(cmd, d.frame, settings_.geometryEdgeRays, settings_.emitterEdgeRays,
+                   static_cast<std::uint32_t>(renderer.lights().size()));
+    d.timestamps.end(cmd, "denoise.edges");
     gpu::computeBarrier(cmd);
     const FrameLayout whole{.width = layout.width, .height = layout.height, .bands = {{0, layout.height}}};
     d.timestamps.begin(cmd, "denoise.tonemap");

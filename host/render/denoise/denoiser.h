@@ -14,7 +14,11 @@
 //             each term's luminance variance
 //   a-trous   edge-aware wavelet iterations (steps 1, 2, 4, ...) guided by normal, depth (plane
 //             distance) and albedo, the luminance weight steered by the variance
-//   remodulate x albedo, + specular, + the seen emission (never filtered); then the tonemap pass
+//   remodulate x albedo, + specular, + the seen emission (never filtered)
+//   edges     the pixels an edge crosses (another surface or another emission in the 3x3 around
+//             them), resolved from camera rays of their own: each ray takes the filtered light of
+//             the neighbour on its surface and its own emission, so a 1-spp frame's silhouettes
+//             and emitter borders are covered by K points instead of one; then the tonemap pass
 //             (display bytes as ObscuranceRenderer::display(): RGBA8, R in the low byte).
 #pragma once
 #include <cstdint>
@@ -25,6 +29,7 @@
 
 #include "gpu/context.h"
 #include "io/image_io.h"
+#include "shared/host_device.h"
 
 namespace obscura::render {
 
@@ -38,6 +43,11 @@ struct DenoiserSettings {
                                         // step may be and still be filtered over (Schied et al. use 4
                                         // with temporal variances; 2 measured lower error with these
                                         // spatial ones at 4 spp: tests/render/denoise_test.cpp)
+  // Camera rays per pixel an edge crosses (denoise_edges.comp): where a geometric edge does, and
+  // where an emitter's border does (its radiance a hundred times its surroundings', the few
+  // pixels where coverage matters most). 0 geometry rays: no edge pass.
+  std::uint32_t geometryEdgeRays = gpu::kEdgeEmissionSamples;
+  std::uint32_t emitterEdgeRays = gpu::kMaxEmissionSamples;
 };
 
 class Denoiser {
@@ -65,7 +75,7 @@ public:
   // The denoised combined image, linear: channels combined.R/G/B.
   io::Image image() const;
   // GPU milliseconds of the last denoise(), in all and per pass (gather, reproject, temporal,
-  // atrous, remodulate, tonemap).
+  // atrous, remodulate, edges, tonemap).
   double lastGpuMs() const;
   std::map<std::string, double> lastPassMs() const;
 

@@ -17,7 +17,7 @@ void RemodulatePass::bind(std::uint32_t parity, const DenoiseFrame& frame) {
     kernel_.bind(gpu::kBindingRemodulateGuide, frame.guide[parity], set);
     kernel_.bind(gpu::kBindingRemodulateIllum, *sources[s], set);
     kernel_.bind(gpu::kBindingRemodulateEmission, frame.emission, set);
-    kernel_.bind(gpu::kBindingRemodulateOut, frame.combined, set);
+    kernel_.bind(gpu::kBindingRemodulateOut, frame.remodulated, set);
   }
 }
 

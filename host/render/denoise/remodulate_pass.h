@@ -1,5 +1,5 @@
-// remodulate_pass.h — the filtered terms times the albedo, plus emission and specular: the
-// denoised linear image (denoise_remodulate.comp).
+// remodulate_pass.h — the filtered terms times the albedo, plus emission and specular
+// (denoise_remodulate.comp): the denoised linear image before its edges are resolved (EdgePass).
 #pragma once
 #include "gpu/kernel.h"
 #include "render/denoise/atrous_pass.h"

@@ -86,6 +86,7 @@ struct SceneSpecialisation {
   }
   // Appends its specialisation constants to `desc` (none where the general kernel's).
   void addTo(gpu::KernelDesc& desc) const;
+  bool operator==(const SceneSpecialisation&) const = default;
 };
 
 class SceneBuffers {

@@ -1,0 +1,35 @@
+// edge_pass.h — the pixels an edge crosses, resolved from camera rays of their own
+// (denoise_edges.comp): the denoised linear image. The only denoiser pass that traces the scene:
+// it is specialised for the renderer's scene as its tracing passes are, and made again when an
+// edit changes what that needs.
+#pragma once
+#include <cstdint>
+
+#include "gpu/kernel.h"
+#include "render/denoise/denoise_frame.h"
+#include "render/scene_data/scene_buffers.h"
+
+namespace obscura::render {
+
+class ObscuranceRenderer;
+
+class EdgePass {
+public:
+  EdgePass(const gpu::Context& context, const SceneSpecialisation& scene);
+
+  // Binds the renderer's scene, status counters and light tables and the frame's buffers, with
+  // guide[parity]. Called before every dispatch: an edit may have made the renderer's buffers anew (it is a handful of
+  // descriptor writes); the kernel is made again where the scene's specialisation changed.
+  void bind(const ObscuranceRenderer& renderer, const DenoiseFrame& frame, std::uint32_t parity);
+  // `geometryRays` camera rays in the pixels a geometric edge crosses, `emitterRays` where an
+  // emitter's border does; 0 geometry rays copies the remodulated image.
+  void record(const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame, std::uint32_t geometryRays,
+              std::uint32_t emitterRays, std::uint32_t lights) const;
+
+private:
+  const gpu::Context* context_;
+  SceneSpecialisation scene_;
+  gpu::Kernel kernel_;
+};
+
+} // namespace obscura::render
