@@ -10,14 +10,15 @@
 // own (cheap: a closest hit, no shading). Each ray's surface is looked up among the 3x3 pixels
 // around it (same material, normal and plane as their guide: the filter's own test) and takes
 // that pixel's filtered light; what the ray sees emit is taken from the ray itself (its emitter's
-// unit emission times the E_s compose used), the sky's too. The mean over the rays and the pixel's
-// own sample, (C + sum R_k) / (1 + K), estimates the pixel's box filter with K + 1 points of
-// coverage instead of one.
+// unit emission times the E_s compose used), the sky's too. The mean over the rays is blended
+// with the pixel's own estimate by their counts, (n C + sum R_k) / (n + K): the pixel's box filter
+// with K more points of coverage, the pass fading as samples accumulate.
 //
-// Only frames of one sample (and no history) are resolved: with more, the pixel's own points
-// measure its coverage, and the light taken from a neighbour a pixel away is the larger error
-// (measured: docs/BENCHMARKS.md). A frame that accumulates (the window's, standing still) goes
-// from the resolved image to its own samples' after its first.
+// Geometric edges are resolved only in frames of one sample (and no history): with more, the
+// pixel's own points measure its coverage, and the light taken from a neighbour a pixel away is
+// the larger error (measured: docs/BENCHMARKS.md). An emitter's border is resolved at any count:
+// there the rays' own emission, exact per ray, is nearly all of the pixel (a lamp ~100x its
+// surroundings), and what they take from the neighbours is a rounding error beside it.
 //
 // Which pixels: those whose guide differs from a neighbour's (another surface, found the way the
 // filter stops at it) or whose seen emission does (an emitter's border, where the radiance jumps
@@ -57,10 +58,8 @@ void main() {
   if (p.x >= size.x || p.y >= size.y) return;
   const uint pixel = p.y * size.x + p.x;
   const vec4 own = remodulated[pixel];
-  // One sample (and no history): the pixel shows one surface whole. With more, its own points
-  // measure the coverage, and the neighbours' light, a pixel away, is the larger error (measured:
-  // the pass raised the Cornell box's edge pixels' RMSE at 2 and 4 spp; docs/BENCHMARKS.md).
-  if (pc.geometryRays == 0u || own.w > 1.0) {
+  const float n = max(own.w, 1.0); // the samples (and history) the pixel's own estimate counts for
+  if (pc.geometryRays == 0u) {
     combined[pixel] = vec4(own.rgb, 1.0);
     return;
   }
@@ -82,7 +81,8 @@ void main() {
       geometryEdge = geometryEdge || !same;
       emitterEdge = emitterEdge || emissionDiffers(ownEmission, emission[qi].rgb);
     }
-  if (!geometryEdge && !emitterEdge) {
+  // A geometric edge only in a frame of one sample (see above); an emitter's border always.
+  if (!emitterEdge && !(geometryEdge && n <= 1.0)) {
     combined[pixel] = vec4(own.rgb, 1.0);
     return;
   }
@@ -129,5 +129,5 @@ void main() {
     }
   }
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
-  combined[pixel] = vec4((own.rgb + sum) / float(1u + rays), 1.0);
+  combined[pixel] = vec4((n * own.rgb + sum) / (n + float(rays)), 1.0);
 }

@@ -72,7 +72,8 @@ void addFrameOptions(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--exposure", o.exposure, "PNG exposure in stops");
   cmd.add_flag("--denoise", o.denoise,
                "denoise the obscurance frame (render/denoise/: demodulated direct and ambient terms, edge-aware "
-               "a-trous filter): the PNG of combined shows it, the EXR gets a `denoised` layer");
+               "a-trous filter; at 1 spp, the pixels an edge crosses resolved from camera rays of their own): the PNG "
+               "of combined shows it, the EXR gets a `denoised` layer");
 }
 
 RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh::Bvh& bvh, const gpu::Context& context,
