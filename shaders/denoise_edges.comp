@@ -10,15 +10,17 @@
 // own (cheap: a closest hit, no shading). Each ray's surface is looked up among the 3x3 pixels
 // around it (same material, normal and plane as their guide: the filter's own test) and takes
 // that pixel's filtered light; what the ray sees emit is taken from the ray itself (its emitter's
-// unit emission times the E_s compose used), the sky's too. The mean over the rays is blended
-// with the pixel's own estimate by their counts, (n C + sum R_k) / (n + K): the pixel's box filter
-// with K more points of coverage, the pass fading as samples accumulate.
+// unit emission times the E_s compose used), the sky's too. The rays' means are blended with the
+// pixel's own estimate by the points behind each: its shading (C - M) has the frame's n samples,
+// its seen emission M the renderer's emission rays at each (--emission-samples), so
+//   (n (C - M) + sum S_k) / (n + K)  +  (n E M + sum M_k) / (n E + K):
+// the pixel's box filter with K more points of coverage, fading as samples accumulate.
 //
-// Geometric edges are resolved only in frames of one sample (and no history): with more, the
-// pixel's own points measure its coverage, and the light taken from a neighbour a pixel away is
-// the larger error (measured: docs/BENCHMARKS.md). An emitter's border is resolved at any count:
-// there the rays' own emission, exact per ray, is nearly all of the pixel (a lamp ~100x its
-// surroundings), and what they take from the neighbours is a rounding error beside it.
+// A geometric edge's shading is resolved only in a frame of one sample (and no history): with
+// more, the pixel's own points measure its coverage, and the light taken from a neighbour a pixel
+// away is the larger error (measured: docs/BENCHMARKS.md). An emitter's border is resolved at any
+// count, its emission only: there the seen emission, exact per ray, is nearly all of the pixel (a
+// lamp ~100x its surroundings), and more points of it are what the pixel needs.
 //
 // Which pixels: those whose guide differs from a neighbour's (another surface, found the way the
 // filter stops at it) or whose seen emission does (an emitter's border, where the radiance jumps
@@ -63,25 +65,54 @@ void main() {
     combined[pixel] = vec4(own.rgb, 1.0);
     return;
   }
-  const Guide g = decodeGuide(guide[pixel]);
-  const vec3 ownPoint = pixelPoint(params.camera, ivec2(p), size, g.depth);
-  const vec3 ownEmission = emission[pixel].rgb;
-
-  // The 3x3 neighbourhood: does another surface, or another emission, show in it?
-  bool geometryEdge = false, emitterEdge = false;
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      const ivec2 q = ivec2(p) + ivec2(dx, dy);
-      if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(size)))) continue;
-      const uint qi = uint(q.y) * size.x + uint(q.x);
-      const Guide gq = decodeGuide(guide[qi]);
-      const bool same = guideHit(g) ? sameSurface(g, ownPoint, gq, pixelPoint(params.camera, q, size, gq.depth),
-                                                  planeTolerance(g, size))
-                                    : !guideHit(gq);
-      geometryEdge = geometryEdge || !same;
-      emitterEdge = emitterEdge || emissionDiffers(ownEmission, emission[qi].rgb);
+  // The 3x3 pixels as the rays will compare with them, read once: each one's plane (unit normal
+  // and offset), the inverse of its plane tolerance, its material (kInvalidIndex: outside the
+  // image or no hit) and its filtered light without the emission.
+  vec4 planes[9];
+  vec3 points[9];
+  float inverseTolerance[9];
+  uint materials[9];
+  vec3 light[9];
+  vec3 emissions9[9];
+  for (int c = 0; c < 9; ++c) {
+    const ivec2 q = ivec2(p) + ivec2(c % 3 - 1, c / 3 - 1);
+    materials[c] = kInvalidIndex;
+    planes[c] = vec4(0.0);
+    points[c] = vec3(0.0);
+    inverseTolerance[c] = 0.0;
+    light[c] = vec3(0.0);
+    emissions9[c] = vec3(0.0);
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(size)))) continue;
+    const uint qi = uint(q.y) * size.x + uint(q.x);
+    const Guide gq = decodeGuide(guide[qi]);
+    emissions9[c] = emission[qi].rgb;
+    light[c] = remodulated[qi].rgb - emissions9[c];
+    if (!guideHit(gq)) {
+      materials[c] = kDenoiseNoMaterial; // seen: the sky or nothing
+      continue;
     }
-  // A geometric edge only in a frame of one sample (see above); an emitter's border always.
+    points[c] = pixelPoint(params.camera, q, size, gq.depth);
+    materials[c] = gq.material;
+    planes[c] = vec4(gq.normal, dot(gq.normal, points[c]));
+    inverseTolerance[c] = 1.0 / planeTolerance(gq, size);
+  }
+
+  // Does another surface, or another emission, show in the 3x3? A neighbour on the pixel's
+  // surface has its material, a normal within the filter's cone and its point on the pixel's plane.
+  bool geometryEdge = false, emitterEdge = false;
+  const vec3 ownEmission = emissions9[4];
+  for (int c = 0; c < 9; ++c) {
+    if (c == 4 || materials[c] == kInvalidIndex) continue;
+    const bool hit = materials[4] != kDenoiseNoMaterial, hitQ = materials[c] != kDenoiseNoMaterial;
+    bool same = hit == hitQ;
+    if (hit && hitQ) // the filter's test (sameSurface), from the pixel's side
+      same = materials[c] == materials[4] && dot(planes[c].xyz, planes[4].xyz) > kSameSurfaceCos &&
+             abs(dot(planes[4].xyz, points[c]) - planes[4].w) * inverseTolerance[4] < 1.0;
+    geometryEdge = geometryEdge || !same;
+    emitterEdge = emitterEdge || emissionDiffers(ownEmission, emissions9[c]);
+  }
+  // A geometric edge only in a frame of one sample (see above); an emitter's border always (its
+  // emission alone beyond one sample).
   if (!emitterEdge && !(geometryEdge && n <= 1.0)) {
     combined[pixel] = vec4(own.rgb, 1.0);
     return;
@@ -92,42 +123,51 @@ void main() {
   uint rng = rngSeed(p, 0x6564u, 0u); // a fixed pattern per pixel: the same image every call
   const vec2 shift = vec2(rngNext(rng), rngNext(rng));
   StepBudget budget = newStepBudget();
-  vec3 sum = vec3(0.0);
+  vec3 shading = vec3(0.0), emitted = vec3(0.0); // the rays' sums
+  uint traced = 0u, mostPasses = 0u;
   for (uint j = 0u; j < rays; ++j) {
+    // Up to K rays while the loop budget lasts (the limiter, LAVAPIPE.md): the next ray may take
+    // twice the passes the most costly one so far took; the rays not traced are left to the
+    // pixel's own estimate (K counts the traced ones), and no traversal is cut short.
+    if (subgroupPasses[gl_SubgroupID] + 2u * mostPasses + 64u > kMaxTraversalSteps) break;
     const vec3 direction = cameraRayDirection(params.camera, vec2(p) + pixelSampleOffset(j, shift), vec2(size));
     const RayHit hit = traceWithBudget(budget, params.camera.origin.xyz, direction, 0.0, 1.0 / 0.0, false);
+    mostPasses = max(mostPasses, subgroupMax(hit.steps));
+    ++traced;
     if (hit.primitive == kTruncatedHit) {
-      sum += own.rgb; // out of loop budget (counted in the status word): the pixel's own estimate
+      shading += light[4]; // out of loop budget (counted in the status word): the pixel's own
+      emitted += ownEmission;
       continue;
     }
     if (!rayHitValid(hit) || hit.primitive == kInvalidIndex) {
-      if (skySlot < pc.lightCount) sum += emissions[skySlot].rgb; // the sky at unit radiance times its E_s
+      if (skySlot < pc.lightCount) emitted += emissions[skySlot].rgb; // the sky at unit radiance times its E_s
       continue;
     }
     const Surface s = surfaceAt(hit, params.camera.origin.xyz, direction);
     // The neighbour on the ray's surface whose plane it lies nearest (none: the pixel's own light).
     const uint material = min(s.material, kDenoiseNoMaterial - 1u);
-    uint best = kInvalidIndex;
+    vec3 taken = light[4];
     float bestDistance = 1.0;
     for (int c = 0; c < 9; ++c) {
-      const ivec2 q = ivec2(p) + ivec2(c % 3 - 1, c / 3 - 1);
-      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(size)))) continue;
-      const uint qi = uint(q.y) * size.x + uint(q.x);
-      const Guide gq = decodeGuide(guide[qi]);
-      if (!guideHit(gq) || gq.material != material || dot(gq.normal, s.shadingNormal) <= kSameSurfaceCos) continue;
-      const float d = planeDistance(pixelPoint(params.camera, q, size, gq.depth), gq.normal, s.position,
-                                    planeTolerance(gq, size));
+      if (materials[c] != material || dot(planes[c].xyz, s.shadingNormal) <= kSameSurfaceCos) continue;
+      const float d = abs(dot(planes[c].xyz, s.position) - planes[c].w) * inverseTolerance[c];
       if (d < bestDistance) {
         bestDistance = d;
-        best = qi;
+        taken = light[c];
       }
     }
-    sum += best != kInvalidIndex ? remodulated[best].rgb - emission[best].rgb : own.rgb - ownEmission;
+    shading += taken;
     if (s.lightGroup != kInvalidIndex) {
       const vec3 e = materialEmission(materialAt(s.material), s.uv, s.frontFacing);
-      sum += unitEmission(e, lightScales[s.lightGroup].rgb) * emissions[s.lightGroup].rgb;
+      emitted += unitEmission(e, lightScales[s.lightGroup].rgb) * emissions[s.lightGroup].rgb;
     }
   }
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
-  combined[pixel] = vec4((n * own.rgb + sum) / (n + float(rays)), 1.0);
+  // Each part blended with the pixel's own by the points behind them: its shading has n (and is
+  // kept beyond one sample), its seen emission n x the renderer's emission rays per sample.
+  const float k = float(traced), ownEmissionPoints = n * float(max(pc.ownEmissionRays, 1u));
+  const vec3 ownShading = light[4];
+  const vec3 outShading = n <= 1.0 ? (ownShading + shading) / (1.0 + k) : ownShading;
+  const vec3 outEmission = (ownEmissionPoints * ownEmission + emitted) / (ownEmissionPoints + k);
+  combined[pixel] = vec4(outShading + outEmission, 1.0);
 }

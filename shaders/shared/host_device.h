@@ -827,11 +827,14 @@ OBS_CONST uint kBindingEdgesEmissions = kBindingPassFirst + 5;   // vec4[light]:
 OBS_CONST uint kBindingEdgesOut = kBindingPassFirst + 6;         // vec4[pixel] out: combined
 OBS_CONST uint kEdgesBindingCount = kBindingPassFirst + 7;
 
+// The most camera rays the edge pass traces in a pixel (DenoiserSettings): they stop early where
+// the loop limiter's budget runs low (the rest left to the pixel's own estimate).
+OBS_CONST uint kMaxEdgeRays = 256u;
 struct DenoiseEdgesPush {
   uint geometryRays; // camera rays per pixel a geometric edge crosses (0: the pass copies)
   uint emitterRays;  // per pixel whose seen emission differs from a neighbour's
   uint lightCount;   // the lights' slots (the sky's is camera.up.w when it is one of them)
-  uint unused;
+  uint ownEmissionRays; // the renderer's emission rays per sample at an emitter's border
 };                   // 16 bytes
 
 // ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,

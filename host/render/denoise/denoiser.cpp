@@ -1,5 +1,6 @@
 #include "render/denoise/denoiser.h"
 
+#include <algorithm>
 #include <bit>
 #include <stdexcept>
 
@@ -78,9 +79,8 @@ Denoiser::Denoiser(const gpu::Context& context, const ObscuranceRenderer& render
     throw std::invalid_argument("Denoiser: the renderer must keep its primary and composed AOVs (the normal, depth "
                                 "and albedo guides, the direct and ambient terms)");
   if (settings.iterations > 16) throw std::invalid_argument("Denoiser: at most 16 a-trous iterations");
-  if (settings.geometryEdgeRays > gpu::kMaxEmissionSamples || settings.emitterEdgeRays > gpu::kMaxEmissionSamples)
-    throw std::invalid_argument(fmt::format("Denoiser: at most {} edge rays a pixel (they share the loop limiter's budget)",
-                                            gpu::kMaxEmissionSamples));
+  if (settings.geometryEdgeRays > gpu::kMaxEdgeRays || settings.emitterEdgeRays > gpu::kMaxEdgeRays)
+    throw std::invalid_argument(fmt::format("Denoiser: at most {} edge rays a pixel", gpu::kMaxEdgeRays));
   impl_ = std::make_unique<Impl>(context, renderer);
 }
 
@@ -111,6 +111,13 @@ void Denoiser::denoise(const ObscuranceRenderer& renderer, float exposureStops) 
   const std::map<std::string, double> before = d.timestamps.totalsMs();
   const std::uint32_t parity = d.parity;
   d.edges.bind(renderer, d.frame, parity);
+  // The renderer's emission rays per sample at an emitter's border (--emission-samples): how many
+  // points its own estimate of the seen emission there has.
+  const ObscuranceSettings& rs = renderer.settings();
+  const EdgePass::Dispatch edgeDispatch{.geometryRays = settings_.geometryEdgeRays,
+                                        .emitterRays = settings_.emitterEdgeRays,
+                                        .lights = static_cast<std::uint32_t>(renderer.lights().size()),
+                                        .ownEmissionRays = std::max(rs.emissionSamples, 1u)};
   d.stream.submit([&](const vk::raii::CommandBuffer& cmd) {
     d.timestamps.reset(cmd);
     d.timestamps.begin(cmd, "denoise.gather");
@@ -139,8 +146,7 @@ void Denoiser::denoise(const ObscuranceRenderer& renderer, float exposureStops) 
     d.timestamps.end(cmd, "denoise.remodulate");
     gpu::computeBarrier(cmd);
     d.timestamps.begin(cmd, "denoise.edges");
-    d.edges.record(cmd, d.frame, settings_.geometryEdgeRays, settings_.emitterEdgeRays,
-                   static_cast<std::uint32_t>(renderer.lights().size()));
+    d.edges.record(cmd, d.frame, edgeDispatch);
     d.timestamps.end(cmd, "denoise.edges");
     gpu::computeBarrier(cmd);
     const FrameLayout whole{.width = layout.width, .height = layout.height, .bands = {{0, layout.height}}};

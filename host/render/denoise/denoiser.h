@@ -46,8 +46,8 @@ struct DenoiserSettings {
   // Camera rays per pixel an edge crosses (denoise_edges.comp): where a geometric edge does, and
   // where an emitter's border does (its radiance a hundred times its surroundings', the few
   // pixels where coverage matters most). 0 geometry rays: no edge pass.
-  std::uint32_t geometryEdgeRays = gpu::kEdgeEmissionSamples;
-  std::uint32_t emitterEdgeRays = gpu::kMaxEmissionSamples;
+  std::uint32_t geometryEdgeRays = 8;
+  std::uint32_t emitterEdgeRays = gpu::kMaxEdgeRays;
 };
 
 class Denoiser {

@@ -33,10 +33,9 @@ void EdgePass::bind(const ObscuranceRenderer& renderer, const DenoiseFrame& fram
   kernel_.bind(gpu::kBindingEdgesOut, frame.combined);
 }
 
-void EdgePass::record(const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame, std::uint32_t geometryRays,
-                      std::uint32_t emitterRays, std::uint32_t lights) const {
-  const gpu::DenoiseEdgesPush push{.geometryRays = geometryRays, .emitterRays = emitterRays, .lightCount = lights,
-                                   .unused = 0u};
+void EdgePass::record(const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame, const Dispatch& dispatch) const {
+  const gpu::DenoiseEdgesPush push{.geometryRays = dispatch.geometryRays, .emitterRays = dispatch.emitterRays,
+                                   .lightCount = dispatch.lights, .ownEmissionRays = dispatch.ownEmissionRays};
   dispatchImage(kernel_, cmd, frame, push, 0);
 }
 

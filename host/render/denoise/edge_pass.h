@@ -21,10 +21,14 @@ public:
   // guide[parity]. Called before every dispatch: an edit may have made the renderer's buffers anew (it is a handful of
   // descriptor writes); the kernel is made again where the scene's specialisation changed.
   void bind(const ObscuranceRenderer& renderer, const DenoiseFrame& frame, std::uint32_t parity);
-  // `geometryRays` camera rays in the pixels a geometric edge crosses, `emitterRays` where an
-  // emitter's border does; 0 geometry rays copies the remodulated image.
-  void record(const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame, std::uint32_t geometryRays,
-              std::uint32_t emitterRays, std::uint32_t lights) const;
+  // What a dispatch traces and weighs (DenoiseEdgesPush).
+  struct Dispatch {
+    std::uint32_t geometryRays = 0;    // camera rays where a geometric edge crosses (0: copy)
+    std::uint32_t emitterRays = 0;     // where an emitter's border does
+    std::uint32_t lights = 0;          // the renderer's light slots
+    std::uint32_t ownEmissionRays = 1; // the renderer's emission rays per sample there
+  };
+  void record(const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame, const Dispatch& dispatch) const;
 
 private:
   const gpu::Context* context_;
