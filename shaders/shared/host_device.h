@@ -835,7 +835,9 @@ struct DenoiseEdgesPush {
   uint emitterRays;  // per pixel whose seen emission differs from a neighbour's
   uint lightCount;   // the lights' slots (the sky's is camera.up.w when it is one of them)
   uint ownEmissionRays; // the renderer's emission rays per sample at an emitter's border
-};                   // 16 bytes
+  float ambientLuminance; // of I_a: the scene's radiance scale an emitter's step is measured in
+  uint unused0, unused1, unused2;
+};                   // 32 bytes
 
 // ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,
 // then its Kahan compensation), so accumulation buffers hold kAccumulatorVec4s vec4 per entry.

@@ -117,7 +117,9 @@ void Denoiser::denoise(const ObscuranceRenderer& renderer, float exposureStops) 
   const EdgePass::Dispatch edgeDispatch{.geometryRays = settings_.geometryEdgeRays,
                                         .emitterRays = settings_.emitterEdgeRays,
                                         .lights = static_cast<std::uint32_t>(renderer.lights().size()),
-                                        .ownEmissionRays = std::max(rs.emissionSamples, 1u)};
+                                        .ownEmissionRays = std::max(rs.emissionSamples, 1u),
+                                        .ambientLuminance = glm::dot(renderer.ambientIntensity(),
+                                                                     glm::vec3(0.2126f, 0.7152f, 0.0722f))};
   d.stream.submit([&](const vk::raii::CommandBuffer& cmd) {
     d.timestamps.reset(cmd);
     d.timestamps.begin(cmd, "denoise.gather");

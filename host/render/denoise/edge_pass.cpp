@@ -35,7 +35,9 @@ void EdgePass::bind(const ObscuranceRenderer& renderer, const DenoiseFrame& fram
 
 void EdgePass::record(const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame, const Dispatch& dispatch) const {
   const gpu::DenoiseEdgesPush push{.geometryRays = dispatch.geometryRays, .emitterRays = dispatch.emitterRays,
-                                   .lightCount = dispatch.lights, .ownEmissionRays = dispatch.ownEmissionRays};
+                                   .lightCount = dispatch.lights, .ownEmissionRays = dispatch.ownEmissionRays,
+                                   .ambientLuminance = dispatch.ambientLuminance, .unused0 = 0u, .unused1 = 0u,
+                                   .unused2 = 0u};
   dispatchImage(kernel_, cmd, frame, push, 0);
 }
 

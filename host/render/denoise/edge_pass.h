@@ -27,6 +27,7 @@ public:
     std::uint32_t emitterRays = 0;     // where an emitter's border does
     std::uint32_t lights = 0;          // the renderer's light slots
     std::uint32_t ownEmissionRays = 1; // the renderer's emission rays per sample there
+    float ambientLuminance = 0.0f;     // of the renderer's I_a: the scale of an emitter's step
   };
   void record(const vk::raii::CommandBuffer& cmd, const DenoiseFrame& frame, const Dispatch& dispatch) const;
 
