@@ -23,8 +23,8 @@
 // lamp ~100x its surroundings), and more points of it are what the pixel needs.
 //
 // Which pixels: those whose guide differs from a neighbour's (another surface, found the way the
-// filter stops at it) or whose seen emission does (an emitter's border, where the radiance jumps
-// by a hundred times: more rays, `emitterRays`). A pixel with no such neighbour is copied.
+// filter stops at it) or whose seen emission does (an emitter's border: rays by its step, up to
+// `emitterRays`, see main). A pixel with no such neighbour is copied.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
 #include "lib/scene_bindings.glsl"

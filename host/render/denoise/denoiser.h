@@ -15,10 +15,10 @@
 //   a-trous   edge-aware wavelet iterations (steps 1, 2, 4, ...) guided by normal, depth (plane
 //             distance) and albedo, the luminance weight steered by the variance
 //   remodulate x albedo, + specular, + the seen emission (never filtered)
-//   edges     the pixels an edge crosses (another surface or another emission in the 3x3 around
-//             them), resolved from camera rays of their own: each ray takes the filtered light of
-//             the neighbour on its surface and its own emission, so a 1-spp frame's silhouettes
-//             and emitter borders are covered by K points instead of one; then the tonemap pass
+//   edges     the pixels an edge crosses (another surface, in a 1-spp frame, or another emission
+//             in the 3x3 around them), resolved from camera rays of their own: each ray takes the
+//             filtered light of the neighbour on its surface and its own emission, so silhouettes
+//             and emitter borders are covered by K more points; then the tonemap pass
 //             (display bytes as ObscuranceRenderer::display(): RGBA8, R in the low byte).
 #pragma once
 #include <cstdint>
@@ -43,9 +43,9 @@ struct DenoiserSettings {
                                         // step may be and still be filtered over (Schied et al. use 4
                                         // with temporal variances; 2 measured lower error with these
                                         // spatial ones at 4 spp: tests/render/denoise_test.cpp)
-  // Camera rays per pixel an edge crosses (denoise_edges.comp): where a geometric edge does, and
-  // where an emitter's border does (its radiance a hundred times its surroundings', the few
-  // pixels where coverage matters most). 0 geometry rays: no edge pass.
+  // Camera rays per pixel an edge crosses (denoise_edges.comp): where a geometric edge does (in a
+  // 1-spp frame), and the most where an emitter's border does (8 per unit of its emission step
+  // over I_a's luminance, at least the geometric count). 0 geometry rays: no edge pass.
   std::uint32_t geometryEdgeRays = 8;
   std::uint32_t emitterEdgeRays = gpu::kMaxEdgeRays;
 };
