@@ -764,7 +764,7 @@ OBS_CONST uint kClearBindingCount = 5;
 //          luminance variances (halves); then specular rgb and its variance (halves, x and y),
 //          z unused, w = the samples the terms count for (float bits)
 struct DenoiseParams {
-  GpuCamera camera;   // 0:   the current view (gpuCamera; up.w unused)
+  GpuCamera camera;   // 0:   the current view (the primary pass's: up.w = the sky's light slot)
   GpuCamera previous; // 64:  the view the history was made with
   uvec4 frame;        // 128: width, height, the most samples a reprojected history counts for,
                       //      1 when the frame has specular paths (else the specular term is 0)
@@ -831,13 +831,13 @@ OBS_CONST uint kEdgesBindingCount = kBindingPassFirst + 7;
 // the loop limiter's budget runs low (the rest left to the pixel's own estimate).
 OBS_CONST uint kMaxEdgeRays = 256u;
 struct DenoiseEdgesPush {
-  uint geometryRays; // camera rays per pixel a geometric edge crosses (0: the pass copies)
-  uint emitterRays;  // per pixel whose seen emission differs from a neighbour's
-  uint lightCount;   // the lights' slots (the sky's is camera.up.w when it is one of them)
-  uint ownEmissionRays; // the renderer's emission rays per sample at an emitter's border
+  uint geometryRays;      // camera rays per pixel a geometric edge crosses (0: the pass copies)
+  uint emitterRays;       // the most per pixel whose seen emission differs from a neighbour's
+  uint lightCount;        // the lights' slots (the sky's is camera.up.w when it is one of them)
+  uint ownEmissionRays;   // the renderer's emission rays per sample at an emitter's border
   float ambientLuminance; // of I_a: the scene's radiance scale an emitter's step is measured in
   uint unused0, unused1, unused2;
-};                   // 32 bytes
+};                        // 32 bytes
 
 // ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,
 // then its Kahan compensation), so accumulation buffers hold kAccumulatorVec4s vec4 per entry.

@@ -18,8 +18,9 @@ public:
   EdgePass(const gpu::Context& context, const SceneSpecialisation& scene);
 
   // Binds the renderer's scene, status counters and light tables and the frame's buffers, with
-  // guide[parity]. Called before every dispatch: an edit may have made the renderer's buffers anew (it is a handful of
-  // descriptor writes); the kernel is made again where the scene's specialisation changed.
+  // guide[parity]. Called before every dispatch (a handful of descriptor writes): an edit may have
+  // made the renderer's buffers anew; the kernel is made again where the scene's specialisation
+  // changed.
   void bind(const ObscuranceRenderer& renderer, const DenoiseFrame& frame, std::uint32_t parity);
   // What a dispatch traces and weighs (DenoiseEdgesPush).
   struct Dispatch {
