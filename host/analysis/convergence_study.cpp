@@ -89,6 +89,7 @@ ConvergenceStudy::ConvergenceStudy(const StudySettings& o, const scene::Scene& s
 }
 
 StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, std::uint32_t seed) {
+  if (warmedUp_.insert(m.name).second) render(m, 1, seed);
   StudyRender r;
   const render::RenderStats* stats = nullptr;
   if (m.pathTrace) {

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -91,7 +92,10 @@ public:
                    const gpu::Context& context);
 
   // Method `m` at `spp` samples with `seed`, with the study's persistent renderers: the scene is
-  // uploaded and the pipelines are made once per method family, not once per render.
+  // uploaded and the pipelines are made once per method family, not once per render. A method's
+  // first render is preceded by an untimed 1-spp one: lavapipe compiles a kernel variant on its
+  // first dispatch, inside the GPU timestamps (with a cold shader cache the first points of the
+  // curves took 0.2-0.9 s instead of 40-60 ms).
   StudyRender render(const StudyMethod& m, std::uint32_t spp, std::uint32_t seed);
   // The converged image of a method, from the cache in the output folder when the same settings
   // made it (the path tracing one from --pt-reference where given).
@@ -123,6 +127,7 @@ private:
   std::unique_ptr<render::ObscuranceRenderer> obscurance_;
   std::unique_ptr<render::Denoiser> denoiser_; // bound to obscurance_'s frame
   std::unique_ptr<render::PathTracer> pathTracer_;
+  std::set<std::string> warmedUp_; // methods rendered once, untimed
   scene::Camera camera_;
   std::uint32_t width_ = 0, height_ = 0;
   std::string stem_;
