@@ -68,53 +68,36 @@ void main() {
     combined[pixel] = vec4(own.rgb, 1.0);
     return;
   }
-  // The 3x3 pixels as the rays will compare with them, read once: each one's plane (unit normal
-  // and offset), the inverse of its plane tolerance, its material (kInvalidIndex: outside the
-  // image or no hit) and its filtered light without the emission.
-  vec4 planes[9];
+  // The 3x3 pixels as the rays will compare with them, read once: each one's guide, point (at its
+  // mean depth), plane tolerance, and filtered light without the emission. `inside`: in the image.
+  Guide guides[9];
   vec3 points[9];
-  float inverseTolerance[9];
-  uint materials[9];
+  float tolerance[9];
   vec3 light[9];
-  vec3 emissions9[9];
+  vec3 seen[9];
+  bool inside[9];
   for (int c = 0; c < 9; ++c) {
     const ivec2 q = ivec2(p) + ivec2(c % 3 - 1, c / 3 - 1);
-    materials[c] = kInvalidIndex;
-    planes[c] = vec4(0.0);
-    points[c] = vec3(0.0);
-    inverseTolerance[c] = 0.0;
-    light[c] = vec3(0.0);
-    emissions9[c] = vec3(0.0);
-    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(size)))) continue;
-    const uint qi = uint(q.y) * size.x + uint(q.x);
-    const Guide gq = decodeGuide(guide[qi]);
-    emissions9[c] = emission[qi].rgb;
-    light[c] = remodulated[qi].rgb - emissions9[c];
-    if (!guideHit(gq)) {
-      materials[c] = kDenoiseNoMaterial; // seen: the sky or nothing
-      continue;
-    }
-    points[c] = pixelPoint(params.camera, q, size, gq.depth);
-    materials[c] = gq.material;
-    planes[c] = vec4(gq.normal, dot(gq.normal, points[c]));
-    inverseTolerance[c] = 1.0 / planeTolerance(gq, size);
+    inside[c] = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, ivec2(size)));
+    const uint qi = inside[c] ? uint(q.y) * size.x + uint(q.x) : pixel;
+    guides[c] = decodeGuide(guide[qi]);
+    points[c] = pixelPoint(params.camera, q, size, guides[c].depth);
+    tolerance[c] = planeTolerance(guides[c], size);
+    seen[c] = emission[qi].rgb;
+    light[c] = remodulated[qi].rgb - seen[c];
   }
 
-  // Does another surface, or another emission, show in the 3x3? A neighbour on the pixel's
-  // surface has its material, a normal within the filter's cone and its point on the pixel's plane.
+  // Does another surface (the filter's own test, sameSurface), or another emission, show in the 3x3?
   bool geometryEdge = false, emitterEdge = false;
-  const vec3 ownEmission = emissions9[4];
+  const vec3 ownEmission = seen[4];
   float emissionStep = 0.0; // the largest jump in seen emission (luminance)
   for (int c = 0; c < 9; ++c) {
-    if (c == 4 || materials[c] == kInvalidIndex) continue;
-    emissionStep = max(emissionStep, abs(luminance(emissions9[c]) - luminance(ownEmission)));
-    const bool hit = materials[4] != kDenoiseNoMaterial, hitQ = materials[c] != kDenoiseNoMaterial;
-    bool same = hit == hitQ;
-    if (hit && hitQ) // the filter's test (sameSurface), from the pixel's side
-      same = materials[c] == materials[4] && dot(planes[c].xyz, planes[4].xyz) > kSameSurfaceCos &&
-             abs(dot(planes[4].xyz, points[c]) - planes[4].w) * inverseTolerance[4] < 1.0;
+    if (c == 4 || !inside[c]) continue;
+    emissionStep = max(emissionStep, abs(luminance(seen[c]) - luminance(ownEmission)));
+    const bool same = guideHit(guides[4]) ? sameSurface(guides[4], points[4], guides[c], points[c], tolerance[4])
+                                          : !guideHit(guides[c]);
     geometryEdge = geometryEdge || !same;
-    emitterEdge = emitterEdge || emissionDiffers(ownEmission, emissions9[c]);
+    emitterEdge = emitterEdge || emissionDiffers(ownEmission, seen[c]);
   }
   // A geometric edge only in a frame of one sample (see above); an emitter's border always (its
   // emission alone beyond one sample).
@@ -161,8 +144,10 @@ void main() {
     vec3 taken = light[4];
     float bestDistance = 1.0;
     for (int c = 0; c < 9; ++c) {
-      if (materials[c] != material || dot(planes[c].xyz, s.shadingNormal) <= kSameSurfaceCos) continue;
-      const float d = abs(dot(planes[c].xyz, s.position) - planes[c].w) * inverseTolerance[c];
+      const Guide gq = guides[c];
+      if (!inside[c] || !guideHit(gq) || gq.material != material || dot(gq.normal, s.shadingNormal) <= kSameSurfaceCos)
+        continue;
+      const float d = planeDistance(points[c], gq.normal, s.position, tolerance[c]);
       if (d < bestDistance) {
         bestDistance = d;
         taken = light[c];

@@ -118,7 +118,7 @@ protected:
   }
 };
 
-// Measured (RMSE denoised / undenoised, the edge pass included): 0.482 at 1 spp, 0.807 at 4 spp
+// Measured (RMSE denoised / undenoised, the edge pass included): 0.490 at 1 spp, 0.807 at 4 spp
 // (MAE 0.0050 -> 0.0026, 0.0023 -> 0.0016); without the edge pass 1 spp was 0.850: the geometric
 // edges' pixels, which the filter leaves alone, held the rest.
 TEST_F(Denoise, LowersTheErrorAgainstTheConvergedCornellBoxAt1And4Spp) {
@@ -126,7 +126,7 @@ TEST_F(Denoise, LowersTheErrorAgainstTheConvergedCornellBoxAt1And4Spp) {
   expectLowerError(l, settingsFor(l.scene, 96, 96, 1, 3), 128, 0.95);
 }
 
-// Measured: 0.534 at 1 spp (0.730 without the edge pass), 0.832 at 4 spp (MAE 0.131 -> 0.065,
+// Measured: 0.528 at 1 spp (0.730 without the edge pass), 0.832 at 4 spp (MAE 0.131 -> 0.066,
 // 0.058 -> 0.044); the glossy floor's specular light is filtered too.
 TEST_F(Denoise, LowersTheErrorAgainstTheConvergedModernHallAt1And4Spp) {
   const Loaded l = load(sharedScene("modern-hall/modern-hall.gltf"));
