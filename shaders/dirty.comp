@@ -26,7 +26,8 @@ layout(push_constant) uniform Stage { DirtyStagePush stage; };
 bool maybeTouched(uint pixel) {
   vec4 lo = hitBounds[2u * pixel], hi = hitBounds[2u * pixel + 1u];
   if (hi.w == 0.0) return false; // no sample hit anything: only its camera rays could change
-  if (lo.w != 0.0) return true;  // a specular path left the scene: it may pass anywhere
+  if (lo.w != 0.0) return true;  // a specular path left the scene, or an obscurance ray was traced
+                                 // past dMax (kFlagDarkEscapes): it may pass anywhere
   vec3 ac = 0.5 * (lo.xyz + hi.xyz), ah = 0.5 * (hi.xyz - lo.xyz);
   const float dMax = pc.dMax;
   const uint traced = pc.tracedLight;

@@ -38,9 +38,14 @@ void main() {
   gLightSampling = (pc.renderFlags & kFlagAreaLightSampling) != 0u ? kLightSamplingArea : kLightSamplingSpatial;
   StepBudget budget = newStepBudget();
   // A probe too (not in the macro): N_obs rays at every primary hit.
-  const vec4 gathered = gatherObscurance(sp, rng, budget, pixel, bp.count, pc.obscuranceRays);
+  uint farRays;
+  const vec4 gathered = gatherObscurance(sp, rng, budget, pixel, bp.count, pc.obscuranceRays, farRays);
   OBS_ACCUMULATE_TEXEL(ambient, pixel, gathered)
   if (kProbe) endProbe(pixel);
-  else atomicAdd(status[kStatusObscuranceRays], pc.obscuranceRays);
+  else {
+    atomicAdd(status[kStatusObscuranceRays], pc.obscuranceRays + farRays);
+    // A ray past dMax may pass anywhere: dirty.comp then cannot bound this pixel's rays.
+    if (farRays > 0u && (pc.dispatchFlags & kShadeFlagPerLight) == 0u) hitBounds[2u * pixel].w = 1.0;
+  }
   if (budget.truncated) atomicAdd(status[kStatusTruncated], 1u);
 }

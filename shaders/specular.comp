@@ -84,7 +84,7 @@ struct PathState {
   uint rng;       // what is gathered
   vec3 pathLo;    // the box of the path's vertices (dirty.comp)
   vec3 pathHi;
-  bool escaped;   // a ray of the path left the scene
+  bool escaped;   // a ray of the path left the scene or reached past dMax (dirty.comp: unbounded)
   bool truncated; // a traversal of the path ran out of loop passes
   uint pixel;     // band-local
 };
@@ -244,9 +244,11 @@ bool followVertex(SpecularConstants c, inout PathState path, uint depth, inout S
     }
   }
   // Secondary reflectors only at primary hits: here the ambient keeps its whole I_a.
-  vec4 aw = gatherObscurance(sp, path.rng, budget, kInvalidIndex, c.pixelCount, obscuranceRays);
+  uint farRays;
+  vec4 aw = gatherObscurance(sp, path.rng, budget, kInvalidIndex, c.pixelCount, obscuranceRays, farRays);
   OBS_ACCUMULATE_TEXEL(specularAmbient, pixel, vec4(throughput * aw.rgb, 0.0))
-  rays += (c.noDirect ? 0u : shadowRays) + obscuranceRays;
+  if (farRays > 0u) path.escaped = true; // a ray past dMax may pass anywhere (dirty.comp)
+  rays += (c.noDirect ? 0u : shadowRays) + obscuranceRays + farRays;
   return true;
 }
 

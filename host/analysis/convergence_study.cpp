@@ -116,6 +116,7 @@ StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, st
     s.lightSampling = m.lightSampling;
     s.ambient = render::AmbientModel::Seen; // the least biased I_a; Reached and Global composed beside it
     s.dMax = o_.dMax;
+    s.escapes = o_.escapes;
     s.secondaryReflectors = m.secondaryReflectors;
     s.vertexRaysByThroughput = m.vertexRaysByThroughput;
     if (!obscurance_)
@@ -182,8 +183,9 @@ io::Image ConvergenceStudy::reference(const StudyMethod& m) {
                                         m.pathTrace ? emissionName(o_.pathEmissionSamples, o_.pathEmissionAtEdges)
                                                     : emissionName(o_.emissionSamples, o_.emissionAtEdges),
                                         nameOf(render::kLightSamplingNames, m.lightSampling),
-                                        m.pathTrace ? "" : fmt::format(" ambient=seen+reached+global dmax={} secondary_reflectors={}",
-                                                                       o_.dMax, m.secondaryReflectors),
+                                        m.pathTrace ? "" : fmt::format(" ambient=seen+reached+global dmax={} escapes={} secondary_reflectors={}",
+                                                                       o_.dMax, nameOf(render::kEscapeModelNames, o_.escapes),
+                                                                       m.secondaryReflectors),
                                         o_.background.empty() ? "" : fmt::format(" background={}", fmt::join(o_.background, ",")));
   if (std::filesystem::exists(exr) && std::filesystem::exists(txt)) {
     std::ifstream in(txt);

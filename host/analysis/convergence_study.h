@@ -43,6 +43,7 @@ struct StudySettings {
   std::string pathReferenceFile;
   std::uint32_t seed = 1;
   float dMax = 0.0f; // 0: the renderer's default
+  render::EscapeModel escapes = render::EscapeModel::Auto; // the obscurance methods' (render --escapes)
   float secondaryReflectors = 0.0f; // > 0: one more method, obscurances with secondary reflectors
   std::vector<float> background;    // R,G,B of a sky (render --background); empty: none
   // Camera rays per sample for the emission the camera sees (render --emission-samples auto|K),

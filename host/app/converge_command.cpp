@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/named_option.h"
 #include "app/render_options.h"
 #include "app/scene_setup.h"
 #include "core/error.h"
@@ -297,6 +298,8 @@ void addConvergeCommand(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "seed");
   cmd->add_option("--dmax", o->dMax, "obscurance dmax (default: the renderer's, half the median free path)")
       ->check(CLI::PositiveNumber);
+  addNamedOption(*cmd, "--escapes", o->escapes, render::kEscapeModelNames,
+                 "obscurance rays that leave the scene: auto, dark or ambient (as render's; default auto)");
   cmd->add_option("--background", o->background, "R,G,B: a constant sky for both methods (as render --background)")
       ->delimiter(',')
       ->expected(3);

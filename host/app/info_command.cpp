@@ -46,11 +46,11 @@ void printScene(const InfoOptions& o) {
   const scene::Camera camera = s.cameras.empty() ? scene::defaultCamera(s.bounds) : s.cameras.front();
   const render::FreePath freePath = render::measureFreePath(s, loaded.bvh, camera);
   fmt::print("bounds: ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g}); default dmax {:.4g} (half the median free "
-             "path {:.4g} seen from the first camera, {:.0f}% of those rays leave the scene; the paper's 1/4 of the "
-             "box: {:.4g})\n",
+             "path {:.4g} seen from the first camera, {:.1f}% of those rays leave the scene; the paper's 1/4 of the "
+             "box: {:.4g}); --escapes auto: {}\n",
              s.bounds.lo.x, s.bounds.lo.y, s.bounds.lo.z, s.bounds.hi.x, s.bounds.hi.y, s.bounds.hi.z,
-             render::defaultDMax(s, loaded.bvh, camera), freePath.median, 100.0 * freePath.escaped,
-             render::boundsDMax(s.bounds));
+             render::defaultDMax(s, freePath), freePath.median, 100.0 * freePath.escaped,
+             render::boundsDMax(s.bounds), freePath.open() ? "dark (rays leave the scene)" : "ambient (closed)");
   const render::LightSet lights = render::buildLightSet(s);
   fmt::print("lights ({}; names for --light and edits):\n", lights.size());
   for (std::size_t i = 0; i < lights.size(); ++i) {

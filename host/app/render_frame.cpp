@@ -152,6 +152,8 @@ RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh
                   {"rho", nameString(render::kRhoKindNames, settings.rho)}, {"tau", settings.tau},
                   {"sampling", nameString(render::kObscuranceSamplingNames, settings.systematic)},
                   {"colour_bleeding", !o.noBleed}, {"max_depth", settings.maxDepth},
+                  {"escapes", nameString(render::kEscapeModelNames, settings.escapes)},
+                  {"dark_escapes", renderer.darkEscapes()},
                   {"vertex_rays", nameString(render::kVertexRaysNames, settings.vertexRaysByThroughput)},
                   {"light_sampling", nameString(render::kLightSamplingNames, settings.lightSampling)},
                   {"ambient", nameString(render::kAmbientModelNames, settings.ambient)},

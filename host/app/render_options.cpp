@@ -85,6 +85,11 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
                  "rays' bounding boxes and shafts may meet the object's old or new place), probe (of those, the ones "
                  "one of whose rays does, found by replaying their rays) or auto (default: probe where the scene has "
                  "glossy surfaces, else bounds)");
+  addNamedOption(cmd, "--escapes", o.obscurance.escapes, render::kEscapeModelNames,
+                 "what an obscurance ray that meets nothing within dmax brings: dark (it is traced on, and if it "
+                 "leaves the scene it brings nothing: outside is only the background, a light of its own), ambient "
+                 "(the paper's R_ave I_a, whatever lies beyond) or auto (default: dark where rays from the camera's "
+                 "surfaces leave the scene, ambient in a closed one, where the extra rays would find a surface)");
   cmd.add_option("--secondary-reflectors", o.obscurance.secondaryReflectors,
                  "T: important secondary reflectors (the paper's future work): surfaces a light lights at least T "
                  "times its mean direct irradiance are marked, and an obscurance ray that lands on one traces the "

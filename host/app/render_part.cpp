@@ -71,6 +71,7 @@ nlohmann::json jobIdentity(const RenderOptions& o) {
     job["dmax"] = o.dMax;
     job["sampling"] = nameString(render::kObscuranceSamplingNames, o.obscurance.systematic);
     job["colour_bleeding"] = !o.noBleed;
+    job["escapes"] = nameString(render::kEscapeModelNames, o.obscurance.escapes);
     job["vertex_rays"] = nameString(render::kVertexRaysNames, o.obscurance.vertexRaysByThroughput);
     job["shadow_sampling"] = nameString(render::kShadowSamplingNames, o.obscurance.shadowSampling);
     job["ambient"] = nameString(render::kAmbientModelNames, o.obscurance.ambient);

@@ -26,6 +26,7 @@ ObscuraFrameResult runObscuraFrame(const gpu::Context& context, const scene::Sce
   settings.rho = render::RhoKind::Sqrt;
   settings.systematic = true;
   settings.colourBleeding = false;
+  settings.escapes = render::EscapeModel::Ambient; // Embree's frame traces to dMax only
   settings.maxDepth = 1; // the primary hit only: no specular pass
   settings.emissionSamples = 1; // the camera rays Embree's frame traces too, no emitter-edge rays
   settings.primaryAovs = false;

@@ -20,8 +20,8 @@ void GeometryRetrace::useBvh(const bvh::Bvh& bvh) {
   bvhNodes_ = bvh.nodes.size();
 }
 
-bool GeometryRetrace::probing(DirtyTest test, bool specular, bool keptEverySample) {
-  return test == DirtyTest::Probe || (test == DirtyTest::Auto && (specular || keptEverySample));
+bool GeometryRetrace::probing(DirtyTest test, bool unbounded, bool keptEverySample) {
+  return test == DirtyTest::Probe || (test == DirtyTest::Auto && (unbounded || keptEverySample));
 }
 
 GeometryRetrace::Result GeometryRetrace::retrace(const Frame& frame, const Edit& edit) {

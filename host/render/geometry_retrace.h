@@ -90,12 +90,13 @@ public:
   // Marks, clears and retraces the pixels `edit` can change, every sample so far.
   Result retrace(const Frame& frame, const Edit& edit);
 
-  // Whether a retrace probes: Probe always, Bounds never, Auto where the frame has specular paths
-  // (a path that left the scene bounds nothing, so the bounds keep most glossy pixels) or keeps
+  // Whether a retrace probes: Probe always, Bounds never, Auto where rays may pass anywhere
+  // (`unbounded`: specular paths, obscurance rays traced on past dMax (EscapeModel); a path that
+  // left the scene bounds nothing, so the bounds keep most of those pixels) or the frame keeps
   // every sample's rays (the probes then draw no light sample: cheaper than the retrace they
   // save). Never after a new light changed how lights are chosen (the replayed rays would not be
   // those traced), nor before a sample.
-  static bool probing(DirtyTest test, bool specular, bool keptEverySample);
+  static bool probing(DirtyTest test, bool unbounded, bool keptEverySample);
 
 private:
   // Every sample so far replayed over the candidates dirty.comp listed, each ray tested against

@@ -85,7 +85,11 @@ ObscuranceRenderer::ObscuranceRenderer(const gpu::Context& context, const scene:
   for (const auto& m : scene.materials) meanAlbedo_.push_back(materialMeanAlbedo(m));
   ambient_ = computeAmbient(scene, lights_, meanAlbedo_, settings.colourBleeding);
   if (settings.ambient != AmbientModel::Global) ambient_.model = settings.ambient;
-  defaultDMax_ = defaultDMax(scene, bvh, settings.camera); // first: the Seen fit needs dmax
+  { // first: the Seen fit needs dmax and the escape model
+    const FreePath freePath = measureFreePath(scene, bvh, settings.camera);
+    defaultDMax_ = defaultDMax(scene, freePath);
+    openScene_ = freePath.open();
+  }
   if (settings.ambient != AmbientModel::Global || settings.secondaryReflectors > 0.0f) {
     useReachRays();
     reach_.measure(scene, bvh, reachInputs(), ambient_);
@@ -120,7 +124,7 @@ SeenView ObscuranceRenderer::seenView() const {
           .aspect = static_cast<float>(settings_.width) / static_cast<float>(std::max(settings_.height, 1u)),
           .dMax = settings_.dMax > 0.0f ? settings_.dMax : defaultDMax_, .rho = static_cast<std::uint32_t>(settings_.rho),
           .tau = settings_.tau, .colourBleeding = settings_.colourBleeding,
-          .averageReflectance = ambient_.averageReflectance};
+          .averageReflectance = ambient_.averageReflectance, .darkEscapes = darkEscapes()};
 }
 
 void ObscuranceRenderer::markReflectors() {
@@ -275,6 +279,7 @@ ShadeSample ObscuranceRenderer::shadeSample(std::uint32_t sample) const {
           .glossyMis = settings_.lightSampling == LightSampling::Spatial &&
                        settings_.shadowSampling == ShadowSampling::Selection && runSpecular_,
           .secondaryReflectors = reflectorsOn(), .vertexRaysByThroughput = settings_.vertexRaysByThroughput,
+          .darkEscapes = darkEscapes(),
           .averageReflectance = ambient_.averageReflectance, .eye = settings_.camera.position,
           .sceneSize = sceneScale_,
           .kappa = ambientShareBeyondFirstBounce(ambient_.averageReflectance,
@@ -466,7 +471,7 @@ std::uint64_t ObscuranceRenderer::retraceDirty(const std::vector<scene::Bounds>&
        .lights = lightCount, .samples = progress().samples, .gbufferSample = progress().gbufferSample, .dMax = dMax_,
        .changedBoxPadding = changedBoxPadding(scene_->bounds), .specular = runSpecular_},
       {.changed = changed, .everyPixel = all, .tracedLight = tracedLight,
-       .probe = GeometryRetrace::probing(settings_.dirtyTest, runSpecular_, keptAll)});
+       .probe = GeometryRetrace::probing(settings_.dirtyTest, runSpecular_ || darkEscapes(), keptAll)});
   progress().primaryRays += r.pixels * progress().samples;
   // The retraced pixels' (and the probed candidates') G-buffer now holds the last sample; the
   // others' still hold theirs.

@@ -49,7 +49,11 @@ void reflectedDirectLight(Surface s, vec3 direction, vec4 u, inout StepBudget bu
 // independent sampling:
 //   W   = 1/pi  int rho(d) cos dw      ~ mean of rho(d_i)              [RTO eq. 2]
 //   W_c = 1/pi  int R(Q) rho(d) cos dw ~ mean of R(Q_i) rho(d_i)        [RTO eq. 6]
-// (the cosine pdf cancels the 1/pi cos factor), R(Q) := R_ave on a miss [SPEC §1.2].
+// (the cosine pdf cancels the 1/pi cos factor), R(Q) := R_ave on a miss [SPEC §1.2]. With
+// kFlagDarkEscapes (OURS) a miss within dMax is traced on, and one that leaves the scene adds
+// nothing to A (rho R(Q) := 0): the ambient model's light comes from the scene's surfaces, and
+// beyond the last of them there are none. `farRays` counts those rays (the caller counts them
+// and marks the pixel's hit bounds: they reach past dMax).
 // Returns (A, W) with A = R(P) W_c (colour bleeding) or R(P) W (grey).
 //
 // With secondary reflectors (`reflectorPixel` a pixel, not kInvalidIndex, and the flag set), a
@@ -60,7 +64,9 @@ void reflectedDirectLight(Surface s, vec3 direction, vec4 u, inout StepBudget bu
 // combine; these shares keep the first bounce from being counted twice and are constants of the
 // render, so I_a stays linear in every emission; secondary_reflectors.h).
 vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, uint reflectorPixel, uint pixelCount,
-                      uint n) {
+                      uint n, out uint farRays) {
+  const bool darkEscapes = (pc.renderFlags & kFlagDarkEscapes) != 0u;
+  farRays = 0u;
   const bool systematic = (pc.renderFlags & kFlagSystematic) != 0u;
   const bool bleed = !kGreyObscurance && (pc.renderFlags & kFlagBleed) != 0u;
   const bool reflectors = kReflectors && reflectorPixel != kInvalidIndex && (pc.renderFlags & kFlagSecondaryReflectors) != 0u;
@@ -115,9 +121,17 @@ vec4 gatherObscurance(ShadingPoint sp, inout uint rng, inout StepBudget budget, 
       } else {
         r = 1.0;
         reflectance = pc.averageReflectance;
+        // Traced on past dMax where rays can leave the scene (kFlagDarkEscapes): one that leaves
+        // it sees the background, which is a light of its own (its direct light is sampled), not
+        // the ambient light between surfaces; a truncated one keeps the ambient.
+        if (darkEscapes) {
+          ++farRays;
+          RayHit far = traceWithBudget(budget, origin, direction, dMax, 1.0 / 0.0, true);
+          if (far.primitive == kInvalidIndex) share = vec3(0.0);
+        }
       }
     }
-    w += r;
+    w += r; // W keeps the paper's meaning (openness within dMax): an escape is open
     wGrey += share * r;
     wc += share * reflectance * r;
   }

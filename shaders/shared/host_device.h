@@ -374,6 +374,10 @@ OBS_CONST uint kFlagSecondaryReflectors = 16u;
 // A specular path's vertices gather with N_s and N_obs scaled by the path's throughput there, at
 // least one ray each (specular.comp, raysAtVertex); without it, N_s and N_obs at every vertex.
 OBS_CONST uint kFlagVertexRaysByThroughput = 32u;
+// An obscurance ray that meets nothing within dMax is traced on (an any-hit ray from dMax): one
+// that leaves the scene brings no ambient light, for what lies outside is the background, a light
+// of its own (lib/obscurance.glsl, gatherObscurance). Set where rays leave the scene (EscapeModel).
+OBS_CONST uint kFlagDarkEscapes = 64u;
 
 OBS_CONST uint kRhoSqrt = 0u;        // rho(d) = sqrt(d / dmax)          [RTO §3, SPEC §1.1]
 OBS_CONST uint kRhoExp = 1u;         // rho(d) = (1 - e^(-tau d/dmax)) / (1 - e^(-tau))
@@ -544,7 +548,8 @@ OBS_CONST uint kBindingPrimaryEmissionBasis = 9; // vec4 pairs [light][pixel]: M
 OBS_CONST uint kBindingPrimaryHitBounds = 10;    // vec4[2 * pixel]: the box of the pixel's primary
                                                  // hits and specular path vertices over samples
                                                  // (min xyz, w = 1 if a specular path left the
-                                                 // scene; max xyz, w = 1 if any sample hit)
+                                                 // scene or an obscurance ray reached past dMax;
+                                                 // max xyz, w = 1 if any sample hit)
 OBS_CONST uint kBindingPrimaryDirty = 11;        // uint[pixel]: 1 = retrace (kPrimaryFlagDirtyOnly)
 OBS_CONST uint kBindingPrimarySampleCounts = 12; // uint[pixel]: the samples in the pixel's sums
                                                  // (restarts at its sample 0, as the sums do);

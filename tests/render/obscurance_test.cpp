@@ -155,6 +155,80 @@ TEST_F(Obscurance, GreyObscuranceTracesTheSameRaysAndLeavesTheColourOut) {
     }
 }
 
+// Dark escapes (EscapeModel): an obscurance ray that misses within dMax is traced on; if it leaves
+// the scene it brings no ambient light, if it meets a surface past dMax it keeps the paper's R_ave.
+TEST_F(Obscurance, ARayThatLeavesTheSceneBringsNoAmbientLight) {
+  SceneBuilder b;
+  b.quad({-kHalfSize, 0, -kHalfSize}, {0, 0, 2 * kHalfSize}, {2 * kHalfSize, 0, 0}, b.lambertian(glm::vec3(0.5f)));
+  b.pointLight({0, 2, 0}, glm::vec3(1.0f), 5.0f); // I_a > 0
+  const scene::Scene s = b.build();
+  auto settings = lookDown(1.0f, 1.0f, 16, 2);
+  settings.obscuranceRays = 8;
+  settings.escapes = render::EscapeModel::Dark;
+  const auto dark = render(s, settings);
+  settings.escapes = render::EscapeModel::Ambient;
+  const auto ambient = render(s, settings);
+  const int w = dark.image.channelIndex("obscurance.Y");
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      ASSERT_EQ(dark.image.at(x, y, w), 1.0f) << "W keeps the paper's openness within dMax";
+      for (int ch = 0; ch < 3; ++ch) {
+        const std::string indirect = std::string("indirect.") + "RGB"[ch];
+        ASSERT_EQ(dark.image.at(x, y, dark.image.channelIndex(indirect)), 0.0f) << x << "," << y;
+        // The paper's: W_c = R_ave on a miss, so the indirect light is R(P) R_ave I_a.
+        const float expected = 0.5f * ambient.ambient.averageReflectance[ch] * ambient.ambientIntensity[ch];
+        ASSERT_GT(expected, 0.0f);
+        ASSERT_NEAR(ambient.image.at(x, y, ambient.image.channelIndex(indirect)), expected, 1e-5f * expected);
+      }
+    }
+}
+
+TEST_F(Obscurance, ARayPastDmaxThatMeetsASurfaceKeepsTheAmbientAndAutoFollowsTheScene) {
+  // Floor under a parallel ceiling 1 above, dMax 0.5: every obscurance ray misses within dMax and
+  // meets the ceiling past it, so dark escapes change nothing (R_ave I_a on every ray), and they
+  // cost one more ray per miss. (A ray can leave only below 0.06 degrees over the horizon, on the
+  // 1000-wide quads: the means are compared, not the pixels.)
+  const scene::Scene slab = slabScene(1.0f, glm::vec3(0.2f, 0.5f, 0.8f));
+  auto settings = lookDown(0.5f, 0.3f, 16, 4);
+  settings.obscuranceRays = 8;
+  settings.dMax = 0.5f;
+  settings.escapes = render::EscapeModel::Dark;
+  const auto dark = render(slab, settings);
+  settings.escapes = render::EscapeModel::Ambient;
+  const auto ambient = render(slab, settings);
+  for (const char* channel : {"indirect.R", "indirect.G", "indirect.B"}) {
+    const double expected = mean(ambient.image, channel);
+    EXPECT_GT(expected, 0.0);
+    EXPECT_NEAR(mean(dark.image, channel), expected, 1e-4 * expected) << channel;
+  }
+  EXPECT_EQ(dark.stats.passes.at("obscurance").rays, 2 * ambient.stats.passes.at("obscurance").rays);
+
+  // Auto: dark where rays from the camera's surfaces leave the scene (the slab's sides, 1000 away,
+  // do not count: none of the free-path rays gets there), ambient in a closed box.
+  const auto resolved = [&](const scene::Scene& scene, const scene::Camera& camera) {
+    render::ObscuranceSettings s;
+    s.width = s.height = 8;
+    s.camera = camera;
+    s.ambient = render::AmbientModel::Global;
+    const bvh::Bvh tree = bvh::build(render::triangleSoup(scene));
+    return render::ObscuranceRenderer(context(), scene, tree, s).darkEscapes();
+  };
+  SceneBuilder box;
+  const auto white = box.lambertian(glm::vec3(0.5f));
+  box.quad({-1, 0, -1}, {0, 0, 2}, {2, 0, 0}, white); // floor, +y
+  box.quad({-1, 2, -1}, {2, 0, 0}, {0, 0, 2}, white); // ceiling, -y
+  box.quad({-1, 0, -1}, {0, 2, 0}, {0, 0, 2}, white); // left, +x
+  box.quad({1, 0, -1}, {0, 0, 2}, {0, 2, 0}, white);  // right, -x
+  box.quad({-1, 0, -1}, {2, 0, 0}, {0, 2, 0}, white); // back, +z
+  const scene::Scene open = box.build();               // no front wall
+  box.quad({-1, 0, 1}, {0, 2, 0}, {2, 0, 0}, white);  // front, -z
+  const scene::Scene closed = box.build();
+  const scene::Camera inside = lookCamera({0, 1, 0.9f}, {0, 0, -1}, {0, 1, 0}, 1.2f);
+  EXPECT_TRUE(resolved(open, inside));
+  EXPECT_FALSE(resolved(closed, inside));
+  EXPECT_FALSE(resolved(slab, lookDown(0.5f, 0.3f, 8, 1).camera));
+}
+
 TEST_F(Obscurance, PointLightOverAPlaneIsExact) {
   SceneBuilder b;
   auto floor = b.lambertian(glm::vec3(0.5f));

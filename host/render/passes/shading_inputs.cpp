@@ -84,7 +84,8 @@ gpu::ShadePush packShadePush(const ShadeSample& sample, const ShadeDispatch& dis
                                     (sample.areaLightSampling ? gpu::kFlagAreaLightSampling : 0u) |
                                     (sample.glossyMis ? gpu::kFlagGlossyMis : 0u) |
                                     (sample.secondaryReflectors ? gpu::kFlagSecondaryReflectors : 0u) |
-                                    (sample.vertexRaysByThroughput ? gpu::kFlagVertexRaysByThroughput : 0u);
+                                    (sample.vertexRaysByThroughput ? gpu::kFlagVertexRaysByThroughput : 0u) |
+                                    (sample.darkEscapes ? gpu::kFlagDarkEscapes : 0u);
   const std::uint32_t dispatchFlags = (dispatch.dirtyOnly ? gpu::kShadeFlagDirtyOnly : 0u) |
                                       (dispatch.oneLight() ? gpu::kShadeFlagPerLight : 0u) |
                                       (dispatch.noDirect ? gpu::kShadeFlagNoDirect : 0u) |

@@ -75,6 +75,7 @@ struct ShadeSample {
   bool glossyMis = false;              // kFlagGlossyMis
   bool secondaryReflectors = false;    // kFlagSecondaryReflectors (with kappa and r below)
   bool vertexRaysByThroughput = true;  // kFlagVertexRaysByThroughput
+  bool darkEscapes = false;            // kFlagDarkEscapes
   glm::vec3 averageReflectance{0.0f};  // R_ave (SPEC §1.2)
   glm::vec3 eye{0.0f};                 // the camera's position
   float sceneSize = 1.0f;              // scales the ray-origin offset (ray.glsl)

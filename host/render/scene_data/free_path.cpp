@@ -57,7 +57,10 @@ FreePath measureFreePath(const scene::Scene& scene, const bvh::Bvh& bvh, const s
 }
 
 float defaultDMax(const scene::Scene& scene, const bvh::Bvh& bvh, const scene::Camera& camera) {
-  FreePath f = measureFreePath(scene, bvh, camera);
+  return defaultDMax(scene, measureFreePath(scene, bvh, camera));
+}
+
+float defaultDMax(const scene::Scene& scene, const FreePath& f) {
   if (f.rays == 0 || !std::isfinite(f.median) || !(f.median > 0.0f)) return boundsDMax(scene.bounds);
   return 0.5f * f.median;
 }

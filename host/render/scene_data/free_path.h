@@ -20,6 +20,8 @@ struct FreePath {
   float median = 0.0f;      // median distance to the next surface (infinite when most rays leave)
   double escaped = 0.0;     // share of the cosine rays that left the scene
   std::uint32_t rays = 0;   // cosine rays traced (camera rays that hit something)
+  // Some rays left the scene: obscurance rays there are traced on past dmax (EscapeModel::Auto).
+  bool open() const { return escaped > 0.0; }
 };
 
 // 48 x 48 camera rays through the image (aspect from the camera, 4:3 when it has none).
@@ -28,6 +30,8 @@ FreePath measureFreePath(const scene::Scene& scene, const bvh::Bvh& bvh, const s
 // Half the median free path seen from `camera`; a quarter of the largest bounding-box extent (the
 // paper's) when the camera sees nothing or most rays leave the scene.
 float defaultDMax(const scene::Scene& scene, const bvh::Bvh& bvh, const scene::Camera& camera);
+// The same from a measurement made already.
+float defaultDMax(const scene::Scene& scene, const FreePath& measured);
 
 // The paper's: a quarter of the largest bounding-box extent.
 float boundsDMax(const scene::Bounds& bounds);

@@ -640,7 +640,8 @@ void ReachedSurfaces::setSeenView(const SeenView& view) {
 }
 
 // The camera's points (a jittered grid), then at each W_c (or W) as obscurance.glsl estimates it
-// (cosine rays of length dmax) and what comes back at all (any distance: the later bounces' q).
+// (cosine rays of length dmax, or unbounded with dark escapes: one that leaves the scene adds
+// nothing) and what comes back at all (any distance: the later bounces' q).
 // Each cell draws from a stream of its own, so that a stage's rays are traced together.
 void ReachedSurfaces::setSeenView(RayBatch& batch, const SeenView& view) {
   seen_.clear();
@@ -674,7 +675,8 @@ void ReachedSurfaces::setSeenView(RayBatch& batch, const SeenView& view) {
       const float u1 = rng.next(), u2 = rng.next();
       bounceRays.push_back({.origin = origin, .direction = cosineDirection(n, u1, u2)});
       const float v1 = rng.next(), v2 = rng.next();
-      obscuranceRays.push_back({.origin = origin, .direction = cosineDirection(n, v1, v2), .tmin = 0.0f, .tmax = view.dMax});
+      obscuranceRays.push_back({.origin = origin, .direction = cosineDirection(n, v1, v2), .tmin = 0.0f,
+                                .tmax = view.darkEscapes ? std::numeric_limits<float>::infinity() : view.dMax});
     }
   }
   const std::vector<bvh::Hit> bounceHits = batch.closest(bounceRays);
@@ -689,9 +691,11 @@ void ReachedSurfaces::setSeenView(RayBatch& batch, const SeenView& view) {
       const bvh::Hit& q = obscuranceHits[i * kSeenObscuranceRays + k];
       glm::vec3 r = view.colourBleeding ? view.averageReflectance : glm::vec3(1.0f);
       float rho = 1.0f;
-      if (q.hit()) {
+      if (q.hit() && q.t < view.dMax) {
         rho = obscuranceRho(q.t, view.dMax, view.rho, view.tau);
         r = view.colourBleeding ? reflectance_[q.primitive] : glm::vec3(1.0f);
+      } else if (!q.hit() && view.darkEscapes) {
+        r = glm::vec3(0.0f); // it left the scene (the closest hit past dmax stands for the shader's any-hit)
       }
       w += glm::dvec3(r) * static_cast<double>(rho);
     }

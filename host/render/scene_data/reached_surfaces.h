@@ -102,6 +102,7 @@ struct SeenView {
   float tau = 3.0f;
   bool colourBleeding = true;
   glm::vec3 averageReflectance{0.5f}; // R(Q) of a miss within dmax
+  bool darkEscapes = false;           // a miss within dmax that leaves the scene brings nothing
   bool operator==(const SeenView&) const = default;
 };
 
