@@ -90,6 +90,7 @@ def render(
     dmax: Optional[float] = None,
     sampling: Optional[Literal["systematic", "random"]] = None,
     no_bleed: bool = False,
+    escapes: Optional[Literal["auto", "dark", "ambient"]] = None,
     ambient: Optional[str] = None,
     light_sampling: Optional[str] = None,
     shadow_sampling: Optional[str] = None,
