@@ -83,8 +83,8 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
   addNamedOption(cmd, "--dirty-test", o.obscurance.dirtyTest, render::kDirtyTestNames,
                  "which pixels a geometry edit (relight --edits: move, remove, insert) retraces: bounds (those whose "
                  "rays' bounding boxes and shafts may meet the object's old or new place), probe (of those, the ones "
-                 "one of whose rays does, found by replaying their rays) or auto (default: probe where the scene has "
-                 "glossy surfaces, else bounds)");
+                 "one of whose rays does, found by replaying their rays) or auto (default: probe where rays may pass "
+                 "anywhere: glossy surfaces' paths, obscurance rays traced past dmax (--escapes); else bounds)");
   addNamedOption(cmd, "--escapes", o.obscurance.escapes, render::kEscapeModelNames,
                  "what an obscurance ray that meets nothing within dmax brings: dark (it is traced on, and if it "
                  "leaves the scene it brings nothing: outside is only the background, a light of its own), ambient "
