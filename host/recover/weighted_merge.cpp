@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "core/luminance.h"
+
 namespace obscura::recover {
 namespace {
-
-float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 bool sameSurface(const PixelGeometry& g, std::size_t p, std::size_t q) {
   return g.object[q] == g.object[p] && glm::dot(g.normal[q], g.normal[p]) >= 0.95f;

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <glm/gtc/packing.hpp>
 
+#include "core/luminance.h"
 #include "gpu/command_stream.h"
 #include "gpu/timestamps.h"
 #include "render/denoise/atrous_pass.h"
@@ -118,8 +119,7 @@ void Denoiser::denoise(const ObscuranceRenderer& renderer, float exposureStops) 
                                         .emitterRays = settings_.emitterEdgeRays,
                                         .lights = static_cast<std::uint32_t>(renderer.lights().size()),
                                         .ownEmissionRays = std::max(rs.emissionSamples, 1u),
-                                        .ambientLuminance = glm::dot(renderer.ambientIntensity(),
-                                                                     glm::vec3(0.2126f, 0.7152f, 0.0722f))};
+                                        .ambientLuminance = luminance(renderer.ambientIntensity())};
   d.stream.submit([&](const vk::raii::CommandBuffer& cmd) {
     d.timestamps.reset(cmd);
     d.timestamps.begin(cmd, "denoise.gather");
