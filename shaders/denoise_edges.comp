@@ -118,6 +118,7 @@ void main() {
   uint rng = rngSeed(p, 0x6564u, 0u); // a fixed pattern per pixel: the same image every call
   const vec2 shift = vec2(rngNext(rng), rngNext(rng));
   StepBudget budget = newStepBudget();
+  const bool resolveShading = n <= 1.0; // beyond one sample the rays bring the emission alone
   vec3 shading = vec3(0.0), emitted = vec3(0.0); // the rays' sums
   uint traced = 0u, mostPasses = 0u;
   for (uint j = 0u; j < rays; ++j) {
@@ -139,21 +140,23 @@ void main() {
       continue;
     }
     const Surface s = surfaceAt(hit, params.camera.origin.xyz, direction);
-    // The neighbour on the ray's surface whose plane it lies nearest (none: the pixel's own light).
-    const uint material = min(s.material, kDenoiseNoMaterial - 1u);
-    vec3 taken = light[4];
-    float bestDistance = 1.0;
-    for (int c = 0; c < 9; ++c) {
-      const Guide gq = guides[c];
-      if (!inside[c] || !guideHit(gq) || gq.material != material || dot(gq.normal, s.shadingNormal) <= kSameSurfaceCos)
-        continue;
-      const float d = planeDistance(points[c], gq.normal, s.position, tolerance[c]);
-      if (d < bestDistance) {
-        bestDistance = d;
-        taken = light[c];
+    if (resolveShading) {
+      // The neighbour on the ray's surface whose plane it lies nearest (none: the pixel's own light).
+      const uint material = min(s.material, kDenoiseNoMaterial - 1u);
+      vec3 taken = light[4];
+      float bestDistance = 1.0;
+      for (int c = 0; c < 9; ++c) {
+        const Guide gq = guides[c];
+        if (!inside[c] || !guideHit(gq) || gq.material != material || dot(gq.normal, s.shadingNormal) <= kSameSurfaceCos)
+          continue;
+        const float d = planeDistance(points[c], gq.normal, s.position, tolerance[c]);
+        if (d < bestDistance) {
+          bestDistance = d;
+          taken = light[c];
+        }
       }
+      shading += taken;
     }
-    shading += taken;
     if (s.lightGroup != kInvalidIndex) {
       const vec3 e = materialEmission(materialAt(s.material), s.uv, s.frontFacing);
       emitted += unitEmission(e, lightScales[s.lightGroup].rgb) * emissions[s.lightGroup].rgb;
@@ -164,7 +167,7 @@ void main() {
   // kept beyond one sample), its seen emission n x the renderer's emission rays per sample.
   const float k = float(traced), ownEmissionPoints = n * float(max(pc.ownEmissionRays, 1u));
   const vec3 ownShading = light[4];
-  const vec3 outShading = n <= 1.0 ? (ownShading + shading) / (1.0 + k) : ownShading;
+  const vec3 outShading = resolveShading ? (ownShading + shading) / (1.0 + k) : ownShading;
   const vec3 outEmission = (ownEmissionPoints * ownEmission + emitted) / (ownEmissionPoints + k);
   combined[pixel] = vec4(outShading + outEmission, 1.0);
 }
