@@ -140,7 +140,7 @@ TEST_F(Denoise, LowersTheErrorAgainstTheConvergedModernHallAt1And4Spp) {
 // image, over the pixels it changed, the same frame denoised with and without it: off the lamp
 // (silhouettes, creases) and on the lamp's border (its coverage times a radiance ~100x the walls').
 // Measured over seeds 5, 6, 7 (Cornell box 96x96, dark escapes): RMSE ratio off the lamp
-// 0.491-0.495, on its border 0.105-0.135, 16 % of the pixels changed. In a 2-spp frame only pixels
+// 0.491-0.495, on its border 0.105-0.135, 17 % of the pixels changed. In a 2-spp frame only pixels
 // next to the lamp change (ratio 0.158, 74 pixels); its geometric edges stay as the filter left them.
 TEST_F(Denoise, EdgePassResolvesEdgePixelsOfOneSampleFramesAndEmitterBordersAtAnyCount) {
   const Loaded l = load(repoPath("scenes/cornell-box/cornell-box.gltf"));
