@@ -110,7 +110,7 @@ void main() {
   // K well-spread points leave a coverage error of about step / K, held to an eighth of I_a. RMSE
   // is a frame's measure, so the scale is the frame's, not the light around the pixel (which
   // gave modern-hall's lamps 8 rays and a 1-spp frame's RMSE 0.101 against 0.088 with 64).
-  // Measured: the Cornell box lamp takes 256 (the most), modern-hall's lamps 16-72.
+  // Measured: the Cornell box lamp takes 256 (the most), modern-hall's lamps 8-57 (median 43).
   const float contrast = emissionStep / max(pc.ambientLuminance, 1e-3);
   const uint emitterRays = uint(clamp(ceil(kEdgeRaysPerContrast * contrast), float(pc.geometryRays), float(pc.emitterRays)));
   const uint rays = emitterEdge ? max(emitterRays, pc.geometryRays) : pc.geometryRays;
