@@ -150,6 +150,48 @@ TEST(ReachedSurfaces, RemeasureAfterAMoveEqualsMeasuringTheMovedScene) {
   EXPECT_NE(stale.rays.firstSeenTry, fresh.rays.firstSeenTry) << "the move changes what some samples see";
 }
 
+// The same for every kind of light, and for a re-measurement of a re-measurement (whose rays are
+// the ones the first replay kept or drew again): the Cornell box with a point light, a spot, the
+// sun and a sky added, cube_2 moved twice. Each replay equals measuring the moved scene afresh,
+// down to the rays it keeps for the next one, while tracing fewer rays than that.
+TEST(ReachedSurfaces, RemeasureOfARemeasureEqualsMeasuringAfreshForEveryKindOfLight) {
+  scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
+  const glm::vec3 centre = 0.5f * (s.bounds.lo + s.bounds.hi), extent = s.bounds.extent();
+  s.punctualLights.push_back({.name = "bulb", .position = centre + glm::vec3(0.2f, 0.3f, 0.1f) * extent});
+  s.punctualLights.push_back({.name = "spot", .type = scene::PunctualType::Spot,
+                              .position = centre + glm::vec3(-0.2f, 0.4f, 0.0f) * extent,
+                              .direction = glm::vec3(0.0f, -1.0f, 0.0f), .outerConeAngle = 0.5f});
+  s.punctualLights.push_back({.name = "sun", .type = scene::PunctualType::Directional,
+                              .direction = glm::normalize(glm::vec3(0.2f, -0.5f, -1.0f))});
+  s.background = glm::vec3(0.2f);
+  bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+  const render::LightSet lights = render::buildLightSet(s);
+  ASSERT_EQ(lights.size(), 5u) << "the ceiling lamp, three punctual lights and the sky";
+  render::ReachedSurfaces reached(s, tree, render::triangleReflectances(s, albedos(s)));
+  std::vector<render::LightReach> previous;
+  for (std::size_t light = 0; light < lights.size(); ++light) previous.push_back(reached.measure(lights, light));
+
+  MovedObject once = moveAndRefit(s, tree, "cube_2", {0.08f * extent.x, 0.0f, 0.0f}, 1e-3f);
+  MovedObject twice = moveAndRefit(once.scene, once.tree, "cube_2", {0.0f, 0.0f, 0.06f * extent.z}, 1e-3f);
+  ASSERT_EQ(twice.scene.bounds.lo, s.bounds.lo) << "the scene's box unchanged: the sun's and sky's rays replay too";
+  ASSERT_EQ(twice.scene.bounds.hi, s.bounds.hi);
+  const render::ReachedSurfaces* before = &reached;
+  render::ReachedSurfaces afterOnce(once.scene, once.tree, render::triangleReflectances(once.scene, albedos(once.scene)));
+  render::ReachedSurfaces afterTwice(twice.scene, twice.tree, render::triangleReflectances(twice.scene, albedos(twice.scene)));
+  for (const auto& [moved, changed] : {std::pair{&afterOnce, &once.changed}, std::pair{&afterTwice, &twice.changed}}) {
+    for (std::size_t light = 0; light < lights.size(); ++light) {
+      SCOPED_TRACE(lights.names[light] + (moved == &afterOnce ? ", first move" : ", second move"));
+      const render::LightReach fresh = moved->measure(lights, light);
+      render::LightReach replayed = moved->remeasure(*before, previous[light], lights, light, *changed);
+      expectReplayEqualsFresh(replayed, fresh);
+      EXPECT_EQ(replayed.reflectance, fresh.reflectance);
+      EXPECT_LT(replayed.rays.traced, fresh.rays.traced) << "the replay traced every ray again";
+      previous[light] = std::move(replayed);
+    }
+    before = moved;
+  }
+}
+
 // The default dmax (render/scene_data/free_path.h), on the same rooms: from inside a closed cube of side
 // 2, half the median free path lies in the paper's 1/4 .. 1/2 of the side; classroom, whose 221 m
 // ground plane makes the paper's 1/4 of the box 55 m, gets a room-sized dmax.

@@ -241,6 +241,15 @@ void expectReplayEqualsFresh(const render::LightReach& replayed, const render::L
   EXPECT_EQ(replayed.escapeDirect, fresh.escapeDirect);
   EXPECT_EQ(replayed.escapeBounce, fresh.escapeBounce);
   EXPECT_EQ(replayed.landedTriangles, fresh.landedTriangles);
+  // The rays kept for the next replay: the same rays (where a try was blocked may differ: any hit
+  // along it will do).
+  ASSERT_EQ(replayed.rays.lightRay.size(), fresh.rays.lightRay.size());
+  for (std::size_t i = 0; i < fresh.rays.lightRay.size(); ++i) {
+    ASSERT_EQ(replayed.rays.lightRay[i].origin, fresh.rays.lightRay[i].origin) << "light ray " << i;
+    ASSERT_EQ(replayed.rays.lightRay[i].direction, fresh.rays.lightRay[i].direction) << "light ray " << i;
+  }
+  EXPECT_EQ(replayed.rays.bounceDirection, fresh.rays.bounceDirection);
+  EXPECT_EQ(replayed.rays.landingTryDraws, fresh.rays.landingTryDraws);
 }
 
 MovedObject moveAndRefit(const scene::Scene& scene, const bvh::Bvh& tree, const std::string& name, glm::vec3 by,

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <numbers>
 #include <limits>
 #include <random>
@@ -26,8 +25,12 @@ public:
   }
   float next() { return static_cast<float>(next64() >> 40) * 0x1p-24f; } // uniform in [0, 1)
   std::uint32_t below(std::uint32_t n) { return static_cast<std::uint32_t>((next64() >> 32) * n >> 32); }
+  // Where the stream stands, to go on from there later (ReachRays::landingTryDraws).
+  std::uint64_t state() const { return state_; }
+  static StreamRng resumed(std::uint64_t state) { return StreamRng(state); }
 
 private:
+  explicit StreamRng(std::uint64_t state) : state_(state) {}
   std::uint64_t next64() {
     std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -146,9 +149,22 @@ float offsetAt(glm::vec3 p, float offset) {
   return std::max(offset, 4e-6f * std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z))));
 }
 
+// `p` moved off its surface (normal `n`) by `offset` (at least offsetAt's) to the side `towards` lies on.
+glm::vec3 offsetToward(glm::vec3 p, glm::vec3 n, glm::vec3 towards, float offset) {
+  const float o = offsetAt(p, offset);
+  return p + (glm::dot(n, towards - p) >= 0.0f ? o : -o) * n;
+}
+
 // Whether the segment origin + t direction, t in [0, tmax] (tmax may be infinite), meets the box:
 // the slab test, an axis the direction runs parallel to tested on the origin alone.
 bool segmentMeetsBox(glm::vec3 origin, glm::vec3 direction, float tmax, const scene::Bounds& box) {
+  // First the segment's own box against it (most of a replay's segments pass far from a moved
+  // object): no division.
+  if (std::isfinite(tmax)) {
+    const glm::vec3 end = origin + tmax * direction;
+    const glm::vec3 lo = glm::min(origin, end), hi = glm::max(origin, end);
+    if (glm::any(glm::lessThan(hi, box.lo)) || glm::any(glm::greaterThan(lo, box.hi))) return false;
+  }
   float t0 = 0.0f, t1 = tmax;
   for (int axis = 0; axis < 3; ++axis) {
     const float o = origin[axis], d = direction[axis];
@@ -215,10 +231,16 @@ struct ReachedSurfaces::Replay {
   const ReachRays& rays;
   const std::vector<scene::Bounds>& changed;
   bool samplesComparable; // the same number of surface samples: sample j before is sample j now
+  bool raysKept;          // `rays` holds the rays themselves (ReachRays::lightRay and the rest)
 
   bool meets(glm::vec3 origin, glm::vec3 direction, float tmax) const {
     for (const scene::Bounds& b : changed)
       if (segmentMeetsBox(origin, direction, tmax, b)) return true;
+    return false;
+  }
+  bool overlaps(const scene::Bounds& box) const {
+    for (const scene::Bounds& b : changed)
+      if (!box.empty() && glm::all(glm::lessThanEqual(box.lo, b.hi)) && glm::all(glm::lessThanEqual(b.lo, box.hi))) return true;
     return false;
   }
 };
@@ -245,7 +267,11 @@ LightReach ReachedSurfaces::remeasure(RayBatch& batch, const ReachedSurfaces& be
   const bool placedByBounds = type == gpu::kLightBackground || type == gpu::kLightDirectional;
   if (placedByBounds && (before.bounds_.lo != bounds_.lo || before.bounds_.hi != bounds_.hi))
     return measure(batch, lights, light);
-  const Replay replay{before, previous.rays, changed, before.samples_.size() == samples_.size()};
+  const ReachRays& kept = previous.rays;
+  const bool raysKept = kept.lightRay.size() == kLightRays && kept.bounceDirection.size() == kLightRays &&
+                        kept.landingTryDraws.size() == before.samples_.size() &&
+                        kept.triedBounds.size() == before.samples_.size();
+  const Replay replay{before, previous.rays, changed, before.samples_.size() == samples_.size(), raysKept};
   return trace(batch, lights, light, &replay);
 }
 
@@ -267,10 +293,10 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   const std::uint32_t seed = lightSeed(lights.names[light]);
   const scene::Scene& scene = *scene_;
   ReachRays& rays = reach.rays;
-  auto offsetToward = [&](glm::vec3 p, glm::vec3 n, glm::vec3 towards) {
-    const float o = offsetAt(p, offset_);
-    return p + (glm::dot(n, towards - p) >= 0.0f ? o : -o) * n;
-  };
+  auto offsetToward = [&](glm::vec3 p, glm::vec3 n, glm::vec3 towards) { return render::offsetToward(p, n, towards, offset_); };
+  // A replay takes the rays from the measurement before where they are the same rays (the same
+  // light, the same surface sample), instead of drawing them again.
+  const bool keptRays = replay && replay->raysKept;
   // The rays of one stage: `ray[i]` belongs to `owner[i]`.
   struct Stage {
     std::vector<bvh::Ray> ray;
@@ -292,18 +318,26 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   std::vector<Landing> landingOf(kLightRays); // by light ray; valid where landingT is finite
   rays.landingT.assign(kLightRays, std::numeric_limits<float>::quiet_NaN());
   rays.landingPrimitive.assign(kLightRays, gpu::kInvalidIndex);
-  std::vector<bvh::Ray> lightRay(kLightRays);
+  std::vector<bvh::Ray>& lightRay = rays.lightRay;
+  lightRay.assign(kLightRays, bvh::Ray{.origin = glm::vec3(0.0f), .direction = glm::vec3(0.0f)});
   std::vector<std::uint8_t> retraced(kLightRays, 0);
   std::uint32_t emitted = 0, landed = 0;
   {
     Stage stage;
     for (std::uint32_t i = 0; i < kLightRays; ++i) {
-      StreamRng rng(seed, Stream::LightRay, i);
-      LightPoint p = samplePoint(lights, light, rng, scene.bounds);
-      glm::vec3 d;
-      if (!emitDirection(lights, light, p, rng, d)) continue;
-      const bvh::Ray ray{.origin = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, p.position + d),
-                         .direction = d};
+      bvh::Ray ray;
+      if (keptRays) {
+        if (std::isnan(replay->rays.landingT[i])) continue; // it emitted nothing before: nor now
+        ray = replay->rays.lightRay[i];
+      } else {
+        StreamRng rng(seed, Stream::LightRay, i);
+        LightPoint p = samplePoint(lights, light, rng, scene.bounds);
+        glm::vec3 direction;
+        if (!emitDirection(lights, light, p, rng, direction)) continue;
+        ray = {.origin = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, p.position + direction),
+               .direction = direction};
+      }
+      const glm::vec3 d = ray.direction;
       lightRay[i] = ray;
       ++emitted;
       const float t = replay ? replay->rays.landingT[i] : 0.0f;
@@ -324,7 +358,8 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
       rays.landingPrimitive[i] = hits[k].hit() ? hits[k].primitive : gpu::kInvalidIndex;
     }
   }
-  std::map<std::uint32_t, std::uint32_t> landedOn; // triangle -> rays
+  std::vector<std::uint32_t> landedOn; // the triangle of every landing
+  landedOn.reserve(kLightRays);
   for (std::uint32_t i = 0; i < kLightRays; ++i) {
     const float t = rays.landingT[i];
     if (!std::isfinite(t)) continue;
@@ -337,9 +372,15 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     landingOf[i] = {lightRay[i].origin + t * d, n, reflectance_[primitive], lightRay[i].origin, d,
                     retraced[i] != 0 && replay != nullptr};
     ++landed;
-    ++landedOn[primitive];
+    landedOn.push_back(primitive);
   }
-  reach.landedTriangles.assign(landedOn.begin(), landedOn.end());
+  std::sort(landedOn.begin(), landedOn.end()); // (triangle, rays) by triangle
+  for (std::size_t i = 0; i < landedOn.size();) {
+    std::size_t end = i;
+    while (end < landedOn.size() && landedOn[end] == landedOn[i]) ++end;
+    reach.landedTriangles.emplace_back(landedOn[i], static_cast<std::uint32_t>(end - i));
+    i = end;
+  }
   reach.landings = landed;
 
   // What leaves the scene: directly (not for a directional light, whose flux counts only what
@@ -347,13 +388,20 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   const bool directional = lights.lights[light].info.x == gpu::kLightDirectional;
   reach.escapeDirect = directional || emitted == 0 ? 0.0 : 1.0 - static_cast<double>(landed) / emitted;
   rays.bounceBlockedAt.assign(kLightRays, kInfinity);
+  rays.bounceDirection.assign(kLightRays, glm::vec3(0.0f));
   {
     Stage stage;
     for (std::uint32_t i = 0; i < kLightRays; ++i) {
       if (!std::isfinite(rays.landingT[i])) continue;
       const Landing& h = landingOf[i];
-      StreamRng rng(seed, Stream::Bounce, i);
-      glm::vec3 d = cosineDirection(h.normal, rng.next(), rng.next());
+      glm::vec3 d;
+      if (keptRays && !h.moved) {
+        d = replay->rays.bounceDirection[i]; // the same landing: the same reflected ray
+      } else {
+        StreamRng rng(seed, Stream::Bounce, i);
+        d = cosineDirection(h.normal, rng.next(), rng.next());
+      }
+      rays.bounceDirection[i] = d;
       bvh::Ray ray{.origin = h.position + offsetAt(h.position, offset_) * h.normal, .direction = d};
       // Blocked at t before: still blocked unless the segment up to there meets a changed box; left
       // the scene: still does unless the whole ray meets one.
@@ -374,90 +422,125 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   // light, then as many landing points (a light ray picked at random; none when it did not land),
   // the first seen deciding. Before an edit, try k of sample j was unseen for k < its first seen
   // try, seen at it, and not traced after it.
-  const gpu::GpuLight& l = lights.lights[light];
-  rays.firstSeenTry.assign(samples_.size(), kNotSeen);
-  rays.tryBlockedAt.assign(samples_.size() * kTries, kNaN);
   // A try's outcome: known from before the edit, or found by its ray.
   enum class Outcome : std::uint8_t { Skipped, Seen, Blocked, Traced };
   struct Try {
     Outcome outcome = Outcome::Skipped;
     float blockedAt = kNaN; // Blocked: where
     std::uint32_t ray = 0;  // Traced: its index in the stage
+    glm::vec3 from{0.0f}, to{0.0f};
   };
-  std::vector<Try> tries(samples_.size() * kTries);
-  std::vector<StreamRng> sampleRng;
-  sampleRng.reserve(samples_.size());
-  auto sameSample = [&](std::size_t j) { return replay && replay->samplesComparable && replay->before.samples_[j] == samples_[j]; };
+  std::vector<std::uint8_t> same(samples_.size(), 0); // sample j is the one before the edit
+  if (replay && replay->samplesComparable)
+    for (std::size_t j = 0; j < samples_.size(); ++j) same[j] = replay->before.samples_[j] == samples_[j];
+  auto sameSample = [&](std::size_t j) { return same[j] != 0; };
+  // A sample of the replay whose tries all find what they found before: the box around their
+  // segments meets no changed box, and no landing one of them aimed at was re-traced (so moved).
+  // Its outcome is copied whole, the tries not looked at one by one (most samples of a move).
+  std::vector<std::uint8_t> kept(samples_.size(), 0);
+  auto keepsItsTries = [&](std::size_t j) {
+    if (replay->overlaps(replay->rays.triedBounds[j])) return false;
+    const std::uint8_t first = replay->rays.firstSeenTry[j];
+    if (first != kNotSeen && first < kVisibilityTries) return true; // no landing tried
+    StreamRng draws = StreamRng::resumed(replay->rays.landingTryDraws[j]);
+    for (std::uint32_t landingTry = 0; landingTry < kVisibilityTries; ++landingTry)
+      if (retraced[draws.below(kLightRays)]) return false;
+    return true;
+  };
+  // The tries of the samples not kept, kTries each from triesOf[j].
+  std::vector<std::uint32_t> triesOf(samples_.size(), 0);
+  std::vector<std::uint32_t> lookedAt; // the samples not kept, in order
+  for (std::size_t j = 0; j < samples_.size(); ++j) {
+    kept[j] = keptRays && sameSample(j) && keepsItsTries(j);
+    if (kept[j]) continue;
+    triesOf[j] = static_cast<std::uint32_t>(kTries * lookedAt.size());
+    lookedAt.push_back(static_cast<std::uint32_t>(j));
+  }
+  const std::size_t looked = lookedAt.size();
+  std::vector<Try> tries(kTries * looked);
   // Try k of sample j, the segment from -> to: seen before and its whole segment clear of the
   // changed boxes, or blocked at t before and its segment up to t clear of them, it finds the
   // same now; otherwise its ray goes into the stage.
   // decided[j]: a try of sample j is known seen, so its later tries cannot matter (not planned).
   std::vector<std::uint8_t> decided(samples_.size(), 0);
   auto plan = [&](Stage& stage, std::size_t j, std::uint32_t k, glm::vec3 from, glm::vec3 to, bool targetMoved) {
-    Try& tr = tries[j * kTries + k];
+    Try& tr = tries[triesOf[j] + k];
     if (decided[j]) return;
     if (sameSample(j) && !targetMoved) {
       const float before = replay->rays.tryBlockedAt[j * kTries + k];
       if (k == replay->rays.firstSeenTry[j] && !replay->meets(from, to - from, 1.0f)) {
-        tr.outcome = Outcome::Seen;
+        tr = {Outcome::Seen, kNaN, 0, from, to};
         decided[j] = 1;
         return;
       }
       if (!std::isnan(before) && !replay->meets(from, to - from, before)) {
-        tr = {Outcome::Blocked, before};
+        tr = {Outcome::Blocked, before, 0, from, to};
         return;
       }
     }
-    tr = {Outcome::Traced, kNaN, static_cast<std::uint32_t>(stage.ray.size())};
+    tr = {Outcome::Traced, kNaN, static_cast<std::uint32_t>(stage.ray.size()), from, to};
     stage.add(static_cast<std::uint32_t>(j), {.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f});
   };
   // Walks tries [first, last) of sample j in order with their stage's results: the first seen
   // decides; the blocked ones before it keep where they were blocked.
   auto decide = [&](std::size_t j, std::uint32_t first, std::uint32_t last, const std::vector<float>& blocked) {
     for (std::uint32_t k = first; k < last; ++k) {
-      const Try& tr = tries[j * kTries + k];
+      const Try& tr = tries[triesOf[j] + k];
       float at = tr.blockedAt;
       if (tr.outcome == Outcome::Skipped) continue;
       if (tr.outcome == Outcome::Traced) at = blocked[tr.ray];
+      scene::Bounds& box = rays.triedBounds[j];
+      box.grow(tr.from);
       if (tr.outcome == Outcome::Seen || std::isinf(at)) {
+        box.grow(tr.to);
         rays.firstSeenTry[j] = static_cast<std::uint8_t>(k);
         return true;
       }
+      box.grow(tr.from + at * (tr.to - tr.from));
       rays.tryBlockedAt[j * kTries + k] = at;
     }
     return false;
   };
   {
     Stage stage; // the tries at points of the light
-    for (std::size_t j = 0; j < samples_.size(); ++j) {
+    if (looked < samples_.size()) {
+      // Most samples kept: their outcomes copied whole, the others' cleared below.
+      rays.firstSeenTry = replay->rays.firstSeenTry;
+      rays.tryBlockedAt = replay->rays.tryBlockedAt;
+      rays.triedBounds = replay->rays.triedBounds;
+      rays.landingTryDraws = replay->rays.landingTryDraws;
+    } else {
+      rays.firstSeenTry.assign(samples_.size(), kNotSeen);
+      rays.tryBlockedAt.assign(samples_.size() * kTries, kNaN);
+      rays.triedBounds.assign(samples_.size(), scene::Bounds{});
+      rays.landingTryDraws.resize(samples_.size());
+    }
+    for (const std::uint32_t j : lookedAt) { // the others are found as before, try by try
+      rays.firstSeenTry[j] = kNotSeen;
+      std::fill_n(&rays.tryBlockedAt[j * kTries], kTries, kNaN);
+      rays.triedBounds[j] = {};
+      // The points on the light drawn again (a few per sample that is not kept).
       const SurfacePoint& s = samples_[j];
-      StreamRng& rng = sampleRng.emplace_back(seed, Stream::Sample, static_cast<std::uint32_t>(j));
+      StreamRng rng(seed, Stream::Sample, static_cast<std::uint32_t>(j));
       for (std::uint32_t k = 0; k < kVisibilityTries; ++k) {
-        LightPoint p = samplePoint(lights, light, rng, scene.bounds);
-        if (p.directional) {
-          glm::vec3 to = s.position - 4.0f * largestExtent(scene.bounds) * p.direction;
-          plan(stage, j, k, offsetToward(s.position, s.normal, to), to, false);
-          continue;
-        }
-        if (p.normal != glm::vec3(0.0f) && !p.twoSided && glm::dot(p.normal, s.position - p.position) <= 0.0f) continue;
-        if (l.info.x == gpu::kLightSpot && glm::dot(glm::normalize(s.position - p.position), glm::vec3(l.direction)) < l.params.w)
-          continue;
-        glm::vec3 target = p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, s.position);
-        plan(stage, j, k, offsetToward(s.position, s.normal, target), target, false);
+        const glm::vec3 target = lightTryTarget(lights, light, s, rng);
+        if (!std::isnan(target.x)) plan(stage, j, k, offsetToward(s.position, s.normal, target), target, false);
       }
+      rays.landingTryDraws[j] = rng.state();
     }
     const std::vector<float> blocked = batch.blockedAt(stage.ray);
     rays.traced += stage.ray.size();
-    for (std::size_t j = 0; j < samples_.size(); ++j) decide(j, 0, kVisibilityTries, blocked);
+    for (const std::uint32_t j : lookedAt) decide(j, 0, kVisibilityTries, blocked);
   }
   if (landed > 0) {
     Stage stage; // the tries at landing points, for the samples the light itself did not see
-    for (std::size_t j = 0; j < samples_.size(); ++j) {
+    for (const std::uint32_t j : lookedAt) {
       if (rays.firstSeenTry[j] != kNotSeen) continue;
       const SurfacePoint& s = samples_[j];
+      StreamRng draws = StreamRng::resumed(rays.landingTryDraws[j]);
       for (std::uint32_t landingTry = 0; landingTry < kVisibilityTries; ++landingTry) {
         const std::uint32_t k = kVisibilityTries + landingTry;
-        const std::uint32_t i = sampleRng[j].below(kLightRays);
+        const std::uint32_t i = draws.below(kLightRays);
         if (!std::isfinite(rays.landingT[i])) continue; // that light ray left the scene
         const Landing& h = landingOf[i];
         if (glm::dot(h.normal, s.position - h.position) <= 0.0f) continue; // behind the lit side
@@ -467,7 +550,7 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     }
     const std::vector<float> blocked = batch.blockedAt(stage.ray);
     rays.traced += stage.ray.size();
-    for (std::size_t j = 0; j < samples_.size(); ++j)
+    for (const std::uint32_t j : lookedAt)
       if (rays.firstSeenTry[j] == kNotSeen) decide(j, kVisibilityTries, kTries, blocked);
   }
   std::size_t reached = 0;
@@ -554,6 +637,17 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     reach.seenFitted = true;
   }
   return reach;
+}
+
+glm::vec3 ReachedSurfaces::lightTryTarget(const LightSet& lights, std::size_t light, const SurfacePoint& sample,
+                                          StreamRng& rng) const {
+  const gpu::GpuLight& l = lights.lights[light];
+  const LightPoint p = samplePoint(lights, light, rng, scene_->bounds);
+  if (p.directional) return sample.position - 4.0f * largestExtent(scene_->bounds) * p.direction; // towards the sun
+  if (p.normal != glm::vec3(0.0f) && !p.twoSided && glm::dot(p.normal, sample.position - p.position) <= 0.0f) return glm::vec3(kNaN);
+  if (l.info.x == gpu::kLightSpot && glm::dot(glm::normalize(sample.position - p.position), glm::vec3(l.direction)) < l.params.w)
+    return glm::vec3(kNaN);
+  return p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, sample.position, offset_);
 }
 
 float ReachedSurfaces::sceneRadius() const {

@@ -70,6 +70,17 @@ struct ReachRays {
                                                  // not traced (skipped, or after the seen one)
   std::uint64_t traced = 0;                      // rays this measurement traced (re-traced ones only
                                                  // for remeasure)
+  // The rays themselves, so that a replay tests each one's segment against the changed boxes
+  // without drawing it again: drawing every light's rays anew was ~90 % of a move's host work
+  // (modern-hall's 13 lights, ~24 ms; BENCHMARKS). ~0.3 MB a light.
+  std::vector<bvh::Ray> lightRay;                // per light ray as emitted (only where landingT is not NaN)
+  std::vector<glm::vec3> bounceDirection;        // per light ray that landed: its reflected ray's direction
+  std::vector<std::uint64_t> landingTryDraws;    // per surface sample: its stream after the light tries,
+                                                 // where the tries at landings draw their light rays
+  std::vector<scene::Bounds> triedBounds;        // per surface sample: the box around the segments of
+                                                 // the tries that decided it (a blocked one up to where
+                                                 // it was blocked); a replay keeps a sample whose box
+                                                 // meets no changed box without looking at its tries
 };
 
 struct LightReach {
@@ -165,6 +176,9 @@ private:
     bool operator==(const SurfacePoint&) const = default;
   };
   struct Replay; // what remeasure reuses
+  // The point a light try of `sample` aims at, drawn from the sample's stream; NaN: none (the
+  // sample is behind the light's point, or outside a spot's cone).
+  glm::vec3 lightTryTarget(const LightSet& lights, std::size_t light, const SurfacePoint& sample, StreamRng& rng) const;
   LightReach trace(RayBatch& rays, const LightSet& lights, std::size_t light, const Replay* replay) const;
   struct Photon { // a landing point as a virtual point light of the Seen fit
     glm::vec3 position, normal, reflectance;
