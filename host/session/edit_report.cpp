@@ -30,7 +30,10 @@ nlohmann::json EditReport::json() const {
                          {"host_ms", hostMs()},
                          {"cpu_ms", cpuMs},
                          {"total_ms", totalMs}};
-  if (bvh) line["bvh"] = {{"kind", bvh->refit ? "refit" : "rebuild"}, {"ms", bvh->ms}};
+  if (bvh) {
+    line["bvh"] = {{"kind", bvh->refit ? "refit" : "rebuild"}, {"ms", bvh->ms}};
+    if (bvh->refit) line["bvh"]["nodes"] = bvh->nodes;
+  }
   if (reach) line["reach"] = {{"rays", reach->rays}, {"ms", reach->ms}};
   return line;
 }

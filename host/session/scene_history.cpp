@@ -12,6 +12,7 @@ SceneHistory::SceneHistory(scene::Scene scene, bvh::Bvh bvh, bvh::BuildOptions r
     : rebuildOptions_(rebuildOptions) {
   scenes_.push_back(std::move(scene));
   trees_.push_back(std::move(bvh));
+  refitter_.emplace(trees_.back());
 }
 
 GeometryChange SceneHistory::apply(const Edit& e, const std::string& where) {
@@ -40,10 +41,23 @@ GeometryChange SceneHistory::apply(const Edit& e, const std::string& where) {
   change.bvh.refit = e.kind == Kind::Move || e.kind == Kind::Remove;
   bvh::Bvh tree;
   if (change.bvh.refit) {
+    // The object's triangles only (they have vertices of their own): the nodes above them.
+    const scene::SceneObject& object = next.objects[change.object];
+    std::vector<std::uint32_t> ids(object.triangleCount);
+    bvh::TriangleSoup moved;
+    for (std::uint32_t k = 0; k < object.triangleCount; ++k) {
+      const std::uint32_t id = object.firstTriangle + k;
+      const glm::uvec3& t = next.triangles[id];
+      ids[k] = id;
+      moved.v0.push_back(next.positions[t.x]);
+      moved.v1.push_back(next.positions[t.y]);
+      moved.v2.push_back(next.positions[t.z]);
+    }
     tree = trees_.back();
-    bvh::refit(tree, render::triangleSoup(next));
+    change.bvh.nodes = refitter_->refit(tree, ids, moved).size();
   } else {
     tree = bvh::build(render::triangleSoup(next), rebuildOptions_);
+    refitter_.emplace(tree);
   }
   change.bvh.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   scenes_.push_back(std::move(next));

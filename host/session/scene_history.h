@@ -1,23 +1,26 @@
 // scene_history.h — the scene being edited and its BVH, one version per geometry edit, and the
 // choice of how the BVH follows an edit: a move or a removal keeps every triangle, so the tree is
-// refitted (bvh/refit.cpp); an insert or an emissive quad adds triangles, so it is rebuilt with
-// the options the device's traversal wants (render/scene_data/bvh_layout.h). A renderer holds
-// pointers to the newest version; the one before stays until dropPrevious(), once the renderer
-// has moved on to the new one.
+// refitted, above the object's triangles only (bvh/incremental_refit.h); an insert or an emissive
+// quad adds triangles, so it is rebuilt with the options the device's traversal wants
+// (render/scene_data/bvh_layout.h). A renderer holds pointers to the newest version; the one
+// before stays until dropPrevious(), once the renderer has moved on to the new one.
 #pragma once
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "bvh/bvh.h"
+#include "bvh/incremental_refit.h"
 #include "scene/scene.h"
 #include "session/edit.h"
 
 namespace obscura::session {
 
 struct BvhUpdate {
-  bool refit = false; // refitted (true) or rebuilt
-  double ms = 0.0;    // host wall time of the update
+  bool refit = false;     // refitted (true) or rebuilt
+  double ms = 0.0;        // host wall time of the update
+  std::size_t nodes = 0;  // refitted: the nodes above the object's triangles (bvh/incremental_refit.h)
 };
 
 // What a geometry edit changed.
@@ -45,6 +48,7 @@ private:
   std::deque<scene::Scene> scenes_; // a deque: its elements stay where they are as it grows
   std::deque<bvh::Bvh> trees_;
   bvh::BuildOptions rebuildOptions_;
+  std::optional<bvh::IncrementalRefit> refitter_; // for trees_.back()
 };
 
 } // namespace obscura::session
