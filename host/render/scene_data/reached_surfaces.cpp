@@ -83,8 +83,12 @@ LightPoint samplePoint(const LightSet& lights, std::size_t s, StreamRng& rng, co
   LightPoint p;
   if (l.info.x == gpu::kLightArea) {
     float u = uni(rng);
-    std::uint32_t first = l.info.y, count = l.info.z, e = first;
-    while (e + 1 < first + count && lights.emitters[e].v0.w <= u) ++e;
+    // The first emitter whose cumulative share (v0.w) exceeds u, else the last: a light group may
+    // hold thousands of triangles.
+    const std::uint32_t first = l.info.y, count = l.info.z;
+    const auto begin = lights.emitters.begin() + first, last = begin + (count - 1);
+    const std::uint32_t e = first + static_cast<std::uint32_t>(
+        std::upper_bound(begin, last, u, [](float x, const gpu::GpuEmitter& em) { return x < em.v0.w; }) - begin);
     const auto& em = lights.emitters[e];
     float r = std::sqrt(uni(rng)), v = uni(rng);
     glm::vec3 a(em.v0), b(em.v1), c(em.v2);
@@ -229,6 +233,7 @@ ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh,
 struct ReachedSurfaces::Replay {
   const ReachedSurfaces& before;
   const ReachRays& rays;
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>>& landedTriangles;
   const std::vector<scene::Bounds>& changed;
   bool samplesComparable; // the same number of surface samples: sample j before is sample j now
   bool raysKept;          // `rays` holds the rays themselves (ReachRays::lightRay and the rest)
@@ -271,7 +276,7 @@ LightReach ReachedSurfaces::remeasure(RayBatch& batch, const ReachedSurfaces& be
   const bool raysKept = kept.lightRay.size() == kLightRays && kept.bounceDirection.size() == kLightRays &&
                         kept.landingTryDraws.size() == before.samples_.size() &&
                         kept.triedBounds.size() == before.samples_.size();
-  const Replay replay{before, previous.rays, changed, before.samples_.size() == samples_.size(), raysKept};
+  const Replay replay{before, previous.rays, previous.landedTriangles, changed, before.samples_.size() == samples_.size(), raysKept};
   return trace(batch, lights, light, &replay);
 }
 
@@ -374,6 +379,9 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     ++landed;
     landedOn.push_back(primitive);
   }
+  const bool sameLandings = replay && std::find(retraced.begin(), retraced.end(), 1) == retraced.end();
+  if (sameLandings) landedOn.clear(); // the same triangles as before
+  reach.landedTriangles = sameLandings ? replay->landedTriangles : decltype(reach.landedTriangles){};
   std::sort(landedOn.begin(), landedOn.end()); // (triangle, rays) by triangle
   for (std::size_t i = 0; i < landedOn.size();) {
     std::size_t end = i;
