@@ -154,7 +154,7 @@ float offsetAt(glm::vec3 p, float offset) {
 }
 
 // `p` moved off its surface (normal `n`) by `offset` (at least offsetAt's) to the side `towards` lies on.
-glm::vec3 offsetToward(glm::vec3 p, glm::vec3 n, glm::vec3 towards, float offset) {
+[[gnu::always_inline]] inline glm::vec3 offsetToward(glm::vec3 p, glm::vec3 n, glm::vec3 towards, float offset) {
   const float o = offsetAt(p, offset);
   return p + (glm::dot(n, towards - p) >= 0.0f ? o : -o) * n;
 }
@@ -436,7 +436,6 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     Outcome outcome = Outcome::Skipped;
     float blockedAt = kNaN; // Blocked: where
     std::uint32_t ray = 0;  // Traced: its index in the stage
-    glm::vec3 from{0.0f}, to{0.0f};
   };
   std::vector<std::uint8_t> same(samples_.size(), 0); // sample j is the one before the edit
   if (replay && replay->samplesComparable)
@@ -471,40 +470,51 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   // same now; otherwise its ray goes into the stage.
   // decided[j]: a try of sample j is known seen, so its later tries cannot matter (not planned).
   std::vector<std::uint8_t> decided(samples_.size(), 0);
+  // A try found as before goes into the sample's triedBounds now (should an earlier try turn out
+  // seen, the box is only larger than it need be); a traced one when it is decided.
   auto plan = [&](Stage& stage, std::size_t j, std::uint32_t k, glm::vec3 from, glm::vec3 to, bool targetMoved) {
     Try& tr = tries[triesOf[j] + k];
     if (decided[j]) return;
     if (sameSample(j) && !targetMoved) {
       const float before = replay->rays.tryBlockedAt[j * kTries + k];
       if (k == replay->rays.firstSeenTry[j] && !replay->meets(from, to - from, 1.0f)) {
-        tr = {Outcome::Seen, kNaN, 0, from, to};
+        tr = {Outcome::Seen, kNaN, 0};
+        rays.triedBounds[j].grow(from);
+        rays.triedBounds[j].grow(to);
         decided[j] = 1;
         return;
       }
       if (!std::isnan(before) && !replay->meets(from, to - from, before)) {
-        tr = {Outcome::Blocked, before, 0, from, to};
+        tr = {Outcome::Blocked, before, 0};
+        rays.triedBounds[j].grow(from);
+        rays.triedBounds[j].grow(from + before * (to - from));
         return;
       }
     }
-    tr = {Outcome::Traced, kNaN, static_cast<std::uint32_t>(stage.ray.size()), from, to};
+    tr = {Outcome::Traced, kNaN, static_cast<std::uint32_t>(stage.ray.size())};
     stage.add(static_cast<std::uint32_t>(j), {.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f});
   };
   // Walks tries [first, last) of sample j in order with their stage's results: the first seen
   // decides; the blocked ones before it keep where they were blocked.
-  auto decide = [&](std::size_t j, std::uint32_t first, std::uint32_t last, const std::vector<float>& blocked) {
+  auto decide = [&](std::size_t j, std::uint32_t first, std::uint32_t last, const Stage& stage,
+                    const std::vector<float>& blocked) {
+    scene::Bounds& box = rays.triedBounds[j];
     for (std::uint32_t k = first; k < last; ++k) {
       const Try& tr = tries[triesOf[j] + k];
       float at = tr.blockedAt;
       if (tr.outcome == Outcome::Skipped) continue;
-      if (tr.outcome == Outcome::Traced) at = blocked[tr.ray];
-      scene::Bounds& box = rays.triedBounds[j];
-      box.grow(tr.from);
-      if (tr.outcome == Outcome::Seen || std::isinf(at)) {
-        box.grow(tr.to);
+      const bool traced = tr.outcome == Outcome::Traced;
+      if (traced) at = blocked[tr.ray];
+      const bool seen = tr.outcome == Outcome::Seen || std::isinf(at);
+      if (traced) { // its segment, up to where it was blocked
+        const bvh::Ray& ray = stage.ray[tr.ray];
+        box.grow(ray.origin);
+        box.grow(ray.origin + (seen ? 1.0f : at) * ray.direction);
+      }
+      if (seen) {
         rays.firstSeenTry[j] = static_cast<std::uint8_t>(k);
         return true;
       }
-      box.grow(tr.from + at * (tr.to - tr.from));
       rays.tryBlockedAt[j * kTries + k] = at;
     }
     return false;
@@ -538,7 +548,7 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     }
     const std::vector<float> blocked = batch.blockedAt(stage.ray);
     rays.traced += stage.ray.size();
-    for (const std::uint32_t j : lookedAt) decide(j, 0, kVisibilityTries, blocked);
+    for (const std::uint32_t j : lookedAt) decide(j, 0, kVisibilityTries, stage, blocked);
   }
   if (landed > 0) {
     Stage stage; // the tries at landing points, for the samples the light itself did not see
@@ -559,7 +569,7 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     const std::vector<float> blocked = batch.blockedAt(stage.ray);
     rays.traced += stage.ray.size();
     for (const std::uint32_t j : lookedAt)
-      if (rays.firstSeenTry[j] == kNotSeen) decide(j, kVisibilityTries, kTries, blocked);
+      if (rays.firstSeenTry[j] == kNotSeen) decide(j, kVisibilityTries, kTries, stage, blocked);
   }
   std::size_t reached = 0;
   glm::dvec3 reflectance(0.0);
