@@ -91,13 +91,18 @@ LightReachModel::Measurement LightReachModel::measurementOf(const scene::Scene& 
                                                             const std::vector<scene::Bounds>* changed) {
   const auto start = Clock::now();
   Measurement m;
-  // Every triangle's mean reflectance: a move or a removal keeps them; an insert brings its own
-  // (with the textures' means kept: averaging modern-hall's takes ~0.25 s).
+  // Every triangle's mean reflectance: a move or a removal keeps them; an insert or a quad brings
+  // its own (with the textures' means kept: averaging modern-hall's takes ~0.25 s).
+  bool replayable = changed && reached_;
   if (!changed || reflectance_.size() != scene.triangles.size()) {
     std::vector<glm::vec3> meanAlbedo;
     for (const auto& material : scene.materials) meanAlbedo.push_back(materialMeanAlbedo(material));
     textureMeans_ = textureMeanColours(scene, std::move(textureMeans_));
     m.reflectance = triangleReflectances(scene, meanAlbedo, textureMeans_);
+    // Triangles appended (a quad, an inserted object) and the others as they were: the rays before
+    // still say what they found (surface samples are drawn triangle by triangle).
+    replayable = replayable && m.reflectance.size() >= reflectance_.size() &&
+                 std::equal(reflectance_.begin(), reflectance_.end(), m.reflectance.begin());
   } else {
     m.reflectance = reflectance_;
   }
@@ -107,11 +112,11 @@ LightReachModel::Measurement LightReachModel::measurementOf(const scene::Scene& 
     else m.reached->setSeenView(*seen);
   }
   std::vector<scene::Bounds> padded;
-  if (changed && reached_) {
+  if (replayable) {
     const float pad = changedBoxPadding(scene.bounds);
     for (scene::Bounds b : *changed) padded.push_back({b.lo - pad, b.hi + pad});
   }
-  m.reach = reachOfEveryLight(*m.reached, lights, changed ? reached_.get() : nullptr, previous, padded);
+  m.reach = reachOfEveryLight(*m.reached, lights, replayable ? reached_.get() : nullptr, previous, padded);
   for (const LightReach& r : m.reach) m.update.rays += r.rays.traced;
   m.update.ms = msSince(start); // the reflectances and surface samples included
   return m;

@@ -440,11 +440,12 @@ bool ObscuranceRenderer::replaceScene(const scene::Scene& edited, const bvh::Bvh
   } else if (reachRays_ && rebind) {
     reachRays_->rebind();
   }
-  // Moved occluders change what every light reaches: where the emitters and surfaces stayed, only
+  // Moved or added occluders change what every light reaches: where the emitters stayed and the
+  // surfaces before the edit are as they were (LightReachModel checks their reflectances), only
   // the rays that meet the changed boxes are traced again (on the device, through the buffers
   // just updated).
   if (reach_.measured()) {
-    const std::vector<scene::Bounds>* boxes = emittersMoved || !sameSurfaces ? nullptr : changed;
+    const std::vector<scene::Bounds>* boxes = emittersMoved ? nullptr : changed;
     if (reflectorsOn()) {
       reach_.measure(edited, bvh, reachInputs(), ambient_, boxes); // markReflectors below needs it
     } else {
@@ -789,7 +790,7 @@ std::uint64_t ObscuranceRenderer::addEmitter(const scene::Scene& edited, const b
   updateAmbientWeights(ambient_, lights_, settings_.colourBleeding);
   // The quad is geometry too: replaceScene uploads it, measures what every light reaches anew,
   // and the pixels it can change are retraced for every light (the new one included).
-  const bool everyPixel = replaceScene(edited, bvh, nullptr);
+  const bool everyPixel = replaceScene(edited, bvh, &changed);
   std::uint64_t retraced = 0;
   if (reflectorsOn()) {
     retraceAll();

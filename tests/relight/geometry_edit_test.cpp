@@ -124,7 +124,9 @@ protected:
         if (std::bit_cast<std::uint32_t>(old.at(x, y, direct)) != std::bit_cast<std::uint32_t>(moved.at(x, y, direct)) ||
             old.at(x, y, old.channelIndex("obscurance.Y")) != moved.at(x, y, moved.channelIndex("obscurance.Y")))
           ++changed;
-    if (directOrObscuranceChange_) EXPECT_GT(changed, 0u);
+    if (directOrObscuranceChange_) {
+      EXPECT_GT(changed, 0u);
+    }
     EXPECT_LE(changed, retraced);
     old_ = old;
     moved_ = moved;

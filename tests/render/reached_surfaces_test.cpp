@@ -192,6 +192,71 @@ TEST(ReachedSurfaces, RemeasureOfARemeasureEqualsMeasuringAfreshForEveryKindOfLi
   }
 }
 
+// An added emissive quad is an occluder too: the lights before it re-measured from their rays
+// before (the surface samples drawn triangle by triangle keep their places when triangles are
+// appended) equal a fresh measurement of the edited scene, tracing fewer rays. The quad, under
+// the Cornell box's ceiling, shades part of the room from the ceiling lamp.
+TEST(ReachedSurfaces, RemeasureAfterAnAddedQuadEqualsMeasuringTheEditedScene) {
+  scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
+  const glm::vec3 centre = 0.5f * (s.bounds.lo + s.bounds.hi), extent = s.bounds.extent();
+  s.punctualLights.push_back({.name = "bulb", .position = centre + glm::vec3(0.2f, 0.3f, 0.1f) * extent});
+  bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+  const render::LightSet lights = render::buildLightSet(s);
+  render::ReachedSurfaces reached(s, tree, render::triangleReflectances(s, albedos(s)));
+  std::vector<render::LightReach> before;
+  for (std::size_t light = 0; light < lights.size(); ++light) before.push_back(reached.measure(lights, light));
+
+  scene::Scene edited = s;
+  const glm::vec3 corner = centre + glm::vec3(-0.15f, 0.3f, -0.15f) * extent;
+  const std::size_t quad = scene::insertEmissiveQuad(
+      edited, {.name = "panel", .corner = corner, .edge1 = {0.3f * extent.x, 0, 0}, .edge2 = {0, 0, 0.3f * extent.z},
+               .emission = glm::vec3(2.0f)});
+  scene::Bounds box = scene::objectBounds(edited, quad);
+  const float pad = render::changedBoxPadding(edited.bounds);
+  const std::vector<scene::Bounds> changed{{box.lo - pad, box.hi + pad}};
+  const bvh::Bvh editedTree = bvh::build(render::triangleSoup(edited));
+  render::ReachedSurfaces after(edited, editedTree, render::triangleReflectances(edited, albedos(edited)));
+  const auto triangles = static_cast<std::uint32_t>(s.triangles.size());
+  // The quad takes its share of the samples (1.5 % of this small room's area): the triangles before
+  // it lose as many, where their count crossed its rounding; the rest stay.
+  const double kept = static_cast<double>(reached.surfaceSamples()) * reached.totalArea() / after.totalArea();
+  const double lost = static_cast<double>(reached.surfaceSamples()) - kept;
+  EXPECT_NEAR(static_cast<double>(after.samplesOn(0, triangles)), kept, 4.0 * std::sqrt(lost) + 2.0);
+  EXPECT_GT(after.samplesOn(triangles, 2), 0u) << "the quad's own";
+  for (std::size_t light = 0; light < lights.size(); ++light) { // the lights before the quad
+    SCOPED_TRACE(lights.names[light]);
+    const render::LightReach fresh = after.measure(lights, light);
+    const render::LightReach replayed = after.remeasure(reached, before[light], lights, light, changed);
+    expectReplayEqualsFresh(replayed, fresh);
+    EXPECT_EQ(replayed.reflectance, fresh.reflectance);
+    EXPECT_LT(replayed.rays.traced, fresh.rays.traced / 2) << "the replay re-traced most rays";
+    EXPECT_NE(fresh.area, before[light].area) << "the quad shades nothing: the test could not see it left out";
+  }
+}
+
+// The surface samples are kSurfaceSamples in expectation, uniform by area: on the Cornell box the
+// count within 4 sigma of a Poisson count (at most that spread: the per-triangle rounding is
+// less noisy), and each wall's share within 4 sigma of its share of the area.
+TEST(ReachedSurfaces, SurfaceSamplesAreUniformByArea) {
+  const scene::Scene s = scene::loadGltf(repoPath("scenes/cornell-box/cornell-box.gltf"));
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(s));
+  const render::ReachedSurfaces reached(s, tree, render::triangleReflectances(s, albedos(s)));
+  const double n = render::ReachedSurfaces::kSurfaceSamples;
+  EXPECT_NEAR(static_cast<double>(reached.surfaceSamples()), n, 4.0 * std::sqrt(n));
+  for (std::size_t object = 0; object < s.objects.size(); ++object) {
+    const scene::SceneObject& o = s.objects[object];
+    double area = 0.0;
+    for (std::uint32_t t = o.firstTriangle; t < o.firstTriangle + o.triangleCount; ++t) {
+      const glm::uvec3 tri = s.triangles[t];
+      area += 0.5 * glm::length(glm::cross(glm::dvec3(s.positions[tri.y] - s.positions[tri.x]),
+                                           glm::dvec3(s.positions[tri.z] - s.positions[tri.x])));
+    }
+    const double expected = n * area / reached.totalArea();
+    EXPECT_NEAR(static_cast<double>(reached.samplesOn(o.firstTriangle, o.triangleCount)), expected,
+                4.0 * std::sqrt(expected) + 1.0) << o.name;
+  }
+}
+
 // The default dmax (render/scene_data/free_path.h), on the same rooms: from inside a closed cube of side
 // 2, half the median free path lies in the paper's 1/4 .. 1/2 of the side; classroom, whose 221 m
 // ground plane makes the paper's 1/4 of the box 55 m, gets a room-sized dmax.

@@ -13,7 +13,7 @@
 namespace obscura::render {
 
 // The streams of a light's measurement: one per ray (or per surface sample, whose tries share it).
-enum class Stream : std::uint32_t { LightRay = 1, Bounce = 2, Sample = 3, Seen = 4, SeenGrid = 5 };
+enum class Stream : std::uint32_t { LightRay = 1, Bounce = 2, Sample = 3, Seen = 4, SeenGrid = 5, SampleCount = 6, SamplePoint = 7 };
 
 // A counter-based generator (splitmix64, Steele, Lea & Flood 2014) for one stream: cheap to start
 // at any (light, stream, index), so that every ray has numbers of its own.
@@ -206,27 +206,48 @@ ReachedSurfaces::ReachedSurfaces(const scene::Scene& scene, const bvh::Bvh& bvh,
     : scene_(&scene), bvhCopy_(copyBvh ? std::optional<bvh::Bvh>(bvh) : std::nullopt),
       callersBvh_(&bvh), reflectance_(reflectance), bounds_(scene.bounds),
       offset_(1e-5f * largestExtent(scene.bounds)) {
-  std::vector<double> cdf;
-  cdf.reserve(scene.triangles.size());
-  for (const auto& t : scene.triangles) {
-    glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
-    totalArea_ += 0.5 * glm::length(glm::cross(b - a, c - a));
-    cdf.push_back(totalArea_);
+  std::vector<double> area(scene.triangles.size());
+  for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+    const glm::uvec3 tri = scene.triangles[t];
+    glm::dvec3 a(scene.positions[tri.x]), b(scene.positions[tri.y]), c(scene.positions[tri.z]);
+    area[t] = 0.5 * glm::length(glm::cross(b - a, c - a));
+    totalArea_ += area[t];
   }
   if (!(totalArea_ > 0.0)) return;
-  std::mt19937 rng(0x5eed);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  for (std::uint32_t i = 0; i < kSurfaceSamples; ++i) {
-    auto it = std::upper_bound(cdf.begin(), cdf.end(), uni(rng) * totalArea_);
-    std::size_t t = std::min<std::size_t>(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
+  // Uniform by area, kSurfaceSamples in expectation, drawn triangle by triangle: triangle t gets
+  // floor(N a_t / A + xi_t) points (xi_t its own uniform number), point k of it at barycentrics of
+  // its own. So an edit that appends triangles (a quad, an inserted object), or moves some, leaves
+  // nearly every point where it was (only triangles whose count crosses its xi_t gain or lose one),
+  // and the points keep their numbers: a re-measurement matches them by (t, k) (remeasure).
+  for (std::uint32_t t = 0; t < scene.triangles.size(); ++t) {
+    const double expected = static_cast<double>(kSurfaceSamples) * area[t] / totalArea_;
+    const auto count = static_cast<std::uint32_t>(expected + StreamRng(0x5eedu, Stream::SampleCount, t).next());
+    if (count == 0) continue;
     const glm::uvec3 tri = scene.triangles[t];
     glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
-    float r = static_cast<float>(std::sqrt(uni(rng))), v = static_cast<float>(uni(rng));
     glm::vec3 n = glm::cross(b - a, c - a);
-    float len = glm::length(n);
+    const float len = glm::length(n);
     if (!(len > 0.0f)) continue;
-    samples_.push_back({(1.0f - r) * a + r * (1.0f - v) * b + r * v * c, n / len, reflectance[t]});
+    for (std::uint32_t k = 0; k < count; ++k) {
+      const std::uint64_t key = std::uint64_t{t} << 32 | k;
+      StreamRng rng(0x5eedu, Stream::SamplePoint, sampleStream(key));
+      const float r = std::sqrt(rng.next()), v = rng.next();
+      samples_.push_back({(1.0f - r) * a + r * (1.0f - v) * b + r * v * c, n / len, reflectance[t]});
+      sampleKeys_.push_back(key);
+    }
   }
+}
+
+std::size_t ReachedSurfaces::samplesOn(std::uint32_t first, std::uint32_t count) const {
+  const auto lo = std::lower_bound(sampleKeys_.begin(), sampleKeys_.end(), std::uint64_t{first} << 32);
+  const auto hi = std::lower_bound(sampleKeys_.begin(), sampleKeys_.end(), std::uint64_t{first + count} << 32);
+  return static_cast<std::size_t>(hi - lo);
+}
+
+std::uint32_t ReachedSurfaces::sampleStream(std::uint64_t key) {
+  std::uint64_t z = key * 0x9e3779b97f4a7c15ull; // a 32-bit stream index of its own for each (t, k)
+  z = (z ^ (z >> 31)) * 0xbf58476d1ce4e5b9ull;
+  return static_cast<std::uint32_t>(z ^ (z >> 29));
 }
 
 // What remeasure reuses: the measurement before the edit and the boxes the edit changed.
@@ -235,7 +256,9 @@ struct ReachedSurfaces::Replay {
   const ReachRays& rays;
   const std::vector<std::pair<std::uint32_t, std::uint32_t>>& landedTriangles;
   const std::vector<scene::Bounds>& changed;
-  bool samplesComparable; // the same number of surface samples: sample j before is sample j now
+  std::vector<std::uint32_t> sampleBefore; // per surface sample: the same (t, k) before the edit, or kNone
+  bool samplesInPlace;                     // sampleBefore[j] == j for every sample, and as many before
+  static constexpr std::uint32_t kNone = ~0u;
   bool raysKept;          // `rays` holds the rays themselves (ReachRays::lightRay and the rest)
 
   bool meets(glm::vec3 origin, glm::vec3 direction, float tmax) const {
@@ -276,7 +299,16 @@ LightReach ReachedSurfaces::remeasure(RayBatch& batch, const ReachedSurfaces& be
   const bool raysKept = kept.lightRay.size() == kLightRays && kept.bounceDirection.size() == kLightRays &&
                         kept.landingTryDraws.size() == before.samples_.size() &&
                         kept.triedBounds.size() == before.samples_.size();
-  const Replay replay{before, previous.rays, previous.landedTriangles, changed, before.samples_.size() == samples_.size(), raysKept};
+  Replay replay{before, previous.rays, previous.landedTriangles, changed, {}, false, raysKept};
+  // The points matched by their keys (both sorted): an edit that added or moved triangles leaves
+  // most where they were, under other indices after the first triangle whose count changed.
+  replay.sampleBefore.assign(samples_.size(), Replay::kNone);
+  for (std::size_t j = 0, i = 0; j < samples_.size(); ++j) {
+    while (i < before.sampleKeys_.size() && before.sampleKeys_[i] < sampleKeys_[j]) ++i;
+    if (i < before.sampleKeys_.size() && before.sampleKeys_[i] == sampleKeys_[j]) replay.sampleBefore[j] = static_cast<std::uint32_t>(i);
+  }
+  replay.samplesInPlace = before.samples_.size() == samples_.size();
+  for (std::size_t j = 0; replay.samplesInPlace && j < samples_.size(); ++j) replay.samplesInPlace = replay.sampleBefore[j] == j;
   return trace(batch, lights, light, &replay);
 }
 
@@ -437,19 +469,23 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     float blockedAt = kNaN; // Blocked: where
     std::uint32_t ray = 0;  // Traced: its index in the stage
   };
-  std::vector<std::uint8_t> same(samples_.size(), 0); // sample j is the one before the edit
-  if (replay && replay->samplesComparable)
-    for (std::size_t j = 0; j < samples_.size(); ++j) same[j] = replay->before.samples_[j] == samples_[j];
+  std::vector<std::uint8_t> same(samples_.size(), 0); // sample j is where it was before the edit
+  if (replay)
+    for (std::size_t j = 0; j < samples_.size(); ++j) {
+      const std::uint32_t i = replay->sampleBefore[j];
+      same[j] = i != Replay::kNone && replay->before.samples_[i] == samples_[j];
+    }
   auto sameSample = [&](std::size_t j) { return same[j] != 0; };
+  auto was = [&](std::size_t j) { return replay->sampleBefore[j]; }; // its index before (sameSample)
   // A sample of the replay whose tries all find what they found before: the box around their
   // segments meets no changed box, and no landing one of them aimed at was re-traced (so moved).
   // Its outcome is copied whole, the tries not looked at one by one (most samples of a move).
   std::vector<std::uint8_t> kept(samples_.size(), 0);
   auto keepsItsTries = [&](std::size_t j) {
-    if (replay->overlaps(replay->rays.triedBounds[j])) return false;
-    const std::uint8_t first = replay->rays.firstSeenTry[j];
+    if (replay->overlaps(replay->rays.triedBounds[was(j)])) return false;
+    const std::uint8_t first = replay->rays.firstSeenTry[was(j)];
     if (first != kNotSeen && first < kVisibilityTries) return true; // no landing tried
-    StreamRng draws = StreamRng::resumed(replay->rays.landingTryDraws[j]);
+    StreamRng draws = StreamRng::resumed(replay->rays.landingTryDraws[was(j)]);
     for (std::uint32_t landingTry = 0; landingTry < kVisibilityTries; ++landingTry)
       if (retraced[draws.below(kLightRays)]) return false;
     return true;
@@ -476,8 +512,8 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     Try& tr = tries[triesOf[j] + k];
     if (decided[j]) return;
     if (sameSample(j) && !targetMoved) {
-      const float before = replay->rays.tryBlockedAt[j * kTries + k];
-      if (k == replay->rays.firstSeenTry[j] && !replay->meets(from, to - from, 1.0f)) {
+      const float before = replay->rays.tryBlockedAt[was(j) * kTries + k];
+      if (k == replay->rays.firstSeenTry[was(j)] && !replay->meets(from, to - from, 1.0f)) {
         tr = {Outcome::Seen, kNaN, 0};
         rays.triedBounds[j].grow(from);
         rays.triedBounds[j].grow(to);
@@ -521,8 +557,8 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   };
   {
     Stage stage; // the tries at points of the light
-    if (looked < samples_.size()) {
-      // Most samples kept: their outcomes copied whole, the others' cleared below.
+    if (looked < samples_.size() && replay->samplesInPlace) {
+      // Most samples kept, where they were: their outcomes copied whole, the others' cleared below.
       rays.firstSeenTry = replay->rays.firstSeenTry;
       rays.tryBlockedAt = replay->rays.tryBlockedAt;
       rays.triedBounds = replay->rays.triedBounds;
@@ -532,6 +568,14 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
       rays.tryBlockedAt.assign(samples_.size() * kTries, kNaN);
       rays.triedBounds.assign(samples_.size(), scene::Bounds{});
       rays.landingTryDraws.resize(samples_.size());
+      if (looked < samples_.size()) // kept under other indices
+        for (std::size_t j = 0; j < samples_.size(); ++j) {
+          if (!kept[j]) continue;
+          rays.firstSeenTry[j] = replay->rays.firstSeenTry[was(j)];
+          std::copy_n(&replay->rays.tryBlockedAt[was(j) * kTries], kTries, &rays.tryBlockedAt[j * kTries]);
+          rays.triedBounds[j] = replay->rays.triedBounds[was(j)];
+          rays.landingTryDraws[j] = replay->rays.landingTryDraws[was(j)];
+        }
     }
     for (const std::uint32_t j : lookedAt) { // the others are found as before, try by try
       rays.firstSeenTry[j] = kNotSeen;
@@ -539,7 +583,7 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
       rays.triedBounds[j] = {};
       // The points on the light drawn again (a few per sample that is not kept).
       const SurfacePoint& s = samples_[j];
-      StreamRng rng(seed, Stream::Sample, static_cast<std::uint32_t>(j));
+      StreamRng rng(seed, Stream::Sample, sampleStream(sampleKeys_[j]));
       for (std::uint32_t k = 0; k < kVisibilityTries; ++k) {
         const glm::vec3 target = lightTryTarget(lights, light, s, rng);
         if (!std::isnan(target.x)) plan(stage, j, k, offsetToward(s.position, s.normal, target), target, false);

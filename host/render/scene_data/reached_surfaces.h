@@ -155,9 +155,13 @@ public:
   // The BVH the CPU's rays run through (a copy of the one it was made with).
   const bvh::Bvh& bvh() const { return bvhCopy_ ? *bvhCopy_ : *callersBvh_; }
   std::size_t seenPoints() const { return seen_.size(); }
+  std::size_t surfaceSamples() const { return samples_.size(); }
+  // The surface samples on triangles [first, first + count).
+  std::size_t samplesOn(std::uint32_t first, std::uint32_t count) const;
 
   // Light rays per light and surface samples over the scene (OURS: a few thousand keep the
-  // estimate within a percent or two of the reached fraction, tested, at ~0.01 s per light).
+  // estimate within a percent or two of the reached fraction, tested, at ~0.01 s per light). The
+  // samples are kSurfaceSamples in expectation (drawn triangle by triangle, see the constructor).
   static constexpr std::uint32_t kLightRays = 1024;
   static constexpr std::uint32_t kSurfaceSamples = 4096;
   static constexpr std::uint32_t kVisibilityTries = 4; // shadow rays per sample and kind of target
@@ -199,6 +203,8 @@ private:
   std::optional<bvh::Bvh> bvhCopy_;
   const bvh::Bvh* callersBvh_; // bvh(): the copy when there is one
   std::vector<SurfacePoint> samples_;
+  std::vector<std::uint64_t> sampleKeys_; // per sample: triangle << 32 | its number on it, ascending
+  static std::uint32_t sampleStream(std::uint64_t key); // the index of its streams
   std::vector<glm::vec3> reflectance_; // per triangle
   std::vector<SurfacePoint> seen_;     // camera points (reflectance = R(P))
   glm::dvec3 seenModel_{0.0};
