@@ -31,7 +31,7 @@ nlohmann::json EditReport::json() const {
                          {"cpu_ms", cpuMs},
                          {"total_ms", totalMs}};
   if (bvh) {
-    line["bvh"] = {{"kind", bvh->refit ? "refit" : "rebuild"}, {"ms", bvh->ms}};
+    line["bvh"] = {{"kind", bvh->refit ? "refit" : bvh->inserted ? "insert" : "rebuild"}, {"ms", bvh->ms}};
     if (bvh->refit) line["bvh"]["nodes"] = bvh->nodes;
   }
   if (reach) line["reach"] = {{"rays", reach->rays}, {"ms", reach->ms}};

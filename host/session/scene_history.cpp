@@ -3,6 +3,7 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "bvh/insert.h"
 #include "render/scene_data/scene_buffers.h"
 #include "scene/scene_edit.h"
 
@@ -55,6 +56,8 @@ GeometryChange SceneHistory::apply(const Edit& e, const std::string& where) {
     }
     tree = trees_.back();
     change.bvh.nodes = refitter_->refit(tree, ids, moved).size();
+  } else if (e.kind == Kind::AddQuad && insertQuad(next, change.object, tree)) {
+    change.bvh.inserted = true;
   } else {
     tree = bvh::build(render::triangleSoup(next), rebuildOptions_);
     refitter_.emplace(tree);
@@ -63,6 +66,25 @@ GeometryChange SceneHistory::apply(const Edit& e, const std::string& where) {
   scenes_.push_back(std::move(next));
   trees_.push_back(std::move(tree));
   return change;
+}
+
+bool SceneHistory::insertQuad(const scene::Scene& next, std::size_t object, bvh::Bvh& tree) {
+  // Its two triangles hung into the tree before (bvh/insert.h), the boxes above them refitted.
+  const scene::SceneObject& quad = next.objects[object];
+  std::vector<std::uint32_t> ids;
+  bvh::TriangleSoup added;
+  for (std::uint32_t id = quad.firstTriangle; id < quad.firstTriangle + quad.triangleCount; ++id) {
+    const glm::uvec3& t = next.triangles[id];
+    ids.push_back(id);
+    added.v0.push_back(next.positions[t.x]);
+    added.v1.push_back(next.positions[t.y]);
+    added.v2.push_back(next.positions[t.z]);
+  }
+  tree = trees_.back();
+  if (!bvh::insertTriangles(tree, ids, added)) return false;
+  refitter_.emplace(tree);
+  refitter_->refit(tree, ids, added);
+  return true;
 }
 
 void SceneHistory::dropPrevious() {

@@ -1,8 +1,8 @@
 // scene_history.h — the scene being edited and its BVH, one version per geometry edit, and the
 // choice of how the BVH follows an edit: a move or a removal keeps every triangle, so the tree is
-// refitted, above the object's triangles only (bvh/incremental_refit.h); an insert or an emissive
-// quad adds triangles, so it is rebuilt with the options the device's traversal wants
-// (render/scene_data/bvh_layout.h). A renderer holds pointers to the newest version; the one
+// refitted, above the object's triangles only (bvh/incremental_refit.h); an emissive quad's two
+// triangles are hung into it (bvh/insert.h); an insert adds many triangles, so the tree is rebuilt
+// with the options the device's traversal wants (render/scene_data/bvh_layout.h). A renderer holds pointers to the newest version; the one
 // before stays until dropPrevious(), once the renderer has moved on to the new one.
 #pragma once
 #include <deque>
@@ -21,6 +21,7 @@ struct BvhUpdate {
   bool refit = false;     // refitted (true) or rebuilt
   double ms = 0.0;        // host wall time of the update
   std::size_t nodes = 0;  // refitted: the nodes above the object's triangles (bvh/incremental_refit.h)
+  bool inserted = false;  // an added quad hung into the tree before (bvh/insert.h), not rebuilt
 };
 
 // What a geometry edit changed.
@@ -45,6 +46,9 @@ public:
   void dropPrevious();
 
 private:
+  // An added quad (object `object` of `next`) into a copy of the current tree; false when it has no room.
+  bool insertQuad(const scene::Scene& next, std::size_t object, bvh::Bvh& tree);
+
   std::deque<scene::Scene> scenes_; // a deque: its elements stay where they are as it grows
   std::deque<bvh::Bvh> trees_;
   bvh::BuildOptions rebuildOptions_;

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "bvh/bvh.h"
+#include "bvh/incremental_refit.h"
+#include "bvh/insert.h"
 #include "gpu_test.h"
 #include "render/obscurance_renderer.h"
 #include "render/one_shot.h"
@@ -345,17 +347,35 @@ TEST_F(Relight, AddedLightByTheKeptPathHitsEqualsTracingThePathsAgain) {
 }
 
 // An emissive quad is a light and an object: its light is traced at every pixel, and the pixels
-// its surface can change (seen, shadowing, occluding) are retraced for every light.
+// its surface can change (seen, shadowing, occluding) are retraced for every light. Its triangles
+// in a rebuilt tree (diffuse floor) or hung into the tree before (glossy floor, as edits do:
+// bvh/insert.h).
 TEST_F(Relight, AddedEmissiveQuadMatchesAFreshRenderWithIt) {
   for (bool glossyFloor : {false, true}) {
-    SCOPED_TRACE(glossyFloor ? "glossy floor" : "diffuse floor");
+    SCOPED_TRACE(glossyFloor ? "glossy floor, the quad inserted into the tree" : "diffuse floor, the tree rebuilt");
     renderer_.reset();
     RoomLights lights;
     lights.glossyFloor = glossyFloor;
     auto& r = base(lights);
     edited_ = scene_;
     const std::size_t object = scene::insertEmissiveQuad(edited_, kPanel);
-    editedBvh_ = bvh::build(render::triangleSoup(edited_));
+    if (glossyFloor) {
+      const scene::SceneObject& quad = edited_.objects[object];
+      std::vector<std::uint32_t> ids;
+      bvh::TriangleSoup added;
+      const bvh::TriangleSoup all = render::triangleSoup(edited_);
+      for (std::uint32_t id = quad.firstTriangle; id < quad.firstTriangle + quad.triangleCount; ++id) {
+        ids.push_back(id);
+        added.v0.push_back(all.v0[id]);
+        added.v1.push_back(all.v1[id]);
+        added.v2.push_back(all.v2[id]);
+      }
+      editedBvh_ = bvh_;
+      ASSERT_TRUE(bvh::insertTriangles(editedBvh_, ids, added));
+      bvh::IncrementalRefit(editedBvh_).refit(editedBvh_, ids, added);
+    } else {
+      editedBvh_ = bvh::build(render::triangleSoup(edited_));
+    }
     const std::uint64_t retraced = r.addEmitter(edited_, editedBvh_, {scene::objectBounds(edited_, object)});
     r.compose();
     EXPECT_EQ(r.lightIndex("panel"), 2u) << "area lights first: after the lamps, before the bulb";
