@@ -39,18 +39,12 @@ std::vector<std::array<Box, gpu::kBvhWidth>> exactSlotBoxes(const Bvh& bvh) {
   std::vector<Box> nodeBox(bvh.nodes.size());
   for (std::size_t n = bvh.nodes.size(); n-- > 0;) {
     const gpu::BvhNode& node = bvh.nodes[n];
-    const std::uint32_t imask = internalMask(node);
+    const std::array<WideChild, gpu::kBvhWidth> children = exactSlots(node, bvh.triangles, nodeBox);
     for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
-      const std::uint32_t meta = slotMeta(node, s);
-      if (meta == 0) continue;
+      if (children[s].kind == WideChild::Kind::Empty) continue;
       Box& box = slots[n][s];
-      if (imask >> s & 1u) {
-        box = nodeBox[childNodeIndex(node, s)];
-      } else {
-        const std::uint32_t first = firstTriangle(node) + (meta >> 2 & 31u);
-        for (std::uint32_t t = first; t < first + (meta & 3u); ++t)
-          for (const gpu::vec4* v : {&bvh.triangles[t].v0, &bvh.triangles[t].v1, &bvh.triangles[t].v2})
-            box.grow(glm::vec3(*v));
+      box = children[s].box;
+      if (children[s].kind == WideChild::Kind::Leaf) {
         const Box slot = decodedBox(node, s);
         box.lo = glm::max(box.lo, slot.lo);
         box.hi = glm::min(box.hi, slot.hi);

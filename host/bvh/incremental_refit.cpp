@@ -5,34 +5,6 @@
 #include <stdexcept>
 
 namespace obscura::bvh {
-namespace {
-
-// The slots of `node` with their exact boxes: interior ones from `nodeBox`, leaves from their
-// triangles (refit.cpp's loop body).
-std::array<WideChild, gpu::kBvhWidth> exactSlots(const Bvh& bvh, const gpu::BvhNode& node, const std::vector<Box>& nodeBox) {
-  const std::uint32_t imask = internalMask(node);
-  std::array<WideChild, gpu::kBvhWidth> slots{};
-  for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
-    const std::uint32_t meta = slotMeta(node, s);
-    if (meta == 0) continue;
-    WideChild& c = slots[s];
-    if (imask >> s & 1u) {
-      c.kind = WideChild::Kind::Internal;
-      c.box = nodeBox[childNodeIndex(node, s)];
-    } else {
-      c.kind = WideChild::Kind::Leaf;
-      c.triangleCount = meta & 3u;
-      c.triangleOffset = meta >> 2 & 31u;
-      const std::uint32_t first = firstTriangle(node) + c.triangleOffset;
-      for (std::uint32_t t = first; t < first + c.triangleCount; ++t)
-        for (const gpu::vec4* v : {&bvh.triangles[t].v0, &bvh.triangles[t].v1, &bvh.triangles[t].v2})
-          c.box.grow(glm::vec3(*v));
-    }
-  }
-  return slots;
-}
-
-} // namespace
 
 IncrementalRefit::IncrementalRefit(const Bvh& bvh)
     : parent_(bvh.nodes.size(), 0), leafNode_(bvh.triangles.size(), 0), nodeBox_(bvh.nodes.size()),
@@ -51,7 +23,7 @@ IncrementalRefit::IncrementalRefit(const Bvh& bvh)
         for (std::uint32_t t = first; t < first + (meta & 3u); ++t) leafNode_[t] = static_cast<std::uint32_t>(n);
       }
     }
-    for (const WideChild& c : exactSlots(bvh, node, nodeBox_))
+    for (const WideChild& c : exactSlots(node, bvh.triangles, nodeBox_))
       if (c.kind != WideChild::Kind::Empty) nodeBox_[n].grow(c.box);
   }
   // Where each original triangle lies (counting sort of `order`).
@@ -93,7 +65,7 @@ std::span<const std::uint32_t> IncrementalRefit::refit(Bvh& bvh, std::span<const
   std::sort(refitted_.begin(), refitted_.end(), std::greater<>());
   for (const std::uint32_t n : refitted_) {
     gpu::BvhNode& node = bvh.nodes[n];
-    const std::array<WideChild, gpu::kBvhWidth> slots = exactSlots(bvh, node, nodeBox_);
+    const std::array<WideChild, gpu::kBvhWidth> slots = exactSlots(node, bvh.triangles, nodeBox_);
     nodeBox_[n] = Box{};
     for (const WideChild& c : slots)
       if (c.kind != WideChild::Kind::Empty) nodeBox_[n].grow(c.box);

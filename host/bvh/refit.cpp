@@ -20,26 +20,9 @@ void refit(Bvh& bvh, const TriangleSoup& soup) {
   std::vector<Box> nodeBox(bvh.nodes.size());
   for (std::size_t n = bvh.nodes.size(); n-- > 0;) {
     gpu::BvhNode& node = bvh.nodes[n];
-    const std::uint32_t imask = internalMask(node);
-    std::array<WideChild, gpu::kBvhWidth> slots{};
-    for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
-      const std::uint32_t meta = slotMeta(node, s);
-      if (meta == 0) continue;
-      WideChild& c = slots[s];
-      if (imask >> s & 1u) {
-        c.kind = WideChild::Kind::Internal;
-        c.box = nodeBox[childNodeIndex(node, s)];
-      } else {
-        c.kind = WideChild::Kind::Leaf;
-        c.triangleCount = meta & 3u;
-        c.triangleOffset = meta >> 2 & 31u;
-        const std::uint32_t first = firstTriangle(node) + c.triangleOffset;
-        for (std::uint32_t t = first; t < first + c.triangleCount; ++t)
-          for (const gpu::vec4* v : {&bvh.triangles[t].v0, &bvh.triangles[t].v1, &bvh.triangles[t].v2})
-            c.box.grow(glm::vec3(*v));
-      }
-      nodeBox[n].grow(c.box);
-    }
+    const std::array<WideChild, gpu::kBvhWidth> slots = exactSlots(node, bvh.triangles, nodeBox);
+    for (const WideChild& c : slots)
+      if (c.kind != WideChild::Kind::Empty) nodeBox[n].grow(c.box);
     writeWideNode(node, slots, firstChild(node), firstTriangle(node));
   }
 }

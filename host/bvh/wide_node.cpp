@@ -103,6 +103,29 @@ void writeWideNode(gpu::BvhNode& node, const std::array<WideChild, gpu::kBvhWidt
   node.qz = gpu::vec4(asFloat(q[2].x), asFloat(q[2].y), asFloat(q[2].z), asFloat(q[2].w));
 }
 
+std::array<WideChild, gpu::kBvhWidth> exactSlots(const gpu::BvhNode& node, const std::vector<gpu::BvhTriangle>& triangles,
+                                                 const std::vector<Box>& nodeBox) {
+  const std::uint32_t imask = internalMask(node);
+  std::array<WideChild, gpu::kBvhWidth> slots{};
+  for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
+    const std::uint32_t meta = slotMeta(node, s);
+    if (meta == 0) continue;
+    WideChild& c = slots[s];
+    if (imask >> s & 1u) {
+      c.kind = WideChild::Kind::Internal;
+      c.box = nodeBox[childNodeIndex(node, s)];
+    } else {
+      c.kind = WideChild::Kind::Leaf;
+      c.triangleCount = meta & 3u;
+      c.triangleOffset = meta >> 2 & 31u;
+      const std::uint32_t first = firstTriangle(node) + c.triangleOffset;
+      for (std::uint32_t t = first; t < first + c.triangleCount; ++t)
+        for (const gpu::vec4* v : {&triangles[t].v0, &triangles[t].v1, &triangles[t].v2}) c.box.grow(glm::vec3(*v));
+    }
+  }
+  return slots;
+}
+
 std::uint32_t internalMask(const gpu::BvhNode& node) { return bits(node.origin.w) >> 24; }
 std::uint32_t firstChild(const gpu::BvhNode& node) { return bits(node.refs.x); }
 std::uint32_t firstTriangle(const gpu::BvhNode& node) { return bits(node.refs.y); }

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -34,6 +35,12 @@ struct WideChild {
 // the internal-child mask. `firstChild` / `firstTriangle` go to refs.x / refs.y.
 void writeWideNode(gpu::BvhNode& node, const std::array<WideChild, gpu::kBvhWidth>& slots,
                    std::uint32_t firstChild, std::uint32_t firstTriangle);
+
+// The slots of `node` as refit sees them, with exact boxes: an interior slot's from `nodeBox` (per
+// node, filled by the caller bottom-up: children follow their parent), a leaf slot's from its
+// triangles (`triangles`: Bvh::triangles, their whole boxes).
+std::array<WideChild, gpu::kBvhWidth> exactSlots(const gpu::BvhNode& node, const std::vector<gpu::BvhTriangle>& triangles,
+                                                 const std::vector<Box>& nodeBox);
 
 // Decoded fields.
 std::uint32_t internalMask(const gpu::BvhNode& node);   // bit s: slot s is an interior node
