@@ -6,8 +6,6 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <limits>
-#include <random>
 #include <string>
 
 namespace obscura::render {
@@ -154,7 +152,7 @@ float offsetAt(glm::vec3 p, float offset) {
 }
 
 // `p` moved off its surface (normal `n`) by `offset` (at least offsetAt's) to the side `towards` lies on.
-[[gnu::always_inline]] inline glm::vec3 offsetToward(glm::vec3 p, glm::vec3 n, glm::vec3 towards, float offset) {
+glm::vec3 offsetToward(glm::vec3 p, glm::vec3 n, glm::vec3 towards, float offset) {
   const float o = offsetAt(p, offset);
   return p + (glm::dot(n, towards - p) >= 0.0f ? o : -o) * n;
 }

@@ -42,7 +42,6 @@
 #pragma once
 #include <cstdint>
 #include <optional>
-#include <random>
 #include <utility>
 #include <vector>
 
