@@ -9,6 +9,7 @@
 //     nothing there.
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -92,8 +93,8 @@ double lampIrradiance(const Fixture& f, glm::vec3 q, glm::vec3 n, std::mt19937& 
 // emission, `emitter` a material that reflects nothing (skipped), -1 if none.
 template <class Direct>
 double oneBounceFit(const scene::Scene& scene, const bvh::Bvh& tree, glm::vec3 eye, float reflectance, int emitter,
-                    Direct direct) {
-  std::mt19937 rng(12345);
+                    Direct direct, std::uint32_t seed = 12345) {
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
   constexpr int kGrid = 24, kRays = 24;
   const float tanHalf = std::tan(0.6f);
@@ -151,41 +152,82 @@ TEST(SeenAmbient, FirstBounceFitEqualsTheOneBounceIrradianceTheCameraSees) {
   EXPECT_LT(r.seenFirstBounce.x, 3.0 * reachedFirst);
 }
 
-// A roofless 4 x 3 x 4 m room on a 200 m ground under the sun, the camera inside: of the sun's
-// first 1024 light rays, spread over the 200 m world, almost none land in the room. The beams
-// across the seen box (beamPhotons) must give the room its share.
-TEST(SeenAmbient, SunOnASmallRoomInALargeWorldIsFittedFromBeamsAcrossTheSeenBox) {
-  SceneBuilder b;
-  const auto grey = b.lambertian(glm::vec3(0.5f), glm::vec3(0.0f), true);
-  b.quad({-100, 0, -100}, {0, 0, 200}, {200, 0, 0}, grey); // the ground, facing +y
-  b.quad({0, 0, 0}, {0, 3, 0}, {0, 0, 4}, grey);            // the walls (two-sided)
-  b.quad({4, 0, 0}, {0, 0, 4}, {0, 3, 0}, grey);
-  b.quad({0, 0, 0}, {4, 0, 0}, {0, 3, 0}, grey);
-  b.quad({0, 0, 4}, {0, 3, 0}, {4, 0, 0}, grey);
-  const glm::vec3 sunTravels = glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f));
-  b.directionalLight(sunTravels, glm::vec3(1.0f), 1.0f);
-  scene::Scene s = b.build();
-  bvh::Bvh tree = bvh::build(render::triangleSoup(s));
-  render::LightSet lights = render::buildLightSet(s);
+// A roofless 4 x 3 x 4 m room on a 200 m ground, the camera inside, lit from outside the scene:
+// of the sun's or the sky's rays, spread over the 200 m world, almost none land in the room
+// (classroom's sun through its windows is the real case). Their first bounce is gathered from
+// where the seen points' rays land (gatheredFirstBounce).
+struct RooflessRoom {
+  scene::Scene scene;
+  bvh::Bvh tree;
+  render::LightSet lights;
   std::vector<glm::vec3> albedo;
-  for (const auto& m : s.materials) albedo.push_back(render::materialMeanAlbedo(m));
-  render::ReachedSurfaces reached(s, tree, render::triangleReflectances(s, albedo));
-  const glm::vec3 eye(2.0f, 1.5f, 0.2f);
-  reached.setSeenView(viewFrom(eye, 1e-4f));
-  const render::LightReach r = reached.measure(lights, 0);
+  static constexpr glm::vec3 kEye{2.0f, 1.5f, 0.2f};
+
+  // Lit by the sun travelling along `sunTravels`, or by a constant sky of radiance `sky`.
+  RooflessRoom(std::optional<glm::vec3> sunTravels, glm::vec3 sky) {
+    SceneBuilder b;
+    const auto grey = b.lambertian(glm::vec3(0.5f), glm::vec3(0.0f), true);
+    b.quad({-100, 0, -100}, {0, 0, 200}, {200, 0, 0}, grey); // the ground, facing +y
+    b.quad({0, 0, 0}, {0, 3, 0}, {0, 0, 4}, grey);            // the walls (two-sided)
+    b.quad({4, 0, 0}, {0, 0, 4}, {0, 3, 0}, grey);
+    b.quad({0, 0, 0}, {4, 0, 0}, {0, 3, 0}, grey);
+    b.quad({0, 0, 4}, {0, 3, 0}, {4, 0, 0}, grey);
+    if (sunTravels) b.directionalLight(*sunTravels, glm::vec3(1.0f), 1.0f);
+    scene = b.build();
+    scene.background = sky;
+    tree = bvh::build(render::triangleSoup(scene));
+    lights = render::buildLightSet(scene);
+    for (const auto& m : scene.materials) albedo.push_back(render::materialMeanAlbedo(m));
+  }
+  render::LightReach measured() const {
+    render::ReachedSurfaces reached(scene, tree, render::triangleReflectances(scene, albedo));
+    reached.setSeenView(viewFrom(kEye, 1e-4f));
+    return reached.measure(lights, 0);
+  }
+};
+
+// Both sides are means over ~570 seen points, by independent estimators. Over 8 seeds of the seen
+// grid the fit is 0.99 of the reference on average (sun and sky alike), with a spread of 2.7 %;
+// the reference's own spread over 8 of its seeds is 1.2 %; together 3 %: asserted within 10 %.
+// The beams across the seen box that the sun and the sky used before gave 0.64-0.97 of it over 12
+// seeds, 0.75 on average (the virtual point lights' clamp r_c next to the seen points); without
+// any, the fit is 0.
+TEST(SeenAmbient, SunOnASmallRoomInALargeWorldIsGatheredWhereTheSeenPointsLook) {
+  const glm::vec3 sunTravels = glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f));
+  const RooflessRoom room(sunTravels, glm::vec3(0.0f));
+  const render::LightReach r = room.measured();
   ASSERT_TRUE(r.seenFitted);
-  const double expected = oneBounceFit(s, tree, eye, 0.5f, -1, [&](glm::vec3 q, glm::vec3 n, std::mt19937&) {
+  const double expected = oneBounceFit(room.scene, room.tree, RooflessRoom::kEye, 0.5f, -1, [&](glm::vec3 q, glm::vec3 n, std::mt19937&) {
     const float cosine = -glm::dot(n, sunTravels);
     if (cosine <= 0.0f) return 0.0;
-    return bvh::anyHit(tree, {.origin = q, .direction = -sunTravels}) ? 0.0 : static_cast<double>(cosine);
+    return bvh::anyHit(room.tree, {.origin = q, .direction = -sunTravels}) ? 0.0 : static_cast<double>(cosine);
   });
   ASSERT_GT(expected, 0.0);
-  // Low by a quarter: over 12 seeds (the light's name seeds its streams) the fit is 0.75 of this
-  // estimate on average, 0.64 to 0.97, standard deviation 0.08: the clamp r_c of the photons on the
-  // sunlit floor next to the seen points takes more here than in the closed room. Asserted: within
-  // 3 standard deviations of that mean. Without the beams the fit is 0.
-  EXPECT_GT(r.seenFirstBounce.x, 0.5 * expected);
-  EXPECT_LT(r.seenFirstBounce.x, 1.0 * expected);
+  EXPECT_NEAR(r.seenFirstBounce.x, expected, 0.10 * expected);
+}
+
+// The same room under a constant sky (radiance 1): E_dir(Q) = pi x the share of Q's cosine
+// directions that leave the scene. The reference samples 16 of them per landing, the fit one.
+TEST(SeenAmbient, SkyOnASmallRoomInALargeWorldIsGatheredWhereTheSeenPointsLook) {
+  const RooflessRoom room(std::nullopt, glm::vec3(1.0f));
+  ASSERT_EQ(room.lights.lights[0].info.x, gpu::kLightBackground);
+  const render::LightReach r = room.measured();
+  ASSERT_TRUE(r.seenFitted);
+  const double expected = oneBounceFit(room.scene, room.tree, RooflessRoom::kEye, 0.5f, -1, [&](glm::vec3 q, glm::vec3 n, std::mt19937& rng) {
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    glm::vec3 a = std::abs(n.x) > 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+    glm::vec3 tx = glm::normalize(glm::cross(a, n)), ty = glm::cross(n, tx);
+    constexpr int kRays = 16;
+    int open = 0;
+    for (int k = 0; k < kRays; ++k) {
+      float u1 = uni(rng), phi = 2.0f * kPi * uni(rng), rr = std::sqrt(u1);
+      glm::vec3 w = rr * std::cos(phi) * tx + rr * std::sin(phi) * ty + std::sqrt(1.0f - u1) * n;
+      open += bvh::anyHit(room.tree, {.origin = q, .direction = w}) ? 0 : 1;
+    }
+    return static_cast<double>(kPi) * open / kRays;
+  });
+  ASSERT_GT(expected, 0.0);
+  EXPECT_NEAR(r.seenFirstBounce.x, expected, 0.10 * expected);
 }
 
 TEST(SeenAmbient, ALampTheCamerasRoomCannotSeeAddsNoAmbientLightThere) {

@@ -11,7 +11,8 @@
 namespace obscura::render {
 
 // The streams of a light's measurement: one per ray (or per surface sample, whose tries share it).
-enum class Stream : std::uint32_t { LightRay = 1, Bounce = 2, Sample = 3, Seen = 4, SeenGrid = 5, SampleCount = 6, SamplePoint = 7 };
+enum class Stream : std::uint32_t { LightRay = 1, Bounce = 2, Sample = 3, Seen = 4, SeenGrid = 5, SampleCount = 6, SamplePoint = 7,
+                                    SeenGather = 8 };
 
 // A counter-based generator (splitmix64, Steele, Lea & Flood 2014) for one stream: cheap to start
 // at any (light, stream, index), so that every ray has numbers of its own.
@@ -625,76 +626,30 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   reach.area = totalArea_ * reach.fraction;
   reach.reflectance = glm::vec3(reflectance / static_cast<double>(reached));
 
-  // 3. Seen: the one-bounce irradiance at the camera's points, the landings as virtual point
-  // lights ("photons"): each carries its flux Phi_i and reflects R cos / pi per steradian, so
-  //   E_1(P) = sum_i Phi_i R_i cos_i cos_P / (pi max(r^2, r_c,i^2)) V(i, P),
-  // estimated from kSeenLandingsPerPoint random photons. r_c,i, the radius of photon i's share of
-  // the lit area, bounds the 1/r^2 of a landing next to P (that light is the direct light's
-  // neighbourhood, which the ambient term never resolves anyway).
-  // Measured whole after an edit too (its rays are a few per seen point): it reads only the
-  // landings, so a replayed measurement fits what a fresh one fits.
-  std::vector<Landing> landings;
-  for (std::uint32_t i = 0; i < kLightRays; ++i)
-    if (std::isfinite(rays.landingT[i])) landings.push_back(landingOf[i]);
-  StreamRng rng(seed, Stream::Seen, 0);
-  if (!seen_.empty() && !landings.empty() && glm::length(seenModel_) > 0.0) {
-    std::vector<Photon> photons;
-    const std::uint32_t type = lights.lights[light].info.x;
+  // 3. Seen: the one-bounce irradiance at the camera's points. Measured whole after an edit too
+  // (its rays are a few per seen point): it reads only the landings and the seen points, so a
+  // replayed measurement fits what a fresh one fits.
+  const std::uint32_t type = lights.lights[light].info.x;
+  if (!seen_.empty() && glm::length(seenModel_) > 0.0) {
+    std::optional<glm::dvec3> target;
     if (type == gpu::kLightDirectional || type == gpu::kLightBackground) {
-      photons = beamPhotons(batch, lights, light, rng, rays.traced);
-      // The first landings keep the beams outside the seen box's shadow (the strata beamPhotons drew apart).
-      const double perRay = type == gpu::kLightDirectional
-                                ? std::numbers::pi * sceneRadius() * sceneRadius() / emitted // irradiance 1 x the disk's share
-                                : static_cast<double>(lights.unitFlux[light].x) / emitted;
-      for (const Landing& h : landings) {
-        if (beamCrossesSeenBox(h.from, h.direction)) continue;
-        photons.push_back({h.position, h.normal, h.reflectance, glm::dvec3(perRay),
-                           std::numbers::pi * sceneRadius() * sceneRadius() / emitted / std::numbers::pi});
-      }
+      target = gatheredFirstBounce(batch, lights, light, seed, rays.traced);
     } else {
-      const glm::dvec3 flux = glm::dvec3(lights.unitFlux[light]) * (1.0 - reach.escapeDirect) / static_cast<double>(landings.size());
-      const double rc2 = reach.area / (std::numbers::pi * static_cast<double>(landings.size()));
-      for (const Landing& h : landings) photons.push_back({h.position, h.normal, h.reflectance, flux, rc2});
-    }
-    // Every point's photon draws first (they do not depend on what the rays find), then their
-    // shadow rays at once, then the sums in the same order.
-    struct Gather {
-      std::uint32_t point;
-      glm::dvec3 contribution; // if visible
-    };
-    std::vector<Gather> gathers;
-    Stage stage;
-    for (std::uint32_t point = 0; point < seen_.size(); ++point) {
-      const SurfacePoint& p = seen_[point];
-      for (std::uint32_t k = 0; k < kSeenLandingsPerPoint && !photons.empty(); ++k) {
-        const Photon& h = photons[rng.below(static_cast<std::uint32_t>(photons.size()))];
-        glm::vec3 d = h.position - p.position;
-        const float r2 = glm::dot(d, d);
-        if (!(r2 > 0.0f)) continue;
-        d /= std::sqrt(r2);
-        const float cosP = glm::dot(p.normal, d), cosL = -glm::dot(h.normal, d);
-        if (cosP <= 0.0f || cosL <= 0.0f) continue;
-        glm::vec3 from = p.position + offsetAt(p.position, offset_) * p.normal;
-        glm::vec3 to = h.position + offsetAt(h.position, offset_) * h.normal;
-        stage.add(point, {.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f});
-        gathers.push_back({point, h.flux * glm::dvec3(h.reflectance) * static_cast<double>(cosP * cosL) /
-                                   std::max(static_cast<double>(r2), h.rc2)});
+      std::vector<SurfacePoint> landings;
+      for (std::uint32_t i = 0; i < kLightRays; ++i)
+        if (std::isfinite(rays.landingT[i])) landings.push_back({landingOf[i].position, landingOf[i].normal, landingOf[i].reflectance});
+      if (!landings.empty()) {
+        const glm::dvec3 flux = glm::dvec3(lights.unitFlux[light]) * (1.0 - reach.escapeDirect) / static_cast<double>(landings.size());
+        const double rc2 = reach.area / (std::numbers::pi * static_cast<double>(landings.size()));
+        target = landingsFirstBounce(batch, landings, flux, rc2, seed, rays.traced);
       }
     }
-    const std::vector<float> blocked = batch.blockedAt(stage.ray);
-    rays.traced += stage.ray.size();
-    std::vector<glm::dvec3> sum(seen_.size(), glm::dvec3(0.0));
-    for (std::size_t g = 0; g < gathers.size(); ++g)
-      if (std::isinf(blocked[g])) sum[gathers[g].point] += gathers[g].contribution;
-    glm::dvec3 target(0.0);
-    for (std::uint32_t point = 0; point < seen_.size(); ++point) {
-      // Photons drawn uniformly: the sum over all of them is photons / K times this one.
-      const glm::dvec3 e1 = sum[point] * (static_cast<double>(photons.size()) / kSeenLandingsPerPoint) / std::numbers::pi;
-      target += glm::dvec3(seen_[point].reflectance) * e1 / std::numbers::pi;
+    if (target) {
+      for (int c = 0; c < 3; ++c)
+        reach.seenFirstBounce[c] = seenModel_[c] > 0.0 ? static_cast<float>((*target)[c] / seenModel_[c]) : 0.0f;
+      reach.seenBounce = seenBounce_;
+      reach.seenFitted = true;
     }
-    for (int c = 0; c < 3; ++c) reach.seenFirstBounce[c] = seenModel_[c] > 0.0 ? static_cast<float>(target[c] / seenModel_[c]) : 0.0f;
-    reach.seenBounce = seenBounce_;
-    reach.seenFitted = true;
   }
   return reach;
 }
@@ -710,82 +665,93 @@ glm::vec3 ReachedSurfaces::lightTryTarget(const LightSet& lights, std::size_t li
   return p.normal == glm::vec3(0.0f) ? p.position : offsetToward(p.position, p.normal, sample.position, offset_);
 }
 
-float ReachedSurfaces::sceneRadius() const {
-  const scene::Bounds& b = scene_->bounds;
-  return 0.5f * glm::length(b.hi - b.lo) + 1e-3f; // samplePoint's sphere and disk
-}
-
-// The rectangle, in the plane across `direction` through the scene's centre (frame t, b), that
-// the seen box projects to, clipped to the disk of the scene's radius; area 0 when empty.
-ReachedSurfaces::BeamRect ReachedSurfaces::seenBoxAcross(glm::vec3 direction) const {
-  const scene::Bounds& bounds = scene_->bounds;
-  const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
-  BeamRect r;
-  Frame f = frameAround(direction);
-  r.t = f.t;
-  r.b = f.b;
-  r.lo = glm::vec2(std::numeric_limits<float>::max());
-  r.hi = glm::vec2(-std::numeric_limits<float>::max());
-  for (int corner = 0; corner < 8; ++corner) {
-    glm::vec3 c((corner & 1) ? seenHi_.x : seenLo_.x, (corner & 2) ? seenHi_.y : seenLo_.y, (corner & 4) ? seenHi_.z : seenLo_.z);
-    glm::vec2 uv(glm::dot(c - centre, f.t), glm::dot(c - centre, f.b));
-    r.lo = glm::min(r.lo, uv);
-    r.hi = glm::max(r.hi, uv);
+// A light inside the scene: its landings as virtual point lights ("photons"), each carrying its
+// flux Phi_i and reflecting R cos / pi per steradian, so
+//   E_1(P) = sum_i Phi_i R_i cos_i cos_P / (pi max(r^2, r_c,i^2)) V(i, P),
+// estimated from kSeenLandingsPerPoint random photons. r_c (rc2 = r_c^2), the radius of a
+// photon's share of the lit area, bounds the 1/r^2 of a landing next to P (that light is the
+// direct light's neighbourhood, which the ambient term never resolves anyway).
+glm::dvec3 ReachedSurfaces::landingsFirstBounce(RayBatch& batch, const std::vector<SurfacePoint>& landings, glm::dvec3 flux,
+                                                double rc2, std::uint32_t seed, std::uint64_t& traced) const {
+  StreamRng rng(seed, Stream::Seen, 0);
+  // Every point's photon draws first (they do not depend on what the rays find), then their
+  // shadow rays at once, then the sums in the same order.
+  struct Gather {
+    std::uint32_t point;
+    glm::dvec3 contribution; // if visible
+  };
+  std::vector<Gather> gathers;
+  std::vector<bvh::Ray> shadow;
+  for (std::uint32_t point = 0; point < seen_.size(); ++point) {
+    const SurfacePoint& p = seen_[point];
+    for (std::uint32_t k = 0; k < kSeenLandingsPerPoint; ++k) {
+      const SurfacePoint& h = landings[rng.below(static_cast<std::uint32_t>(landings.size()))];
+      glm::vec3 d = h.position - p.position;
+      const float r2 = glm::dot(d, d);
+      if (!(r2 > 0.0f)) continue;
+      d /= std::sqrt(r2);
+      const float cosP = glm::dot(p.normal, d), cosL = -glm::dot(h.normal, d);
+      if (cosP <= 0.0f || cosL <= 0.0f) continue;
+      glm::vec3 from = p.position + offsetAt(p.position, offset_) * p.normal;
+      glm::vec3 to = h.position + offsetAt(h.position, offset_) * h.normal;
+      shadow.push_back({.origin = from, .direction = to - from, .tmin = 0.0f, .tmax = 1.0f});
+      gathers.push_back({point, flux * glm::dvec3(h.reflectance) * static_cast<double>(cosP * cosL) /
+                                    std::max(static_cast<double>(r2), rc2)});
+    }
   }
-  const float radius = sceneRadius();
-  r.lo = glm::max(r.lo, glm::vec2(-radius));
-  r.hi = glm::min(r.hi, glm::vec2(radius));
-  return r;
+  const std::vector<float> blocked = batch.blockedAt(shadow);
+  traced += shadow.size();
+  std::vector<glm::dvec3> sum(seen_.size(), glm::dvec3(0.0));
+  for (std::size_t g = 0; g < gathers.size(); ++g)
+    if (std::isinf(blocked[g])) sum[gathers[g].point] += gathers[g].contribution;
+  glm::dvec3 target(0.0);
+  for (std::uint32_t point = 0; point < seen_.size(); ++point) {
+    // Landings drawn uniformly: the sum over all of them is landings / K times this one.
+    const glm::dvec3 e1 = sum[point] * (static_cast<double>(landings.size()) / kSeenLandingsPerPoint) / std::numbers::pi;
+    target += glm::dvec3(seen_[point].reflectance) * e1 / std::numbers::pi;
+  }
+  return target;
 }
 
-bool ReachedSurfaces::beamCrossesSeenBox(glm::vec3 from, glm::vec3 direction) const {
-  const scene::Bounds& bounds = scene_->bounds;
-  const BeamRect r = seenBoxAcross(direction);
-  const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
-  glm::vec2 uv(glm::dot(from - centre, r.t), glm::dot(from - centre, r.b));
-  return r.area() > 0.0f && uv.x >= r.lo.x && uv.x < r.hi.x && uv.y >= r.lo.y && uv.y < r.hi.y;
-}
-
-// Lights from outside the scene (directional, sky) as parallel beams across a disk of the scene's
-// radius (the sky: a beam for every direction, uniform, radiance 1 times 4 pi; the sun: its one
-// direction, irradiance 1). A room in a large world (classroom's 221 m ground) gets almost none of
-// the first landings, so the beams that cross the seen box (grown by dmax) are drawn apart:
-// kSeenBeamRays uniform over the box's projection, each carrying irradiance x projected area / N;
-// measure() keeps the first landings outside that stratum. Landings only (misses carry nothing).
-std::vector<ReachedSurfaces::Photon> ReachedSurfaces::beamPhotons(RayBatch& batch, const LightSet& lights, std::size_t light,
-                                                                   StreamRng& rng, std::uint64_t& traced) const {
-  auto uni = [](StreamRng& r) { return r.next(); };
-  const scene::Bounds& bounds = scene_->bounds;
-  const glm::vec3 centre = 0.5f * (bounds.lo + bounds.hi);
-  const float radius = sceneRadius();
+// The sun and the sky light the seen points' room from outside the scene: of their rays, spread
+// over the whole world, few land where the camera looks (classroom: a room in a 221 m world, lit
+// through its windows), and which few decided the fit (it swung 0.9-1.2x with the streams). So
+// their first bounce is gathered instead, from where the seen points' cosine rays landed (Q, kept
+// by setSeenView): E_1(P) = (1/K) sum_k R(Q_k) E_dir(Q_k) for K cosine rays (L_1 = R E_dir / pi,
+// E = pi x the mean radiance), and E_dir(Q) at unit emission takes one shadow ray: the sun's
+// irradiance 1 across its direction, cos x V; the sky's radiance 1, pi x V of a cosine ray.
+// Every sunlit or skylit surface the room sees counts, wherever it is, with no 1/r^2 to clamp.
+glm::dvec3 ReachedSurfaces::gatheredFirstBounce(RayBatch& batch, const LightSet& lights, std::size_t light,
+                                                std::uint32_t seed, std::uint64_t& traced) const {
   const bool sky = lights.lights[light].info.x == gpu::kLightBackground;
-  std::vector<bvh::Ray> beams;
-  std::vector<float> shares; // each beam's cross-section
-  for (std::uint32_t i = 0; i < kSeenBeamRays; ++i) {
-    const glm::vec3 direction = sky ? sphereDirection(uni(rng), uni(rng)) : glm::normalize(glm::vec3(lights.lights[light].direction));
-    const BeamRect r = seenBoxAcross(direction);
-    if (!(r.area() > 0.0f)) continue;
-    glm::vec2 uv(r.lo.x + uni(rng) * (r.hi.x - r.lo.x), r.lo.y + uni(rng) * (r.hi.y - r.lo.y));
-    if (glm::dot(uv, uv) > radius * radius) continue; // outside the disk: no light there
-    beams.push_back({.origin = centre - 2.0f * radius * direction + uv.x * r.t + uv.y * r.b, .direction = direction});
-    shares.push_back(r.area());
+  const glm::vec3 sunTravels = glm::normalize(glm::vec3(lights.lights[light].direction));
+  std::vector<bvh::Ray> shadow;
+  std::vector<double> cosine;     // E_dir(Q) if the shadow ray is clear
+  std::vector<std::uint32_t> gather; // its seenGathers_ index
+  for (std::uint32_t i = 0; i < seenGathers_.size(); ++i) {
+    const SeenGather& q = seenGathers_[i];
+    glm::vec3 towards;
+    double e = 0.0;
+    if (sky) {
+      StreamRng rng(seed, Stream::SeenGather, i);
+      const float u1 = rng.next(), u2 = rng.next();
+      towards = cosineDirection(q.normal, u1, u2);
+      e = std::numbers::pi;
+    } else {
+      towards = -sunTravels;
+      e = glm::dot(q.normal, towards);
+      if (!(e > 0.0)) continue;
+    }
+    shadow.push_back({.origin = q.position, .direction = towards});
+    cosine.push_back(e);
+    gather.push_back(i);
   }
-  const std::vector<bvh::Hit> hits = batch.closest(beams);
-  traced += beams.size();
-  std::vector<Photon> out;
-  for (std::size_t i = 0; i < beams.size(); ++i) {
-    const bvh::Hit& hit = hits[i];
-    if (!hit.hit()) continue;
-    const glm::vec3 direction = beams[i].direction;
-    const glm::uvec3 tri = scene_->triangles[hit.primitive];
-    glm::vec3 a = scene_->positions[tri.x], b = scene_->positions[tri.y], c = scene_->positions[tri.z];
-    glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-    if (glm::dot(n, direction) > 0.0f) n = -n;
-    const double share = static_cast<double>(shares[i]) / kSeenBeamRays; // cross-section per ray
-    const double flux = (sky ? 4.0 * std::numbers::pi : 1.0) * share;
-    out.push_back({beams[i].origin + hit.t * direction, n, reflectance_[hit.primitive], glm::dvec3(flux), share / std::numbers::pi});
-  }
-  return out;
+  const std::vector<float> blocked = batch.blockedAt(shadow);
+  traced += shadow.size();
+  glm::dvec3 target(0.0);
+  for (std::size_t r = 0; r < shadow.size(); ++r)
+    if (std::isinf(blocked[r])) target += seenGathers_[gather[r]].weight * cosine[r];
+  return target;
 }
 
 void ReachedSurfaces::setSeenView(const SeenView& view) {
@@ -799,9 +765,8 @@ void ReachedSurfaces::setSeenView(const SeenView& view) {
 // Each cell draws from a stream of its own, so that a stage's rays are traced together.
 void ReachedSurfaces::setSeenView(RayBatch& batch, const SeenView& view) {
   seen_.clear();
+  seenGathers_.clear();
   seenModel_ = glm::dvec3(0.0);
-  seenLo_ = glm::vec3(std::numeric_limits<float>::max());
-  seenHi_ = glm::vec3(-std::numeric_limits<float>::max());
   const scene::Scene& scene = *scene_;
   const GridCamera camera{view.position, view.forward, view.up, view.yfov, view.aspect};
   constexpr std::uint32_t kSeenSeed = 0x5ee9u;
@@ -836,8 +801,18 @@ void ReachedSurfaces::setSeenView(RayBatch& batch, const SeenView& view) {
   const std::vector<bvh::Hit> bounceHits = batch.closest(bounceRays);
   const std::vector<bvh::Hit> obscuranceHits = batch.closest(obscuranceRays);
   glm::dvec3 bounce(0.0);
-  for (const bvh::Hit& any : bounceHits)
-    if (any.hit()) bounce += glm::dvec3(reflectance_[any.primitive]);
+  for (std::size_t r = 0; r < bounceRays.size(); ++r) {
+    const bvh::Hit& any = bounceHits[r];
+    if (!any.hit()) continue;
+    bounce += glm::dvec3(reflectance_[any.primitive]);
+    // Where it landed, for gatheredFirstBounce: its share of sum_P R(P) E_1(P) / pi per unit of
+    // the direct irradiance there is R(P) R(Q) / (K pi).
+    const auto q = gridHit(scene, bounceRays[r], any);
+    const glm::dvec3 weight = glm::dvec3(points[r / kSeenObscuranceRays].reflectance) * glm::dvec3(reflectance_[any.primitive]) /
+                              (kSeenObscuranceRays * std::numbers::pi);
+    if (!q || !(weight.x + weight.y + weight.z > 0.0)) continue;
+    seenGathers_.push_back({q->position + offsetAt(q->position, offset_) * q->normal, q->normal, weight});
+  }
   for (std::size_t i = 0; i < points.size(); ++i) {
     const SurfacePoint& p = points[i];
     glm::dvec3 w(0.0);
@@ -855,8 +830,6 @@ void ReachedSurfaces::setSeenView(RayBatch& batch, const SeenView& view) {
     }
     seenModel_ += glm::dvec3(p.reflectance) * w / static_cast<double>(kSeenObscuranceRays);
     seen_.push_back(p);
-    seenLo_ = glm::min(seenLo_, p.position - glm::vec3(view.dMax));
-    seenHi_ = glm::max(seenHi_, p.position + glm::vec3(view.dMax));
   }
   seenBounce_ = bounceRays.empty() ? glm::vec3(0.0f) : glm::vec3(bounce / static_cast<double>(bounceRays.size()));
 }

@@ -26,7 +26,10 @@
 // by its surface's R, one shadow ray to a few of them per point), and the first-bounce term of
 // I_a is fitted to it: the ambient term's first bounce is R(P) x W_c(P) x F_s, so
 //   F_s = sum_P R(P) E_1,s(P) / pi  /  sum_P R(P) W_c(P)          (per channel)
-// with W_c (or W, grey) measured at the same points with the render's rho and dmax. F_s replaces
+// with W_c (or W, grey) measured at the same points with the render's rho and dmax. The sun and
+// the sky, whose rays spread over the whole world and seldom land where the camera looks, are
+// gathered the other way: from where the seen points' cosine rays land, one shadow ray to the
+// light there (gatheredFirstBounce). F_s replaces
 // flux (1 - e_0) / (pi A_s) and I_a's weight is F_s x the same series of later bounces. F_s is
 // still linear in the light's emission (flux per landing), so relighting holds; it is fitted to
 // one camera (like the default dmax). The rays run on the CPU (bvh::closestHit / anyHit): a few
@@ -167,11 +170,11 @@ public:
   static constexpr std::uint8_t kNotSeen = 0xff;
   static constexpr std::uint32_t kTries = 2 * kVisibilityTries; // light points, then landing points
   // Seen fit: camera points (a grid), obscurance rays at each, landings (virtual point lights)
-  // tested from each (OURS: ~16k shadow rays per light; the fit's spread over seeds is a few %).
+  // tested from each (OURS: ~16k shadow rays per light; the fit's spread over seeds is a few %);
+  // the sun and the sky: one shadow ray where each of the points' kSeenObscuranceRays landed.
   static constexpr std::uint32_t kSeenGrid = 24;
   static constexpr std::uint32_t kSeenObscuranceRays = 16;
   static constexpr std::uint32_t kSeenLandingsPerPoint = 32;
-  static constexpr std::uint32_t kSeenBeamRays = 1024; // sun and sky: beams across the seen box
 
 private:
   struct SurfacePoint {
@@ -183,21 +186,19 @@ private:
   // sample is behind the light's point, or outside a spot's cone).
   glm::vec3 lightTryTarget(const LightSet& lights, std::size_t light, const SurfacePoint& sample, StreamRng& rng) const;
   LightReach trace(RayBatch& rays, const LightSet& lights, std::size_t light, const Replay* replay) const;
-  struct Photon { // a landing point as a virtual point light of the Seen fit
-    glm::vec3 position, normal, reflectance;
-    glm::dvec3 flux;
-    double rc2; // r_c^2: its share of the lit area / pi
+  // Where a seen point's cosine ray landed: the sun's and the sky's first bounce is gathered there
+  // (gatheredFirstBounce).
+  struct SeenGather {
+    glm::vec3 position; // off the surface, on the side the ray came from
+    glm::vec3 normal;   // facing the seen point
+    glm::dvec3 weight;  // its share of sum_P R(P) E_1(P) / pi per unit of direct irradiance there
   };
-  struct BeamRect {
-    glm::vec3 t{0.0f}, b{0.0f};
-    glm::vec2 lo{0.0f}, hi{0.0f};
-    float area() const { return hi.x > lo.x && hi.y > lo.y ? (hi.x - lo.x) * (hi.y - lo.y) : 0.0f; }
-  };
-  float sceneRadius() const;
-  BeamRect seenBoxAcross(glm::vec3 direction) const;
-  bool beamCrossesSeenBox(glm::vec3 from, glm::vec3 direction) const;
-  std::vector<Photon> beamPhotons(RayBatch& rays, const LightSet& lights, std::size_t light, StreamRng& rng,
-                                  std::uint64_t& traced) const;
+  // The Seen fit's target, sum_P R(P) E_1(P) / pi, for a light inside the scene (from its landings)
+  // and for the sun and the sky (gathered).
+  glm::dvec3 landingsFirstBounce(RayBatch& rays, const std::vector<SurfacePoint>& landings, glm::dvec3 flux, double rc2,
+                                 std::uint32_t seed, std::uint64_t& traced) const;
+  glm::dvec3 gatheredFirstBounce(RayBatch& rays, const LightSet& lights, std::size_t light, std::uint32_t seed,
+                                 std::uint64_t& traced) const;
   const scene::Scene* scene_;
   std::optional<bvh::Bvh> bvhCopy_;
   const bvh::Bvh* callersBvh_; // bvh(): the copy when there is one
@@ -205,10 +206,10 @@ private:
   std::vector<std::uint64_t> sampleKeys_; // per sample: triangle << 32 | its number on it, ascending
   static std::uint32_t sampleStream(std::uint64_t key); // the index of its streams
   std::vector<glm::vec3> reflectance_; // per triangle
-  std::vector<SurfacePoint> seen_;     // camera points (reflectance = R(P))
-  glm::dvec3 seenModel_{0.0};
-  glm::vec3 seenLo_{0.0f}, seenHi_{0.0f}; // the seen points' box grown by dmax
-  glm::vec3 seenBounce_{0.0f};            // q around the seen points (LightReach::seenBounce)          // sum_P R(P) W_c(P): the model's first bounce per unit F_s
+  std::vector<SurfacePoint> seen_;        // camera points (reflectance = R(P))
+  std::vector<SeenGather> seenGathers_;   // where their cosine rays landed
+  glm::dvec3 seenModel_{0.0};             // sum_P R(P) W_c(P): the model's first bounce per unit F_s
+  glm::vec3 seenBounce_{0.0f};            // q around the seen points (LightReach::seenBounce)
   double totalArea_ = 0.0;
   scene::Bounds bounds_; // the scene's: where the sky's and the sun's light points lie
   float offset_ = 1e-5f; // ray-origin offset along the normal: 1e-5 of the scene's largest extent
