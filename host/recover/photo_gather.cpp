@@ -185,7 +185,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
     }
     // Each hidden vertex's own indirect light: one more cosine-distributed ray, up to
     // hiddenBounces_ vertices deep. It ends at a surface the camera sees (the photograph), or
-    // leaves the room (black), or is cut at the last depth (the mean b).
+    // leaves the room (black), or is cut at the last depth (its object's c_o).
     for (std::uint32_t depth = 0; depth < hiddenBounces_ && !active.empty(); ++depth) {
       bounceRays.clear();
       for (const Active& a : active) {
@@ -234,55 +234,77 @@ PhotoGather PhotoGather::onDevice(const gpu::Context& context, const scene::Scen
 
 std::vector<std::vector<glm::vec3>> PhotoGather::indirect(const std::vector<Shot>& shots,
                                                           const std::vector<glm::vec3>& objectReflectance,
-                                                          const std::vector<glm::vec3>& hiddenAmbient) const {
+                                                          const std::vector<Cut>& cut, std::vector<Cut>* settled) const {
   std::vector<std::vector<glm::vec3>> out;
+  if (settled) settled->assign(shots_, Cut());
   for (std::size_t i = 0; i < shots_; ++i) {
     std::vector<glm::vec3> lampColour(shots_, glm::vec3(0.0f));
     lampColour[i] = shots[i].color;
-    out.push_back(gather(shots[i].radiance, lampColour, objectReflectance, hiddenAmbient[i]));
+    out.push_back(gather(shots[i].radiance, lampColour, objectReflectance, cut.at(i), settled ? &(*settled)[i] : nullptr));
   }
   return out;
 }
 
 std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radiance,
                                            const std::vector<glm::vec3>& lampColour,
-                                           const std::vector<glm::vec3>& objectReflectance,
-                                           const glm::vec3& hiddenAmbient) const {
+                                           const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
+                                           Cut* settled) const {
+  std::vector<glm::dvec3> incoming;
+  std::vector<double> paths;
+  const std::vector<glm::vec3> hidden =
+      hiddenRadiance(radiance, lampColour, objectReflectance, cut, settled ? &incoming : nullptr, &paths);
   std::vector<glm::vec3> out(pixels_, glm::vec3(0.0f));
   const float perRay = 1.0f / float(raysPerPixel_);
+  glm::dvec3 sumB(0.0);
+  std::size_t surfaces = 0;
   for (std::size_t p = 0; p < pixels_; ++p) {
     glm::vec3 sum(0.0f);
     for (std::uint32_t k = seenStart_[p]; k < seenStart_[p + 1]; ++k) sum += radiance[seen_[k]];
-    for (std::uint32_t k = hiddenStart_[p]; k < hiddenEnd_[p]; ++k)
-      sum += hiddenRadiance(k, radiance, lampColour, objectReflectance, hiddenAmbient);
+    for (std::uint32_t k = hiddenStart_[p]; k < hiddenEnd_[p]; ++k) sum += hidden[k];
     out[p] = sum * perRay;
   }
   if (smoothRadius_ > 0) out = smoothOnSurfaces(out, *geometry_, smoothRadius_);
+  if (settled) {
+    // The prior an object with few vertices of its own leans on: the pixels' mean B now.
+    for (std::size_t p = 0; p < pixels_; ++p)
+      if (geometry_->object[p] >= 0) {
+        sumB += glm::dvec3(out[p]);
+        ++surfaces;
+      }
+    const glm::dvec3 b = surfaces > 0 ? sumB / double(surfaces) : glm::dvec3(0.0);
+    settled->resize(cut.size());
+    for (std::size_t o = 0; o < cut.size(); ++o) (*settled)[o] = glm::vec3((incoming[o] + kCutPrior * b) / (paths[o] + kCutPrior));
+  }
   return out;
 }
 
-glm::vec3 PhotoGather::hiddenRadiance(std::uint32_t first, const std::vector<glm::vec3>& radiance,
-                                      const std::vector<glm::vec3>& lampColour,
-                                      const std::vector<glm::vec3>& objectReflectance,
-                                      const glm::vec3& hiddenAmbient) const {
-  // L(v) = R_o(v) (sum_i direct_i(v) lamp_i + L(next)), folded from the path's end.
-  std::uint32_t chain[kMaxHiddenBounces + 1];
-  std::size_t length = 0;
-  std::uint32_t v = first;
-  for (;;) {
-    chain[length++] = v;
-    const std::uint32_t n = next_[v];
-    if (n == kEscaped || n == kTruncated || (n & kSeenFlag) != 0) break;
-    v = n;
+std::vector<glm::vec3> PhotoGather::hiddenRadiance(const std::vector<glm::vec3>& radiance,
+                                                   const std::vector<glm::vec3>& lampColour,
+                                                   const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
+                                                   std::vector<glm::dvec3>* incoming, std::vector<double>* paths) const {
+  // L(v) = R_o(v) (sum_i direct_i(v) lamp_i + L_in(v)), L_in(v) the next vertex's L, the
+  // photograph where the camera sees it, 0 where the ray left, c_o(v) where the path was cut.
+  const std::size_t vertices = hiddenObject_.size();
+  std::vector<glm::vec3> out(vertices);
+  if (incoming) {
+    incoming->assign(cut.size(), glm::dvec3(0.0));
+    paths->assign(cut.size(), 0.0);
   }
-  const std::uint32_t end = next_[chain[length - 1]];
-  glm::vec3 light = end == kEscaped ? glm::vec3(0.0f) : end == kTruncated ? hiddenAmbient : radiance[end & ~kSeenFlag];
-  for (std::size_t k = length; k-- > 0;) {
-    const std::uint32_t u = chain[k];
-    for (std::size_t i = 0; i < shots_; ++i) light += hiddenDirect_[std::size_t(u) * shots_ + i] * lampColour[i];
-    light *= objectReflectance[hiddenObject_[u]];
+  for (std::size_t v = vertices; v-- > 0;) {
+    const std::uint32_t n = next_[v], o = hiddenObject_[v];
+    const glm::vec3 in = n == kEscaped ? glm::vec3(0.0f)
+                         : n == kTruncated ? cut[o]
+                         : (n & kSeenFlag) != 0 ? radiance[n & ~kSeenFlag]
+                                                : out[n];
+    if (incoming && n != kTruncated) {
+      (*incoming)[o] += glm::dvec3(in);
+      (*paths)[o] += 1.0;
+    }
+    glm::vec3 light = in;
+    for (std::size_t i = 0; i < shots_; ++i) light += hiddenDirect_[v * shots_ + i] * lampColour[i];
+    out[v] = light * objectReflectance[o];
   }
-  return light;
+  return out;
 }
 
 std::vector<glm::vec3> smoothOnSurfaces(const std::vector<glm::vec3>& image, const PixelGeometry& pixels, int radius) {

@@ -11,11 +11,17 @@
 // the same estimate one vertex on: a path through the surfaces the camera does not see, one
 // cosine-distributed ray per vertex, until it meets a surface the camera sees (the photograph's
 // radiance ends it), leaves the room (black), or reaches `hiddenBounces` vertices past Q (cut
-// there with b_i, the current mean indirect light of the pixels). With hiddenBounces = 0 every
-// hidden Q takes b_i: the first design, which lit hidden surfaces in shadow (under desks, behind
-// objects) as brightly as the room's average and biased B up where most rays are hidden (69-78 %
-// of them in a large room). One path per hidden hit is a noisy estimate, but a pixel averages its
-// tens of hidden hits and the smoothing below pools a window of pixels.
+// there). One path per hidden hit is a noisy estimate, but a pixel averages its tens of hidden
+// hits and the smoothing below pools a window of pixels.
+//
+// The cut: the light a path would have brought on from its last vertex, which belongs to an object
+// o, is taken as c_o, the mean incoming indirect light of the hidden vertices on o whose paths went
+// on (a radiance cache of one value per object, settled over the caller's iterations: each gather
+// returns the c_o its own paths found, to cut the next one with). The first design cut with b_i,
+// the mean indirect light of the pixels, and with hiddenBounces = 0 gave every hidden Q b_i: that
+// lit hidden surfaces in shadow (under desks, behind objects) and whole dark regions (classroom's
+// hallway, seen through its windows, where the photographs are 1/20 of the walls) as brightly as
+// the room's average, and biased B up where most rays are hidden (69-88 % in a large room).
 // Rays that leave the scene see nothing (the photographs' world is black).
 //
 // The rays depend on the geometry only: they are traced once, through a RayBatch (the device's
@@ -50,7 +56,7 @@ struct PixelGeometry {
 };
 
 // The longest path through hidden surfaces (`hiddenBounces`' range), and the default: at a
-// reflectance of ~0.7 the cut vertex carries 0.7^3 = 1/3 of the mean b's weight at the first.
+// reflectance of ~0.7 the cut vertex carries 0.7^3 = 1/3 of the cut's weight at the first.
 inline constexpr std::uint32_t kMaxHiddenBounces = 8;
 inline constexpr std::uint32_t kDefaultHiddenBounces = 3;
 
@@ -71,17 +77,30 @@ public:
   // and the rays and hits of one batch in tens of MiB of host memory.
   static constexpr std::size_t kRaysPerBatch = std::size_t(1) << 20;
 
+  // The cut c_o per object (see above): the incoming indirect light (per unit reflectance,
+  // radiance units) a path cut at a vertex on object o brings.
+  using Cut = std::vector<glm::vec3>;
+  // A cut of one value b for every one of `objects` objects (the first design's, to start from).
+  static Cut uniformCut(std::size_t objects, glm::vec3 b) { return Cut(objects, b); }
+
   // B_i per pixel for every shot (per unit reflectance, radiance units), with the photographs'
-  // radiance where the camera sees the hit, and objectReflectance / hiddenAmbient[i] elsewhere.
+  // radiance where the camera sees the hit, and objectReflectance and cut[i] elsewhere; with
+  // `settled`, also the cut these paths found for each shot (gather's).
   std::vector<std::vector<glm::vec3>> indirect(const std::vector<Shot>& shots,
                                                const std::vector<glm::vec3>& objectReflectance,
-                                               const std::vector<glm::vec3>& hiddenAmbient) const;
+                                               const std::vector<Cut>& cut, std::vector<Cut>* settled = nullptr) const;
   // One gather of an arbitrary lighting (relighting the recovered room, remodel.h): B(P) with
   // `radiance` the current radiance of the pixels the camera sees, and at hidden hits
-  // objectReflectance x (sum_i lampColour[i] x the shot-i lamp's direct light + hiddenAmbient).
+  // objectReflectance x (sum_i lampColour[i] x the shot-i lamp's direct light + what comes in:
+  // the path's next vertex, or `cut` at its last). With `settled`, also the cut these paths found:
+  // per object, the mean incoming light of its vertices whose paths went on, shrunk towards the
+  // pixels' mean B where they are few (kCutPrior vertices' worth; an object no path went on from,
+  // or every object with hiddenBounces = 0, gets that mean: the first design's cut).
   // indirect() is this with photo i's radiance and only lamp i.
   std::vector<glm::vec3> gather(const std::vector<glm::vec3>& radiance, const std::vector<glm::vec3>& lampColour,
-                                const std::vector<glm::vec3>& objectReflectance, const glm::vec3& hiddenAmbient) const;
+                                const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
+                                Cut* settled = nullptr) const;
+  static constexpr double kCutPrior = 32.0;
   // Fractions of the rays whose hit the camera sees, that are hidden, and that leave the scene.
   double seenFraction() const { return double(seen_.size()) / double(rays_); }
   double hiddenFraction() const { return double(firstHidden_) / double(rays_); }
@@ -90,13 +109,15 @@ public:
 private:
   // next_[v]: where the path goes on from hidden vertex v.
   static constexpr std::uint32_t kEscaped = ~0u;        // the ray left the room
-  static constexpr std::uint32_t kTruncated = ~0u - 1u; // cut at the last depth: the mean b
+  static constexpr std::uint32_t kTruncated = ~0u - 1u; // cut at the last depth: the object's c_o
   static constexpr std::uint32_t kSeenFlag = 1u << 31;  // | the pixel that shows the next hit
   // Otherwise the next hidden vertex's index.
-  // The radiance towards its origin of the path from hidden vertex `first`.
-  glm::vec3 hiddenRadiance(std::uint32_t first, const std::vector<glm::vec3>& radiance,
-                           const std::vector<glm::vec3>& lampColour, const std::vector<glm::vec3>& objectReflectance,
-                           const glm::vec3& hiddenAmbient) const;
+  // Every hidden vertex's radiance towards where its ray came from, folded from the paths' ends
+  // (a vertex's next one always has a larger index); with `incoming`, also per object the sum of
+  // the incoming light of its vertices whose paths went on, and in `paths` how many there were.
+  std::vector<glm::vec3> hiddenRadiance(const std::vector<glm::vec3>& radiance, const std::vector<glm::vec3>& lampColour,
+                                        const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
+                                        std::vector<glm::dvec3>* incoming, std::vector<double>* paths) const;
 
   const PixelGeometry* geometry_;
   int smoothRadius_ = 0;

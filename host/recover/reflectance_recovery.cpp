@@ -280,14 +280,19 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
                       100.0 * out.gatherSeen, 100.0 * out.gatherHidden, secondsSince(stepStart)));
   }
   if (options.indirect != IndirectModel::Constant) {
+    std::vector<PhotoGather::Cut> cuts; // per shot
     for (std::uint32_t it = 1; it <= options.iterations; ++it) {
       stepStart = Clock::now();
       const std::vector<glm::vec3>& means = out.iterations.back().objectReflectance;
       if (gather) {
-        // Hidden surfaces get the mean indirect light of the last estimate.
-        std::vector<glm::vec3> hiddenAmbient;
-        for (const auto& b : out.indirect) hiddenAmbient.push_back(constantAmbient(b, lighting.geometry.object, 1.0f).front());
-        out.indirect = gather->indirect(photos.shots, means, hiddenAmbient);
+        // Paths through hidden surfaces are cut with what the last gather's paths found on each
+        // object (photo_gather.h); the first, with the constant estimate's mean indirect light.
+        if (cuts.empty())
+          for (const auto& b : out.indirect)
+            cuts.push_back(PhotoGather::uniformCut(objects, constantAmbient(b, lighting.geometry.object, 1.0f).front()));
+        std::vector<PhotoGather::Cut> settled;
+        out.indirect = gather->indirect(photos.shots, means, cuts, &settled);
+        cuts = std::move(settled);
       } else {
         lighting = traceLighting(context, room, bvh, camera, photos, means, options);
         out.indirect = lighting.indirect;

@@ -111,11 +111,14 @@ RemodelledFrame renderRemodelled(const gpu::Context& context, const RecoveredRoo
   for (const Shot& lamp : lamps) lampColour.push_back(lamp.color);
   out.indirect.assign(pixels, glm::vec3(0.0f));
   std::vector<glm::vec3> radiance(pixels);
+  // Paths through hidden surfaces cut as recover cuts them, settling with the bounces.
+  PhotoGather::Cut cut = PhotoGather::uniformCut(objectReflectance.size(), glm::vec3(0.0f));
   for (std::uint32_t bounce = 0; bounce <= options.bounces; ++bounce) {
     for (std::size_t p = 0; p < pixels; ++p) radiance[p] = out.reflectance[p] * (out.direct[p] + out.indirect[p]);
     if (bounce == options.bounces) break;
-    const glm::vec3 hiddenAmbient = constantAmbient(out.indirect, view.object, 1.0f).front();
-    out.indirect = gather.gather(radiance, lampColour, objectReflectance, hiddenAmbient);
+    PhotoGather::Cut settled;
+    out.indirect = gather.gather(radiance, lampColour, objectReflectance, cut, &settled);
+    cut = std::move(settled);
   }
   out.radiance = std::move(radiance);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

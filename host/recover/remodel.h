@@ -13,9 +13,9 @@
 //      the edited room, from the relit radiance itself: B_0 = 0, L_k = R (E + B_k),
 //      B_{k+1} = gather(L_k), one more bounce per step [the rendering equation's Neumann series,
 //      Kajiya 1986]. Hidden surfaces are their object's mean reflectance lit by shadow rays
-//      and by paths on through hidden surfaces (photo_gather.h), cut with the mean B. This is
-//      the gather that recover divides the photographs by, so relighting the room under a
-//      photographed lamp gives back its photograph (where R came from that division).
+//      and by paths on through hidden surfaces (photo_gather.h), cut per object as recover cuts
+//      them. This is the gather that recover divides the photographs by, so relighting the room
+//      under a photographed lamp gives back its photograph (where R came from that division).
 // Lamps are glTF point lights (as recover's); inserted objects' textures are not read (their
 // base colour factor is their reflectance).
 #pragma once

@@ -57,7 +57,8 @@ TEST_F(RecoverCornell, GatherOnTheDeviceEqualsItsCpuTwin) {
   EXPECT_NEAR(onDevice.seenFraction(), onCpu.seenFraction(), 1e-4);
   EXPECT_NEAR(onDevice.hiddenFraction(), onCpu.hiddenFraction(), 1e-4);
   const std::vector<glm::vec3> grey(room_->scene.objects.size(), glm::vec3(0.5f));
-  const std::vector<glm::vec3> ambient(photos_->shots.size(), glm::vec3(0.05f));
+  const std::vector<recover::PhotoGather::Cut> ambient(
+      photos_->shots.size(), recover::PhotoGather::uniformCut(room_->scene.objects.size(), glm::vec3(0.05f)));
   const auto a = onCpu.indirect(photos_->shots, grey, ambient), b = onDevice.indirect(photos_->shots, grey, ambient);
   // A ray through an edge or a vertex may find the neighbouring triangle on one side: a few pixels
   // differ by one ray's share, the images' means by far less.

@@ -3,12 +3,15 @@
 // tools/cycles_photo_set.py), where 78 % of the gather's rays meet surfaces the camera does not
 // see, chairs and desks are a few pixels wide and a quarter of the pixels no lamp lights.
 //
-// Measured at the defaults (spp 8, 16 gather rays, 3 hidden bounces, the weighted merge; seeds
-// 1, 2, 3; docs/BENCHMARKS.md "Recovery beyond the Cornell box"):
-//   lit 0.0392 / 0.0399 / 0.0389   lit in some photo 0.0947 / 0.0941 / 0.0944   all 0.1010 / 0.0994 / 0.1001
-//   the walls' mean ratio to the truth 0.98; the first design: all 0.2196 (outliers up to R = 45).
-// The bounds below are the measured figures plus 10 %, ten times the seed-to-seed spread; they
-// are not issue 36's goals (all 0.04, lit in some photo 0.02), which this room does not meet yet.
+// Measured at the defaults (spp 8, 16 gather rays, 3 hidden bounces cut per object, the weighted
+// merge; seeds 1, 2, 3; docs/BENCHMARKS.md "Paths through hidden surfaces cut per object"):
+//   lit 0.0362 / 0.0363 / 0.0360   lit in some photo 0.0932 / 0.0929 / 0.0930   all 0.0967 / 0.0953 / 0.0957
+//   shadow (no lamp lights the pixel) 0.1194 / 0.1118 / 0.1141
+//   the walls' mean ratio to the truth 0.99; the first design: all 0.2196 (outliers up to R = 45).
+// The bounds below are the largest of the three plus 10 %, several times the seed-to-seed spread;
+// they are not issue 36's goals (all 0.04, lit in some photo 0.02), which this room does not meet
+// yet. Cut with the pixels' mean B (before) the shadow pixels came out at 0.1396: the shadow bound
+// fails there.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -35,11 +38,12 @@ TEST_F(RecoverClassroom, ALargerRoomIsRecoveredToItsMeasuredAccuracyWithEveryRef
   const Recovery r =
       recoverReflectance(context(), room.scene, room.bvh, room.scene.cameras.at(0), photos, RecoveryOptions{});
   const RecoveryAccuracy a = recoveryAccuracy(r.reflectance, truth, lightRegions(r.visibility, r.object));
-  EXPECT_LE(a.lit.rmse, 0.044);
-  EXPECT_LE(a.direct.rmse, 0.104);
-  EXPECT_LE(a.all.rmse, 0.111);
+  EXPECT_LE(a.lit.rmse, 0.040);
+  EXPECT_LE(a.direct.rmse, 0.1025);
+  EXPECT_LE(a.all.rmse, 0.1064);
+  EXPECT_LE(a.shadow.rmse, 0.131);
   // A quarter of the pixels no lamp lights; the merge recovers some of them from their indirect
-  // light (measured 3,318), and the fills are counted.
+  // light (measured 3,272-3,353), and the fills are counted.
   EXPECT_GT(r.indirectOnlyPixels, 2000u);
   EXPECT_EQ(r.litPixels + r.indirectOnlyPixels + r.filledFromVisibility + r.filledFromObject, a.all.pixels);
   // Every reflectance is a reflectance: finite, in [0, 1] (the first design had 24 pixels at 3 to 45).
