@@ -1,6 +1,7 @@
 #include "render/scene_data/ambient.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -10,14 +11,23 @@ namespace obscura::render {
 constexpr float kMaxAverageReflectance = 0.999f;
 
 glm::vec3 meanTextureColour(const scene::Texture& texture) {
+  // A texel holds one of 256 values: decoded once into a table (the same sRGB curve, so the same
+  // sums). A pow per texel was ~2 s of a recovery on the staircase's textures, which every render
+  // of a room pays twice (the reach's reflectances and the ambient's).
+  static const std::array<std::array<double, 256>, 2> decoded = [] {
+    std::array<std::array<double, 256>, 2> table{};
+    for (int i = 0; i < 256; ++i) {
+      const double v = i / 255.0;
+      table[0][i] = v;
+      table[1][i] = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+    }
+    return table;
+  }();
+  const std::array<double, 256>& decode = decoded[texture.srgb ? 1 : 0];
   glm::dvec3 sum(0.0);
   const std::size_t n = std::size_t(texture.width) * texture.height;
   for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) {
-      double v = texture.rgba8[i * 4 + c] / 255.0;
-      if (texture.srgb) v = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-      sum[c] += v;
-    }
+    for (int c = 0; c < 3; ++c) sum[c] += decode[texture.rgba8[i * 4 + c]];
   return n ? glm::vec3(sum / static_cast<double>(n)) : glm::vec3(1.0f);
 }
 
