@@ -127,7 +127,8 @@ private:
   // Per pixel p, its seen hits are seen_[seenStart_[p] .. seenStart_[p + 1]) (pixel indices), its
   // hidden hits hiddenObject_/hiddenDirect_ [hiddenStart_[p] .. hiddenEnd_[p]) (hiddenDirect_:
   // shots_ values per vertex, the lamp's unit-reflectance direct light F V I / pi there, without
-  // the lamp's colour). Deeper path vertices follow each chunk's pixels, outside every range.
+  // the lamp's colour; at a deeper vertex one lamp's, weighted, the others 0: see the
+  // constructor). Deeper path vertices follow each chunk's pixels, outside every range.
   std::vector<std::uint32_t> seenStart_, seen_;
   std::vector<std::uint32_t> hiddenStart_, hiddenEnd_, hiddenObject_;
   std::vector<float> hiddenDirect_;
