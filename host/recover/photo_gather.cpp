@@ -268,12 +268,10 @@ std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radianc
                                            Cut* settled) const {
   std::vector<glm::dvec3> incoming;
   std::vector<double> paths;
-  const std::vector<glm::vec3> hidden =
-      hiddenRadiance(radiance, lampColour, objectReflectance, cut, settled ? &incoming : nullptr, &paths);
+  const std::vector<glm::vec3> hidden = hiddenRadiance(radiance, lampColour, objectReflectance, cut,
+                                                       settled ? &incoming : nullptr, settled ? &paths : nullptr);
   std::vector<glm::vec3> out(pixels_, glm::vec3(0.0f));
   const float perRay = 1.0f / float(raysPerPixel_);
-  glm::dvec3 sumB(0.0);
-  std::size_t surfaces = 0;
   for (std::size_t p = 0; p < pixels_; ++p) {
     glm::vec3 sum(0.0f);
     for (std::uint32_t k = seenStart_[p]; k < seenStart_[p + 1]; ++k) sum += radiance[seen_[k]];
@@ -283,6 +281,8 @@ std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radianc
   if (smoothRadius_ > 0) out = smoothOnSurfaces(out, *geometry_, smoothRadius_);
   if (settled) {
     // The prior an object with few vertices of its own leans on: the pixels' mean B now.
+    glm::dvec3 sumB(0.0);
+    std::size_t surfaces = 0;
     for (std::size_t p = 0; p < pixels_; ++p)
       if (geometry_->object[p] >= 0) {
         sumB += glm::dvec3(out[p]);
