@@ -337,6 +337,10 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   struct Stage {
     std::vector<bvh::Ray> ray;
     std::vector<std::uint32_t> owner;
+    void reserve(std::size_t n) {
+      ray.reserve(n);
+      owner.reserve(n);
+    }
     void add(std::uint32_t who, const bvh::Ray& r) {
       ray.push_back(r);
       owner.push_back(who);
@@ -556,6 +560,7 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   };
   {
     Stage stage; // the tries at points of the light
+    stage.reserve(kVisibilityTries * looked);
     if (looked < samples_.size() && replay->samplesInPlace) {
       // Most samples kept, where they were: their outcomes copied whole, the others' cleared below.
       rays.firstSeenTry = replay->rays.firstSeenTry;
@@ -595,6 +600,7 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   }
   if (landed > 0) {
     Stage stage; // the tries at landing points, for the samples the light itself did not see
+    stage.reserve(kVisibilityTries * looked);
     for (const std::uint32_t j : lookedAt) {
       if (rays.firstSeenTry[j] != kNotSeen) continue;
       const SurfacePoint& s = samples_[j];
