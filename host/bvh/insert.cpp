@@ -10,7 +10,8 @@
 namespace obscura::bvh {
 namespace {
 
-// One past the last triangle the node's leaf slots address, relative to its first triangle.
+// One past the last triangle the node's leaf slots address, relative to its first triangle (from
+// the meta bytes alone: every node is looked at).
 std::uint32_t leafRangeEnd(const gpu::BvhNode& node) {
   std::uint32_t end = 0;
   const std::uint32_t imask = internalMask(node);
@@ -70,7 +71,9 @@ bool insertTriangles(Bvh& bvh, std::span<const std::uint32_t> ids, const Triangl
   if (chosen == ~0u) return false;
 
   gpu::BvhNode& node = bvh.nodes[chosen];
-  const std::uint32_t imask = internalMask(node), oldFirst = firstTriangle(node), rangeEnd = leafRangeEnd(node);
+  // The node written again with its slots as they decode, and the new leaf in its first free slot.
+  std::array<WideChild, gpu::kBvhWidth> slots = decodedSlots(node);
+  const std::uint32_t oldFirst = firstTriangle(node), rangeEnd = leafRangeEnd(node);
   const auto newFirst = static_cast<std::uint32_t>(bvh.triangles.size());
   for (std::uint32_t t = 0; t < rangeEnd; ++t) { // the node's leaves, copied to the end
     bvh.triangles.push_back(bvh.triangles[oldFirst + t]);
@@ -84,27 +87,11 @@ bool insertTriangles(Bvh& bvh, std::span<const std::uint32_t> ids, const Triangl
     bvh.triangles.push_back(t);
     bvh.order.push_back(ids[k]);
   }
-  // The node written again with its slots as they decode, and the new leaf in its first free slot.
-  std::array<WideChild, gpu::kBvhWidth> slots{};
-  bool placed = false;
-  for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
-    const std::uint32_t meta = slotMeta(node, s);
-    WideChild& c = slots[s];
-    if (meta == 0) {
-      if (placed) continue;
+  for (WideChild& c : slots)
+    if (c.kind == WideChild::Kind::Empty) {
       c = {.kind = WideChild::Kind::Leaf, .box = box, .triangleOffset = rangeEnd, .triangleCount = count};
-      placed = true;
-      continue;
+      break;
     }
-    c.box = decodedBox(node, s);
-    if (imask >> s & 1u) {
-      c.kind = WideChild::Kind::Internal;
-    } else {
-      c.kind = WideChild::Kind::Leaf;
-      c.triangleCount = meta & 3u;
-      c.triangleOffset = meta >> 2 & 31u;
-    }
-  }
   writeWideNode(node, slots, firstChild(node), newFirst);
   // Its ancestors' boxes for that slot still hold the old box: grown exactly by the refit after.
   return true;

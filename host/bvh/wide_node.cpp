@@ -103,21 +103,34 @@ void writeWideNode(gpu::BvhNode& node, const std::array<WideChild, gpu::kBvhWidt
   node.qz = gpu::vec4(asFloat(q[2].x), asFloat(q[2].y), asFloat(q[2].z), asFloat(q[2].w));
 }
 
-std::array<WideChild, gpu::kBvhWidth> exactSlots(const gpu::BvhNode& node, const std::vector<gpu::BvhTriangle>& triangles,
-                                                 const std::vector<Box>& nodeBox) {
+std::array<WideChild, gpu::kBvhWidth> decodedSlots(const gpu::BvhNode& node) {
   const std::uint32_t imask = internalMask(node);
   std::array<WideChild, gpu::kBvhWidth> slots{};
   for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
     const std::uint32_t meta = slotMeta(node, s);
     if (meta == 0) continue;
     WideChild& c = slots[s];
+    c.box = decodedBox(node, s);
     if (imask >> s & 1u) {
       c.kind = WideChild::Kind::Internal;
-      c.box = nodeBox[childNodeIndex(node, s)];
     } else {
       c.kind = WideChild::Kind::Leaf;
       c.triangleCount = meta & 3u;
       c.triangleOffset = meta >> 2 & 31u;
+    }
+  }
+  return slots;
+}
+
+std::array<WideChild, gpu::kBvhWidth> exactSlots(const gpu::BvhNode& node, const std::vector<gpu::BvhTriangle>& triangles,
+                                                 const std::vector<Box>& nodeBox) {
+  std::array<WideChild, gpu::kBvhWidth> slots = decodedSlots(node);
+  for (unsigned s = 0; s < gpu::kBvhWidth; ++s) {
+    WideChild& c = slots[s];
+    if (c.kind == WideChild::Kind::Internal) {
+      c.box = nodeBox[childNodeIndex(node, s)];
+    } else if (c.kind == WideChild::Kind::Leaf) {
+      c.box = Box{};
       const std::uint32_t first = firstTriangle(node) + c.triangleOffset;
       for (std::uint32_t t = first; t < first + c.triangleCount; ++t)
         for (const gpu::vec4* v : {&triangles[t].v0, &triangles[t].v1, &triangles[t].v2}) c.box.grow(glm::vec3(*v));

@@ -36,6 +36,8 @@ struct WideChild {
 void writeWideNode(gpu::BvhNode& node, const std::array<WideChild, gpu::kBvhWidth>& slots,
                    std::uint32_t firstChild, std::uint32_t firstTriangle);
 
+// The slots of `node` as it decodes: kind, leaf triangles, and the decoded (conservative) boxes.
+std::array<WideChild, gpu::kBvhWidth> decodedSlots(const gpu::BvhNode& node);
 // The slots of `node` as refit sees them, with exact boxes: an interior slot's from `nodeBox` (per
 // node, filled by the caller bottom-up: children follow their parent), a leaf slot's from its
 // triangles (`triangles`: Bvh::triangles, their whole boxes).

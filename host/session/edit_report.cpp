@@ -31,8 +31,9 @@ nlohmann::json EditReport::json() const {
                          {"cpu_ms", cpuMs},
                          {"total_ms", totalMs}};
   if (bvh) {
-    line["bvh"] = {{"kind", bvh->refit ? "refit" : bvh->inserted ? "insert" : "rebuild"}, {"ms", bvh->ms}};
-    if (bvh->refit) line["bvh"]["nodes"] = bvh->nodes;
+    const bool refit = bvh->kind == BvhUpdate::Kind::Refit;
+    line["bvh"] = {{"kind", refit ? "refit" : bvh->kind == BvhUpdate::Kind::Insert ? "insert" : "rebuild"}, {"ms", bvh->ms}};
+    if (refit) line["bvh"]["nodes"] = bvh->nodes;
   }
   if (reach) line["reach"] = {{"rays", reach->rays}, {"ms", reach->ms}};
   return line;

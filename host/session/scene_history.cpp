@@ -39,25 +39,15 @@ GeometryChange SceneHistory::apply(const Edit& e, const std::string& where) {
     }
   }
   const auto start = std::chrono::steady_clock::now();
-  change.bvh.refit = e.kind == Kind::Move || e.kind == Kind::Remove;
   bvh::Bvh tree;
-  if (change.bvh.refit) {
+  if (e.kind == Kind::Move || e.kind == Kind::Remove) {
     // The object's triangles only (they have vertices of their own): the nodes above them.
-    const scene::SceneObject& object = next.objects[change.object];
-    std::vector<std::uint32_t> ids(object.triangleCount);
-    bvh::TriangleSoup moved;
-    for (std::uint32_t k = 0; k < object.triangleCount; ++k) {
-      const std::uint32_t id = object.firstTriangle + k;
-      const glm::uvec3& t = next.triangles[id];
-      ids[k] = id;
-      moved.v0.push_back(next.positions[t.x]);
-      moved.v1.push_back(next.positions[t.y]);
-      moved.v2.push_back(next.positions[t.z]);
-    }
+    const ObjectTriangles moved = objectTriangles(next, change.object);
     tree = trees_.back();
-    change.bvh.nodes = refitter_->refit(tree, ids, moved).size();
+    change.bvh.kind = BvhUpdate::Kind::Refit;
+    change.bvh.nodes = refitter_->refit(tree, moved.ids, moved.soup).size();
   } else if (e.kind == Kind::AddQuad && insertQuad(next, change.object, tree)) {
-    change.bvh.inserted = true;
+    change.bvh.kind = BvhUpdate::Kind::Insert;
   } else {
     tree = bvh::build(render::triangleSoup(next), rebuildOptions_);
     refitter_.emplace(tree);
@@ -70,21 +60,25 @@ GeometryChange SceneHistory::apply(const Edit& e, const std::string& where) {
 
 bool SceneHistory::insertQuad(const scene::Scene& next, std::size_t object, bvh::Bvh& tree) {
   // Its two triangles hung into the tree before (bvh/insert.h), the boxes above them refitted.
-  const scene::SceneObject& quad = next.objects[object];
-  std::vector<std::uint32_t> ids;
-  bvh::TriangleSoup added;
-  for (std::uint32_t id = quad.firstTriangle; id < quad.firstTriangle + quad.triangleCount; ++id) {
-    const glm::uvec3& t = next.triangles[id];
-    ids.push_back(id);
-    added.v0.push_back(next.positions[t.x]);
-    added.v1.push_back(next.positions[t.y]);
-    added.v2.push_back(next.positions[t.z]);
-  }
+  const ObjectTriangles quad = objectTriangles(next, object);
   tree = trees_.back();
-  if (!bvh::insertTriangles(tree, ids, added)) return false;
+  if (!bvh::insertTriangles(tree, quad.ids, quad.soup)) return false;
   refitter_.emplace(tree);
-  refitter_->refit(tree, ids, added);
+  refitter_->refit(tree, quad.ids, quad.soup);
   return true;
+}
+
+SceneHistory::ObjectTriangles SceneHistory::objectTriangles(const scene::Scene& scene, std::size_t object) {
+  const scene::SceneObject& o = scene.objects[object];
+  ObjectTriangles out;
+  for (std::uint32_t id = o.firstTriangle; id < o.firstTriangle + o.triangleCount; ++id) {
+    const glm::uvec3& t = scene.triangles[id];
+    out.ids.push_back(id);
+    out.soup.v0.push_back(scene.positions[t.x]);
+    out.soup.v1.push_back(scene.positions[t.y]);
+    out.soup.v2.push_back(scene.positions[t.z]);
+  }
+  return out;
 }
 
 void SceneHistory::dropPrevious() {

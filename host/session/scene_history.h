@@ -2,8 +2,9 @@
 // choice of how the BVH follows an edit: a move or a removal keeps every triangle, so the tree is
 // refitted, above the object's triangles only (bvh/incremental_refit.h); an emissive quad's two
 // triangles are hung into it (bvh/insert.h); an insert adds many triangles, so the tree is rebuilt
-// with the options the device's traversal wants (render/scene_data/bvh_layout.h). A renderer holds pointers to the newest version; the one
-// before stays until dropPrevious(), once the renderer has moved on to the new one.
+// with the options the device's traversal wants (render/scene_data/bvh_layout.h). A renderer
+// holds pointers to the newest version; the one before stays until dropPrevious(), once the
+// renderer has moved on to the new one.
 #pragma once
 #include <deque>
 #include <optional>
@@ -18,10 +19,14 @@
 namespace obscura::session {
 
 struct BvhUpdate {
-  bool refit = false;     // refitted (true) or rebuilt
+  enum class Kind : std::uint8_t {
+    Rebuild, // built anew
+    Refit,   // the tree before, its boxes above the object's triangles refitted
+    Insert,  // an added quad hung into the tree before (bvh/insert.h)
+  };
+  Kind kind = Kind::Rebuild;
   double ms = 0.0;        // host wall time of the update
   std::size_t nodes = 0;  // refitted: the nodes above the object's triangles (bvh/incremental_refit.h)
-  bool inserted = false;  // an added quad hung into the tree before (bvh/insert.h), not rebuilt
 };
 
 // What a geometry edit changed.
@@ -46,8 +51,15 @@ public:
   void dropPrevious();
 
 private:
-  // An added quad (object `object` of `next`) into a copy of the current tree; false when it has no room.
+  // An added quad (object `object` of `next`) into a copy of the current tree; false when it has
+  // no room.
   bool insertQuad(const scene::Scene& next, std::size_t object, bvh::Bvh& tree);
+  // An object's triangles: their indices and vertices, as the refit and the insert take them.
+  struct ObjectTriangles {
+    std::vector<std::uint32_t> ids;
+    bvh::TriangleSoup soup;
+  };
+  static ObjectTriangles objectTriangles(const scene::Scene& scene, std::size_t object);
 
   std::deque<scene::Scene> scenes_; // a deque: its elements stay where they are as it grows
   std::deque<bvh::Bvh> trees_;

@@ -350,10 +350,8 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
   // 1. Where the light lands: first hits of rays leaving it (the position and the lit side's
   // normal). A light ray is traced again when its segment up to its old hit meets a changed box:
   // every other ray has the same first hit in the edited scene.
-  struct Landing {
-    glm::vec3 position, normal, reflectance;
-    glm::vec3 from, direction; // the light ray that landed there
-    bool moved = false;        // re-traced: what was seen of it before says nothing now
+  struct Landing : SurfacePoint { // where it landed, the lit side's normal, the reflectance there
+    bool moved = false;            // re-traced: what was seen of it before says nothing now
   };
   std::vector<Landing> landingOf(kLightRays); // by light ray; valid where landingT is finite
   rays.landingT.assign(kLightRays, std::numeric_limits<float>::quiet_NaN());
@@ -409,8 +407,7 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     glm::vec3 a = scene.positions[tri.x], b = scene.positions[tri.y], c = scene.positions[tri.z];
     glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
     if (glm::dot(n, d) > 0.0f) n = -n; // the side the light arrives on
-    landingOf[i] = {lightRay[i].origin + t * d, n, reflectance_[primitive], lightRay[i].origin, d,
-                    retraced[i] != 0 && replay != nullptr};
+    landingOf[i] = {{lightRay[i].origin + t * d, n, reflectance_[primitive]}, retraced[i] != 0 && replay != nullptr};
     ++landed;
     landedOn.push_back(primitive);
   }
@@ -643,7 +640,7 @@ LightReach ReachedSurfaces::trace(RayBatch& batch, const LightSet& lights, std::
     } else {
       std::vector<SurfacePoint> landings;
       for (std::uint32_t i = 0; i < kLightRays; ++i)
-        if (std::isfinite(rays.landingT[i])) landings.push_back({landingOf[i].position, landingOf[i].normal, landingOf[i].reflectance});
+        if (std::isfinite(rays.landingT[i])) landings.push_back(landingOf[i]);
       if (!landings.empty()) {
         const glm::dvec3 flux = glm::dvec3(lights.unitFlux[light]) * (1.0 - reach.escapeDirect) / static_cast<double>(landings.size());
         const double rc2 = reach.area / (std::numbers::pi * static_cast<double>(landings.size()));
