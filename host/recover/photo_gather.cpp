@@ -3,12 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include <glm/gtc/constants.hpp>
 
 #include "recover/recovery_scene.h"
 #include "render/gpu_ray_batch.h"
+#include "render/scene_data/camera_grid.h"
 #include "render/scene_data/scene_buffers.h"
 
 namespace obscura::recover {
@@ -37,6 +39,17 @@ void frame(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
   const float a = -1.0f / (sign + n.z), c = n.x * n.y * a;
   t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
   b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+// The interpolated vertex normal at `hit`, turned to the side of `geometric` (the side the ray
+// came from), as surface.glsl's shadingNormal; the geometric normal where the scene has none.
+glm::vec3 shadingNormal(const scene::Scene& room, const bvh::Hit& hit, const glm::vec3& geometric) {
+  if (room.normals.size() != room.positions.size()) return geometric;
+  const glm::uvec3 tri = room.triangles[hit.primitive];
+  const glm::vec3 n = (1.0f - hit.u - hit.v) * room.normals[tri.x] + hit.u * room.normals[tri.y] + hit.v * room.normals[tri.z];
+  const float length = glm::length(n);
+  if (!(length > 0.0f)) return geometric;
+  return glm::dot(n, geometric) < 0.0f ? -n / length : n / length;
 }
 
 } // namespace
@@ -155,20 +168,50 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
     glm::vec3 lit, normal;
   };
   std::vector<Active> active;
+  // Each gather ray starts where a camera ray through a random point of its pixel meets the room,
+  // so B is the mean over the pixel's footprint, as the rendered direct light D is. The pixel's
+  // mean point (the position AOV) is no surface point where the footprint is curved or crosses an
+  // edge: on a chair's tubular frame it lies inside the tube, and rays from there lit it from the
+  // tube's inside (classroom: 57 % of a frame pixel's hidden hits were its own tube, B 0.6 of
+  // path tracing's).
+  render::GridCamera view{camera.position, glm::normalize(camera.forward), camera.up, camera.yfov,
+                          float(pixels.width) / float(pixels.height)};
+  view.up = glm::cross(glm::normalize(glm::cross(view.forward, camera.up)), view.forward); // as projectToPixel
+  std::vector<bvh::Ray> cameraRays;
   for (std::size_t first = 0; first < pixels_; first += pixelsPerChunk) {
     const std::size_t last = std::min(pixels_, first + pixelsPerChunk);
-    gatherRays.clear();
+    cameraRays.clear();
     for (std::size_t p = first; p < last; ++p) {
       if (pixels.object[p] < 0) continue;
-      const glm::vec3 n = pixels.normal[p];
-      const glm::vec3 origin = pixels.position[p] + offset * n;
+      const float x = float(p % std::size_t(pixels.width)), y = float(p / std::size_t(pixels.width));
+      for (std::uint32_t k = 0; k < raysPerPixel; ++k) {
+        const std::uint32_t hp = hash((static_cast<std::uint32_t>(p) * raysPerPixel + k) ^ hash(seed + 7u));
+        cameraRays.push_back(render::gridRay(view, (x + unit(hp)) / float(pixels.width),
+                                             (y + unit(hash(hp))) / float(pixels.height), 1));
+      }
+    }
+    const std::vector<bvh::Hit> surface = rays.closest(cameraRays);
+    gatherRays.clear();
+    std::size_t at = 0;
+    for (std::size_t p = first; p < last; ++p) {
+      if (pixels.object[p] < 0) continue;
       // Stratified in the first dimension, van der Corput in the second, shifted per pixel.
       const std::uint32_t h = hash(static_cast<std::uint32_t>(p) ^ hash(seed));
       const float shift1 = unit(h), shift2 = unit(hash(h));
-      for (std::uint32_t k = 0; k < raysPerPixel; ++k) {
+      for (std::uint32_t k = 0; k < raysPerPixel; ++k, ++at) {
+        const std::optional<render::GridHit> start = render::gridHit(room, cameraRays[at], surface[at]);
+        if (!start) { // this point of the pixel sees nothing: no light, as none in D there
+          gatherRays.push_back({cameraRays[at].origin, cameraRays[at].direction, 0.0f, 0.0f});
+          continue;
+        }
         const float u1 = std::fmod((float(k) + 0.5f) / float(raysPerPixel) + shift1, 1.0f);
         const float u2 = std::fmod(radicalInverse2(k) + shift2, 1.0f);
-        gatherRays.push_back(cosineRay(origin, n, u1, u2));
+        // Cosine-distributed about the shading normal, as the renderer's D and the photographs'
+        // diffuse surfaces reflect; one below the surface's own plane sees its inside: black.
+        const glm::vec3 shading = shadingNormal(room, surface[at], start->normal);
+        bvh::Ray gatherRay = cosineRay(start->position + offset * start->normal, shading, u1, u2);
+        if (!(glm::dot(gatherRay.direction, start->normal) > 0.0f)) gatherRay.tmax = 0.0f;
+        gatherRays.push_back(gatherRay);
       }
     }
     const std::vector<bvh::Hit> hits = rays.closest(gatherRays);

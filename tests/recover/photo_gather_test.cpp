@@ -1,13 +1,19 @@
 // The recovery's gather (recover/photo_gather.h) traced on the device equals its CPU twin: the same
 // rays through the renderer's traversal and through the host's BVH give the same indirect light.
+// And its rays start on the surfaces a pixel sees, not at the pixel's mean point.
 #include <cmath>
+#include <numbers>
+#include <random>
 
 #include <gtest/gtest.h>
 
 #include "recover/photo_gather.h"
 #include "recover/recovery_scene.h"
 #include "recover_cornell_fixture.h"
+#include "render/scene_data/camera_grid.h"
+#include "render/scene_data/scene_buffers.h"
 #include "render/scene_data/ray_batch.h"
+#include "render/test_scenes.h"
 
 namespace obscura::test {
 namespace {
@@ -74,6 +80,127 @@ TEST_F(RecoverCornell, GatherOnTheDeviceEqualsItsCpuTwin) {
     EXPECT_NEAR(sumB / sumA, 1.0, 1e-4) << "shot " << shot;
     EXPECT_LT(differing, a[shot].size() / 1000) << "shot " << shot << ": pixels differing";
   }
+}
+
+
+// A floor and, floating over it, a tube a few pixels wide, seen from above. A pixel on the tube
+// sees a curved surface, or the tube and the floor: its mean point (what the renderer's position
+// AOV holds, and PixelGeometry is) lies inside the tube or in the air beside it, on no surface.
+scene::Scene tubeOverAFloor(float radius, float height, std::uint32_t segments) {
+  scene::Scene s;
+  auto vertex = [&](glm::vec3 p, glm::vec3 n) {
+    s.positions.push_back(p);
+    s.normals.push_back(n);
+    s.uvs.emplace_back(0.0f);
+    s.bounds.grow(p);
+    return static_cast<std::uint32_t>(s.positions.size() - 1);
+  };
+  auto object = [&](const char* name, auto addTriangles) {
+    const auto first = static_cast<std::uint32_t>(s.triangles.size());
+    addTriangles();
+    s.objects.push_back({.name = name, .firstTriangle = first,
+                         .triangleCount = static_cast<std::uint32_t>(s.triangles.size()) - first});
+  };
+  object("floor", [&] {
+    const glm::vec3 up(0.0f, 1.0f, 0.0f);
+    const std::uint32_t a = vertex({-2, 0, -2}, up), b = vertex({2, 0, -2}, up), c = vertex({2, 0, 2}, up),
+                        d = vertex({-2, 0, 2}, up);
+    s.triangles.push_back({a, c, b});
+    s.triangles.push_back({a, d, c});
+  });
+  object("tube", [&] { // along x, smooth normals
+    for (std::uint32_t k = 0; k < segments; ++k) {
+      const float a0 = 2.0f * std::numbers::pi_v<float> * float(k) / float(segments);
+      const float a1 = 2.0f * std::numbers::pi_v<float> * float(k + 1) / float(segments);
+      const glm::vec3 n0(0.0f, std::cos(a0), std::sin(a0)), n1(0.0f, std::cos(a1), std::sin(a1));
+      const glm::vec3 c(0.0f, height, 0.0f);
+      const std::uint32_t p = vertex(c + radius * n0 + glm::vec3(-1, 0, 0), n0), q = vertex(c + radius * n1 + glm::vec3(-1, 0, 0), n1),
+                          r = vertex(c + radius * n1 + glm::vec3(1, 0, 0), n1), t = vertex(c + radius * n0 + glm::vec3(1, 0, 0), n0);
+      s.triangles.push_back({p, q, r}); // outward: n0 x ... faces away from the axis
+      s.triangles.push_back({p, r, t});
+    }
+  });
+  s.triangleMaterial.assign(s.triangles.size(), 0);
+  s.triangleLightGroup.assign(s.triangles.size(), gpu::kInvalidIndex);
+  s.materials.emplace_back();
+  return s;
+}
+
+TEST(PhotoGather, RaysStartOnTheSurfacesAPixelSeesNotAtItsMeanPoint) {
+  const scene::Scene room = tubeOverAFloor(0.02f, 0.05f, 32);
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(room));
+  constexpr int kSize = 64;
+  // 0.6 m across at 1 m: a pixel is 9.4 mm, the tube 4.3 pixels wide.
+  const scene::Camera camera = lookCamera({0.0f, 1.0f, 0.0f}, {0.0f, -1.0f, 0.0f}, {0.0f, 0.0f, -1.0f},
+                                          2.0f * std::atan(0.3f));
+  const render::GridCamera view{camera.position, camera.forward, camera.up, camera.yfov, 1.0f};
+  auto throughPixel = [&](int x, int y, float jx, float jy) {
+    const bvh::Ray ray = render::gridRay(view, (float(x) + jx) / kSize, (float(y) + jy) / kSize, 1);
+    return render::gridHit(room, ray, bvh::closestHit(tree, ray));
+  };
+  // The pixels as the renderer's AOVs give them: the object of the pixel's centre, the mean
+  // point and normal of 4 x 4 points over it.
+  recover::PixelGeometry pixels{.width = kSize, .height = kSize};
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      glm::vec3 position(0.0f), normal(0.0f);
+      int hits = 0;
+      for (int j = 0; j < 16; ++j)
+        if (const auto h = throughPixel(x, y, (float(j % 4) + 0.5f) / 4.0f, (float(j / 4) + 0.5f) / 4.0f)) {
+          position += h->position;
+          normal += h->normal;
+          ++hits;
+        }
+      const auto centre = throughPixel(x, y, 0.5f, 0.5f);
+      pixels.object.push_back(centre ? (centre->primitive < 2 ? 0 : 1) : -1);
+      pixels.position.push_back(hits > 0 ? position / float(hits) : glm::vec3(0.0f));
+      pixels.normal.push_back(hits > 0 ? glm::normalize(normal) : glm::vec3(0.0f, 1.0f, 0.0f));
+    }
+  // The photograph: radiance 1 wherever the camera looks. Where it does not (under and beside the
+  // tube), the floor's radiance is 1 too: a path through a hidden surface cut at once (no hidden
+  // bounce) with c = 1 on a floor of reflectance 1, and no lamp light. The tube reflects nothing.
+  // So B is the share of a pixel's cosine rays that meet the floor.
+  recover::Shot lamp{.position = {0.0f, 0.9f, 0.0f}, .intensity = 0.0f};
+  lamp.radiance.assign(kSize * kSize, glm::vec3(1.0f));
+  constexpr std::uint32_t kRays = 64;
+  render::CpuRayBatch rays(tree);
+  const recover::PhotoGather gather(room, rays, camera, pixels, {lamp}, kRays, 3, 0, 0);
+  const std::vector<glm::vec3> floorOnly{glm::vec3(1.0f), glm::vec3(0.0f)};
+  const std::vector<glm::vec3> b = gather.gather(lamp.radiance, {glm::vec3(1.0f)}, floorOnly, floorOnly);
+
+  // The same share, independently: random points of each tube pixel, cosine rays about their
+  // normal, the floor hits counted.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  double gathered = 0.0, expected = 0.0;
+  int tubePixels = 0;
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      const std::size_t p = std::size_t(y) * kSize + x;
+      if (pixels.object[p] != 1) continue;
+      ++tubePixels;
+      gathered += b[p].x;
+      constexpr int kPoints = 64, kDirections = 16;
+      int floor = 0;
+      for (int i = 0; i < kPoints; ++i) {
+        const auto start = throughPixel(x, y, uniform(rng), uniform(rng));
+        if (!start) continue;
+        glm::vec3 n = start->normal; // the tube's 32 facets: the shading normal within 6 degrees
+        const glm::vec3 t = glm::normalize(glm::cross(std::abs(n.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0), n));
+        const glm::vec3 u = glm::cross(n, t);
+        for (int k = 0; k < kDirections; ++k) {
+          const float r = std::sqrt(uniform(rng)), phi = 2.0f * std::numbers::pi_v<float> * uniform(rng);
+          const glm::vec3 d = r * std::cos(phi) * t + r * std::sin(phi) * u + std::sqrt(std::max(0.0f, 1.0f - r * r)) * n;
+          const bvh::Hit hit = bvh::closestHit(tree, bvh::Ray{start->position + 1e-4f * n, d});
+          if (hit.hit() && hit.primitive < 2) ++floor;
+        }
+      }
+      expected += double(floor) / double(kPoints * kDirections);
+    }
+  ASSERT_GT(tubePixels, 150);
+  // Both are means over the tube's ~270 pixels of 64 and 1,024 rays each: their noise is ~0.3 %.
+  // From the pixels' mean points (inside the tube, or in the air at its edges): 0.17 of this.
+  EXPECT_NEAR(gathered / expected, 1.0, 0.03) << "gathered " << gathered / tubePixels << ", expected " << expected / tubePixels;
 }
 
 } // namespace

@@ -3,15 +3,17 @@
 // tools/cycles_photo_set.py), where 78 % of the gather's rays meet surfaces the camera does not
 // see, chairs and desks are a few pixels wide and a quarter of the pixels no lamp lights.
 //
-// Measured at the defaults (spp 8, 16 gather rays, 3 hidden bounces cut per object, the weighted
-// merge; seeds 1, 2, 3; docs/BENCHMARKS.md "Paths through hidden surfaces cut per object"):
-//   lit 0.0362 / 0.0363 / 0.0360   lit in some photo 0.0932 / 0.0929 / 0.0930   all 0.0967 / 0.0953 / 0.0957
-//   shadow (no lamp lights the pixel) 0.1194 / 0.1118 / 0.1141
-//   the walls' mean ratio to the truth 0.99; the first design: all 0.2196 (outliers up to R = 45).
+// Measured at the defaults (spp 8, 16 gather rays from points of each pixel, 3 hidden bounces cut
+// per object, the weighted merge; seeds 1, 2, 3; docs/BENCHMARKS.md "The gather's rays start on
+// the surfaces a pixel sees"):
+//   lit 0.0228 / 0.0241 / 0.0229   lit in some photo 0.0667 / 0.0668 / 0.0663   all 0.0762 / 0.0748 / 0.0745
+//   shadow (no lamp lights the pixel) 0.1265 / 0.1187 / 0.1196
+//   the walls' mean ratio to the truth 0.997; the first design: all 0.2196 (outliers up to R = 45).
 // The bounds below are the largest of the three plus 10 %, several times the seed-to-seed spread;
 // they are not issue 36's goals (all 0.04, lit in some photo 0.02), which this room does not meet
-// yet. Cut with the pixels' mean B (before) the shadow pixels came out at 0.1396: the shadow bound
-// fails there.
+// yet. With the gather's rays from each pixel's mean point (before) all was 0.0968 and lit 0.0361
+// (a chair's tubular frame: the point inside the tube); cut with the pixels' mean B the shadow
+// pixels came out at 0.1396. Both fail here.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -38,12 +40,12 @@ TEST_F(RecoverClassroom, ALargerRoomIsRecoveredToItsMeasuredAccuracyWithEveryRef
   const Recovery r =
       recoverReflectance(context(), room.scene, room.bvh, room.scene.cameras.at(0), photos, RecoveryOptions{});
   const RecoveryAccuracy a = recoveryAccuracy(r.reflectance, truth, lightRegions(r.visibility, r.object));
-  EXPECT_LE(a.lit.rmse, 0.040);
-  EXPECT_LE(a.direct.rmse, 0.1025);
-  EXPECT_LE(a.all.rmse, 0.1064);
-  EXPECT_LE(a.shadow.rmse, 0.131);
+  EXPECT_LE(a.lit.rmse, 0.0265);
+  EXPECT_LE(a.direct.rmse, 0.0735);
+  EXPECT_LE(a.all.rmse, 0.0838);
+  EXPECT_LE(a.shadow.rmse, 0.139);
   // A quarter of the pixels no lamp lights; the merge recovers some of them from their indirect
-  // light (measured 3,272-3,353), and the fills are counted.
+  // light (measured 3,279-3,355), and the fills are counted.
   EXPECT_GT(r.indirectOnlyPixels, 2000u);
   EXPECT_EQ(r.litPixels + r.indirectOnlyPixels + r.filledFromVisibility + r.filledFromObject, a.all.pixels);
   // Every reflectance is a reflectance: finite, in [0, 1] (the first design had 24 pixels at 3 to 45).
@@ -52,8 +54,8 @@ TEST_F(RecoverClassroom, ALargerRoomIsRecoveredToItsMeasuredAccuracyWithEveryRef
     ASSERT_GE(std::min({v.x, v.y, v.z}), 0.0f);
     ASSERT_LE(std::max({v.x, v.y, v.z}), 1.0f);
   }
-  // The largest object (walls and ceiling, 43 % of the surface pixels): its mean within 3 % of
-  // the truth's (measured 0.98).
+  // The largest object (walls and ceiling, 43 % of the surface pixels): its mean within 2 % of
+  // the truth's (issue 36's goal for large flat surfaces; measured 0.997, 0.986 before).
   std::vector<std::size_t> count(room.scene.objects.size(), 0);
   for (std::int32_t o : r.object)
     if (o >= 0) ++count[static_cast<std::size_t>(o)];
@@ -64,7 +66,7 @@ TEST_F(RecoverClassroom, ALargerRoomIsRecoveredToItsMeasuredAccuracyWithEveryRef
       recovered += r.reflectance[p].x + r.reflectance[p].y + r.reflectance[p].z;
       expected += truth[p].x + truth[p].y + truth[p].z;
     }
-  EXPECT_NEAR(recovered / expected, 1.0, 0.03);
+  EXPECT_NEAR(recovered / expected, 1.0, 0.02);
 }
 
 } // namespace
