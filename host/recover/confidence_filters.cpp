@@ -9,7 +9,7 @@ namespace {
 
 // Applies `reduce(first, last, centre)` to each clipped window's values.
 template <class Reduce>
-ConfidenceImage windowFilter(const ConfidenceImage& in, int radius, Reduce reduce) {
+ConfidenceImage windowFilter(const ConfidenceImage& in, int radius, Reduce reduce, const Surfaces* surfaces = nullptr) {
   ConfidenceImage out = in;
   std::vector<float> window;
   window.reserve(std::size_t(2 * radius + 1) * (2 * radius + 1));
@@ -18,7 +18,8 @@ ConfidenceImage windowFilter(const ConfidenceImage& in, int radius, Reduce reduc
       window.clear();
       for (int wy = std::max(0, y - radius); wy <= std::min(in.height - 1, y + radius); ++wy)
         for (int wx = std::max(0, x - radius); wx <= std::min(in.width - 1, x + radius); ++wx)
-          window.push_back(in.at(wx, wy));
+          if (!surfaces || surfaces->same(std::size_t(y) * in.width + x, std::size_t(wy) * in.width + wx))
+            window.push_back(in.at(wx, wy));
       out.k[std::size_t(y) * in.width + x] = reduce(window, in.at(x, y));
     }
   return out;
@@ -41,16 +42,18 @@ float median(std::vector<float> values) {
 
 } // namespace
 
-ConfidenceImage minFilter(const ConfidenceImage& in, int radius) {
-  return windowFilter(in, radius, [](const std::vector<float>& w, float) { return *std::min_element(w.begin(), w.end()); });
+ConfidenceImage minFilter(const ConfidenceImage& in, int radius, const Surfaces* surfaces) {
+  return windowFilter(
+      in, radius, [](const std::vector<float>& w, float) { return *std::min_element(w.begin(), w.end()); }, surfaces);
 }
 
-ConfidenceImage lowerSmoothing(const ConfidenceImage& in, int radius) {
-  return windowFilter(in, radius, [](const std::vector<float>& w, float centre) { return std::min(centre, mean(w)); });
+ConfidenceImage lowerSmoothing(const ConfidenceImage& in, int radius, const Surfaces* surfaces) {
+  return windowFilter(
+      in, radius, [](const std::vector<float>& w, float centre) { return std::min(centre, mean(w)); }, surfaces);
 }
 
-ConfidenceImage smoothing(const ConfidenceImage& in, int radius) {
-  return windowFilter(in, radius, [](const std::vector<float>& w, float) { return mean(w); });
+ConfidenceImage smoothing(const ConfidenceImage& in, int radius, const Surfaces* surfaces) {
+  return windowFilter(in, radius, [](const std::vector<float>& w, float) { return mean(w); }, surfaces);
 }
 
 void outlierTest(const std::vector<std::vector<glm::vec3>>& estimates, std::vector<ConfidenceImage>& confidences,
@@ -75,18 +78,18 @@ void outlierTest(const std::vector<std::vector<glm::vec3>>& estimates, std::vect
 
 std::vector<ConfidenceImage> filterConfidences(const std::vector<std::vector<glm::vec3>>& estimates,
                                                const std::vector<ConfidenceImage>& visibilities,
-                                               const FilterOptions& options) {
+                                               const FilterOptions& options, const Surfaces* surfaces) {
   std::vector<ConfidenceImage> k = visibilities;
   for (auto& image : k) {
-    if (options.minFilter) image = minFilter(image, 2);
-    if (options.lowerSmoothing) image = lowerSmoothing(image, 2);
+    if (options.minFilter) image = minFilter(image, 2, surfaces);
+    if (options.lowerSmoothing) image = lowerSmoothing(image, 2, surfaces);
   }
   std::vector<ConfidenceImage> beforeOutlier = k;
   if (options.outlier) outlierTest(estimates, k, options.outlierConfidence, options.outlierDistance);
   if (options.finalSmoothing)
     for (std::size_t i = 0; i < k.size(); ++i) {
       const ConfidenceImage afterOutlier = k[i];
-      k[i] = smoothing(k[i], 1);
+      k[i] = smoothing(k[i], 1, surfaces);
       // OURS: a rejected estimate stays rejected. The paper's smoothing gives the rim of a
       // rejected region (a lamp fixture) a third of a photo's weight back, and an outlier 10
       // times the reflectance shows through at that weight.

@@ -39,6 +39,57 @@ TEST(ConfidenceFilters, SmoothingIsTheThreeByThreeMean) {
   EXPECT_FLOAT_EQ(out.at(0, 0), 9.0f / 4.0f); // corner window: 4 pixels
 }
 
+// A 9 x 9 view of a floor (object 0, facing up) with a strip across it at column 4: a chair's
+// frame (object 1), or, with `crease`, a face of the floor's own object turned 90 degrees.
+struct StripView {
+  std::vector<std::int32_t> object;
+  std::vector<glm::vec3> normal;
+  Surfaces surfaces() const { return {&object, &normal}; }
+};
+StripView stripView(bool crease) {
+  StripView v;
+  for (int y = 0; y < 9; ++y)
+    for (int x = 0; x < 9; ++x) {
+      const bool strip = x == 4;
+      v.object.push_back(strip && !crease ? 1 : 0);
+      v.normal.push_back(strip && crease ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
+    }
+  return v;
+}
+
+TEST(ConfidenceFilters, FiltersAlongSurfacesKeepAThinLitStripBesideAShadowedSurface) {
+  for (const bool crease : {false, true}) {
+    const StripView view = stripView(crease);
+    const Surfaces surfaces = view.surfaces();
+    ConfidenceImage k = filled(9, 9, 0.0f); // the floor in the lamp's shadow, the strip lit
+    for (int y = 0; y < 9; ++y) k.k[std::size_t(y) * 9 + 4] = 1.0f;
+    // In image windows the floor's shadow takes the strip's confidence; along surfaces it stays.
+    EXPECT_EQ(minFilter(k, 2).at(4, 4), 0.0f);
+    EXPECT_FLOAT_EQ(lowerSmoothing(k, 2).at(4, 4), 0.2f);
+    EXPECT_FLOAT_EQ(smoothing(k, 1).at(3, 4), 1.0f / 3.0f); // and gives the floor a third
+    for (int y = 0; y < 9; ++y) {
+      EXPECT_EQ(minFilter(k, 2, &surfaces).at(4, y), 1.0f) << "crease " << crease << ", row " << y;
+      EXPECT_EQ(lowerSmoothing(k, 2, &surfaces).at(4, y), 1.0f);
+      EXPECT_EQ(smoothing(k, 1, &surfaces).at(3, y), 0.0f);
+    }
+    // A shadow edge on the strip itself is still widened: its own pixels' window.
+    k.k[4 * 9 + 4] = 0.0f;
+    const ConfidenceImage widened = minFilter(k, 2, &surfaces);
+    for (int y = 0; y < 9; ++y) EXPECT_EQ(widened.at(4, y), std::abs(y - 4) <= 2 ? 0.0f : 1.0f) << y;
+  }
+}
+
+TEST(ConfidenceFilters, APixelWithoutANormalIsItsOwnSurface) {
+  // A face seen edge-on: its pixels' mean normal is no unit vector. Its window is itself.
+  StripView view = stripView(false);
+  view.normal[4 * 9 + 4] = glm::vec3(0.0f);
+  const Surfaces surfaces = view.surfaces();
+  ConfidenceImage k = filled(9, 9, 1.0f);
+  k.k[4 * 9 + 4] = 0.0f;
+  EXPECT_EQ(smoothing(k, 1, &surfaces).at(4, 4), 0.0f);
+  EXPECT_EQ(minFilter(k, 2, &surfaces).at(4, 3), 1.0f);
+}
+
 TEST(ConfidenceFilters, OutlierTestRejectsEstimatesFarFromTheMedianOfConfidentPhotos) {
   // One pixel, four photos: three confident ones at 0.5, 0.52, 0.9 (median 0.52), one not
   // confident (K = 0.5 <= eps1) at 0.1, which does not vote but is tested.

@@ -256,12 +256,16 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   auto stepStart = Clock::now();
   Lighting lighting = traceLighting(context, room, bvh, camera, photos, std::vector<glm::vec3>(objects, glm::vec3(0.5f)),
                                     options);
+  // The weighted merge filters confidences along surfaces (confidence_filters.h); the paper's
+  // merge in image windows. `lighting`'s geometry is the same object when lighting is traced again.
+  const Surfaces pixelSurfaces{&lighting.geometry.object, &lighting.geometry.normal};
+  const Surfaces* surfaces = options.merge == MergeModel::Weighted ? &pixelSurfaces : nullptr;
   std::vector<std::vector<glm::vec3>> ambient;
   for (const auto& shot : photos.shots)
     ambient.push_back(constantAmbient(shot.radiance, lighting.geometry.object, options.constantReflectance));
   out.estimates = estimatesWith(photos, lighting, ambient);
   out.indirect = ambient;
-  out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters);
+  out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters, surfaces);
   WeightedMerge merged = mergeShots(photos, lighting, ambient, out.estimates, out.confidences, options);
   out.iterations.push_back({0, secondsSince(stepStart), 0.0,
                             objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects)});
@@ -298,7 +302,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
         out.indirect = lighting.indirect;
       }
       out.estimates = estimatesWith(photos, lighting, out.indirect);
-      out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters);
+      out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters, surfaces);
       WeightedMerge next = mergeShots(photos, lighting, out.indirect, out.estimates, out.confidences, options);
       double sum = 0.0;
       std::size_t n = 0;
