@@ -168,37 +168,41 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
     glm::vec3 lit, normal;
   };
   std::vector<Active> active;
-  // Each gather ray starts where a camera ray through a random point of its pixel meets the room,
-  // so B is the mean over the pixel's footprint, as the rendered direct light D is. The pixel's
-  // mean point (the position AOV) is no surface point where the footprint is curved or crosses an
-  // edge: on a chair's tubular frame it lies inside the tube, and rays from there lit it from the
-  // tube's inside (classroom: 57 % of a frame pixel's hidden hits were its own tube, B 0.6 of
-  // path tracing's).
+  // The gather rays start where camera rays through random points of their pixel meet the room
+  // (kPointsPerPixel of them, each ray from point k mod that), so B is the mean over the pixel's
+  // footprint, as the rendered direct light D is. The pixel's mean point (the position AOV) is no
+  // surface point where the footprint is curved or crosses an edge: on a chair's tubular frame it
+  // lies inside the tube, and rays from there lit it from the tube's inside (classroom: 57 % of a
+  // frame pixel's hidden hits were its own tube, B 0.6 of path tracing's).
   render::GridCamera view{camera.position, glm::normalize(camera.forward), camera.up, camera.yfov,
                           float(pixels.width) / float(pixels.height)};
   view.up = glm::cross(glm::normalize(glm::cross(view.forward, camera.up)), view.forward); // as projectToPixel
   std::vector<bvh::Ray> cameraRays;
+  const std::uint32_t points = std::min(raysPerPixel, kPointsPerPixel);
   for (std::size_t first = 0; first < pixels_; first += pixelsPerChunk) {
     const std::size_t last = std::min(pixels_, first + pixelsPerChunk);
     cameraRays.clear();
     for (std::size_t p = first; p < last; ++p) {
       if (pixels.object[p] < 0) continue;
       const float x = float(p % std::size_t(pixels.width)), y = float(p / std::size_t(pixels.width));
-      for (std::uint32_t k = 0; k < raysPerPixel; ++k) {
-        const std::uint32_t hp = hash((static_cast<std::uint32_t>(p) * raysPerPixel + k) ^ hash(seed + 7u));
-        cameraRays.push_back(render::gridRay(view, (x + unit(hp)) / float(pixels.width),
-                                             (y + unit(hash(hp))) / float(pixels.height), 1));
+      // Jittered in the cells of a grid over the pixel (2 x 2 for 4 points).
+      const auto cells = static_cast<std::uint32_t>(std::ceil(std::sqrt(float(points))));
+      for (std::uint32_t k = 0; k < points; ++k) {
+        const std::uint32_t hp = hash((static_cast<std::uint32_t>(p) * points + k) ^ hash(seed + 7u));
+        const float jx = (float(k % cells) + unit(hp)) / float(cells), jy = (float(k / cells) + unit(hash(hp))) / float(cells);
+        cameraRays.push_back(render::gridRay(view, (x + jx) / float(pixels.width), (y + jy) / float(pixels.height), 1));
       }
     }
     const std::vector<bvh::Hit> surface = rays.closest(cameraRays);
     gatherRays.clear();
-    std::size_t at = 0;
+    std::size_t pixelFirst = 0; // the pixel's first camera ray
     for (std::size_t p = first; p < last; ++p) {
       if (pixels.object[p] < 0) continue;
       // Stratified in the first dimension, van der Corput in the second, shifted per pixel.
       const std::uint32_t h = hash(static_cast<std::uint32_t>(p) ^ hash(seed));
       const float shift1 = unit(h), shift2 = unit(hash(h));
-      for (std::uint32_t k = 0; k < raysPerPixel; ++k, ++at) {
+      for (std::uint32_t k = 0; k < raysPerPixel; ++k) {
+        const std::size_t at = pixelFirst + k % points;
         const std::optional<render::GridHit> start = render::gridHit(room, cameraRays[at], surface[at]);
         if (!start) { // this point of the pixel sees nothing: no light, as none in D there
           gatherRays.push_back({cameraRays[at].origin, cameraRays[at].direction, 0.0f, 0.0f});
@@ -213,6 +217,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
         if (!(glm::dot(gatherRay.direction, start->normal) > 0.0f)) gatherRay.tmax = 0.0f;
         gatherRays.push_back(gatherRay);
       }
+      pixelFirst += points;
     }
     const std::vector<bvh::Hit> hits = rays.closest(gatherRays);
     shadowRays.clear();

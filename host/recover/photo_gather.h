@@ -101,6 +101,9 @@ public:
                                 const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
                                 Cut* settled = nullptr) const;
   static constexpr double kCutPrior = 32.0;
+  // Points of a pixel's footprint its gather rays start from, each a few rays (a camera ray per
+  // gather ray made the staircase's gather 15-25 % slower for 1 % less RMSE on the classroom).
+  static constexpr std::uint32_t kPointsPerPixel = 4;
   // Fractions of the rays whose hit the camera sees, that are hidden, and that leave the scene.
   double seenFraction() const { return double(seen_.size()) / double(rays_); }
   double hiddenFraction() const { return double(firstHidden_) / double(rays_); }
