@@ -21,6 +21,26 @@ std::vector<std::uint32_t> triangleObjects(const scene::Scene& scene) {
   return object;
 }
 
+std::vector<std::uint32_t> objectMaterials(const scene::Scene& room) {
+  std::vector<std::uint32_t> material(room.objects.size(), 0);
+  for (std::size_t o = 0; o < room.objects.size(); ++o) {
+    const auto& obj = room.objects[o];
+    std::map<std::uint32_t, double> area;
+    for (std::uint32_t t = obj.firstTriangle; t < obj.firstTriangle + obj.triangleCount; ++t) {
+      const glm::uvec3 tri = room.triangles[t];
+      const glm::vec3 a = room.positions[tri.x];
+      area[room.triangleMaterial[t]] += 0.5 * double(glm::length(glm::cross(room.positions[tri.y] - a, room.positions[tri.z] - a)));
+    }
+    double largest = -1.0;
+    for (const auto& [m, sum] : area)
+      if (sum > largest) {
+        largest = sum;
+        material[o] = m;
+      }
+  }
+  return material;
+}
+
 scene::Scene recoveryScene(const scene::Scene& room, const std::vector<Shot>& shots,
                            const std::vector<glm::vec3>& objectReflectance) {
   scene::Scene s = room;

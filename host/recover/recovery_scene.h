@@ -22,6 +22,8 @@ scene::Scene recoveryScene(const scene::Scene& room, const std::vector<Shot>& sh
 
 // The object of every triangle.
 std::vector<std::uint32_t> triangleObjects(const scene::Scene& scene);
+// Each object's material in the room's model: the one covering most of its area.
+std::vector<std::uint32_t> objectMaterials(const scene::Scene& room);
 
 // InputError naming `photos.file` and the shot when a lamp is inside geometry: its sphere (or,
 // for radius 0, the point) touches a triangle, or it lies inside a closed object (3/4 of the rays

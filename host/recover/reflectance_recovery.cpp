@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <memory>
 
 #include <fmt/format.h>
@@ -140,7 +141,8 @@ std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, cons
 }
 
 std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
-                                   const std::vector<std::int32_t>& object, std::size_t objects) {
+                                   const std::vector<std::int32_t>& object, std::size_t objects,
+                                   const std::vector<std::uint32_t>* objectMaterial) {
   std::vector<glm::dvec3> sum(objects, glm::dvec3(0.0));
   std::vector<double> weight(objects, 0.0);
   glm::dvec3 all(0.0);
@@ -154,8 +156,26 @@ std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, co
     allWeight += confidence[p];
   }
   const glm::vec3 fallback = allWeight > 0.0 ? glm::vec3(all / allWeight) : glm::vec3(0.5f);
+  // An object no photograph shows takes the mean of the seen objects of its material.
+  std::map<std::uint32_t, std::pair<glm::dvec3, double>> byMaterial;
+  if (objectMaterial)
+    for (std::size_t o = 0; o < objects; ++o) {
+      auto& m = byMaterial[(*objectMaterial)[o]];
+      m.first += sum[o];
+      m.second += weight[o];
+    }
   std::vector<glm::vec3> means(objects);
-  for (std::size_t o = 0; o < objects; ++o) means[o] = weight[o] > 0.0 ? glm::vec3(sum[o] / weight[o]) : fallback;
+  for (std::size_t o = 0; o < objects; ++o) {
+    if (weight[o] > 0.0) {
+      means[o] = glm::vec3(sum[o] / weight[o]);
+      continue;
+    }
+    means[o] = fallback;
+    if (objectMaterial) {
+      const auto& m = byMaterial[(*objectMaterial)[o]];
+      if (m.second > 0.0) means[o] = glm::vec3(m.first / m.second);
+    }
+  }
   return means;
 }
 
@@ -246,6 +266,9 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
                             const RecoveryLog& log) {
   const auto start = Clock::now();
   const std::size_t objects = room.objects.size();
+  // Objects no photograph shows take their material's recovered mean (objectMeans): the model's
+  // materials say which surfaces are alike, though not their colours.
+  const std::vector<std::uint32_t> objectMaterial = objectMaterials(room);
   Recovery out;
   out.width = photos.width;
   out.height = photos.height;
@@ -268,7 +291,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters, surfaces);
   WeightedMerge merged = mergeShots(photos, lighting, ambient, out.estimates, out.confidences, options);
   out.iterations.push_back({0, secondsSince(stepStart), 0.0,
-                            objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects)});
+                            objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects, &objectMaterial)});
   if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
 
   std::unique_ptr<PhotoGather> gather;
@@ -315,7 +338,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       merged = std::move(next);
       const double change = n > 0 ? std::sqrt(sum / double(n)) : 0.0;
       out.iterations.push_back({it, secondsSince(stepStart), change,
-                                objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects)});
+                                objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects, &objectMaterial)});
       if (log) log(fmt::format("recover: iteration {}: RMS change of R {:.5f}, {:.1f} s", it, change, secondsSince(stepStart)));
     }
   }
