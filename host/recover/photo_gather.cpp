@@ -46,7 +46,8 @@ void frame(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
 glm::vec3 shadingNormal(const scene::Scene& room, const bvh::Hit& hit, const glm::vec3& geometric) {
   if (room.normals.size() != room.positions.size()) return geometric;
   const glm::uvec3 tri = room.triangles[hit.primitive];
-  const glm::vec3 n = (1.0f - hit.u - hit.v) * room.normals[tri.x] + hit.u * room.normals[tri.y] + hit.v * room.normals[tri.z];
+  const glm::vec3 n =
+      (1.0f - hit.u - hit.v) * room.normals[tri.x] + hit.u * room.normals[tri.y] + hit.v * room.normals[tri.z];
   const float length = glm::length(n);
   if (!(length > 0.0f)) return geometric;
   return glm::dot(n, geometric) < 0.0f ? -n / length : n / length;
@@ -189,7 +190,8 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
       const auto cells = static_cast<std::uint32_t>(std::ceil(std::sqrt(float(points))));
       for (std::uint32_t k = 0; k < points; ++k) {
         const std::uint32_t hp = hash((static_cast<std::uint32_t>(p) * points + k) ^ hash(seed + 7u));
-        const float jx = (float(k % cells) + unit(hp)) / float(cells), jy = (float(k / cells) + unit(hash(hp))) / float(cells);
+        const float jx = (float(k % cells) + unit(hp)) / float(cells);
+        const float jy = (float(k / cells) + unit(hash(hp))) / float(cells);
         cameraRays.push_back(render::gridRay(view, (x + jx) / float(pixels.width), (y + jy) / float(pixels.height), 1));
       }
     }

@@ -29,7 +29,8 @@ std::vector<std::uint32_t> objectMaterials(const scene::Scene& room) {
     for (std::uint32_t t = obj.firstTriangle; t < obj.firstTriangle + obj.triangleCount; ++t) {
       const glm::uvec3 tri = room.triangles[t];
       const glm::vec3 a = room.positions[tri.x];
-      area[room.triangleMaterial[t]] += 0.5 * double(glm::length(glm::cross(room.positions[tri.y] - a, room.positions[tri.z] - a)));
+      const glm::vec3 normal = glm::cross(room.positions[tri.y] - a, room.positions[tri.z] - a);
+      area[room.triangleMaterial[t]] += 0.5 * double(glm::length(normal));
     }
     double largest = -1.0;
     for (const auto& [m, sum] : area)

@@ -291,7 +291,8 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters, surfaces);
   WeightedMerge merged = mergeShots(photos, lighting, ambient, out.estimates, out.confidences, options);
   out.iterations.push_back({0, secondsSince(stepStart), 0.0,
-                            objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects, &objectMaterial)});
+                            objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects,
+                                        &objectMaterial)});
   if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
 
   std::unique_ptr<PhotoGather> gather;
@@ -338,7 +339,8 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       merged = std::move(next);
       const double change = n > 0 ? std::sqrt(sum / double(n)) : 0.0;
       out.iterations.push_back({it, secondsSince(stepStart), change,
-                                objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects, &objectMaterial)});
+                                objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object,
+                                            objects, &objectMaterial)});
       if (log) log(fmt::format("recover: iteration {}: RMS change of R {:.5f}, {:.1f} s", it, change, secondsSince(stepStart)));
     }
   }

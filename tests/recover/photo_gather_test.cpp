@@ -114,8 +114,9 @@ scene::Scene tubeOverAFloor(float radius, float height, std::uint32_t segments) 
       const float a1 = 2.0f * std::numbers::pi_v<float> * float(k + 1) / float(segments);
       const glm::vec3 n0(0.0f, std::cos(a0), std::sin(a0)), n1(0.0f, std::cos(a1), std::sin(a1));
       const glm::vec3 c(0.0f, height, 0.0f);
-      const std::uint32_t p = vertex(c + radius * n0 + glm::vec3(-1, 0, 0), n0), q = vertex(c + radius * n1 + glm::vec3(-1, 0, 0), n1),
-                          r = vertex(c + radius * n1 + glm::vec3(1, 0, 0), n1), t = vertex(c + radius * n0 + glm::vec3(1, 0, 0), n0);
+      const glm::vec3 left(-1.0f, 0.0f, 0.0f), right(1.0f, 0.0f, 0.0f);
+      const std::uint32_t p = vertex(c + radius * n0 + left, n0), q = vertex(c + radius * n1 + left, n1),
+                          r = vertex(c + radius * n1 + right, n1), t = vertex(c + radius * n0 + right, n0);
       s.triangles.push_back({p, q, r}); // outward: n0 x ... faces away from the axis
       s.triangles.push_back({p, r, t});
     }
