@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "core/parallel_for.h"
+
 namespace obscura::recover {
 namespace {
 
@@ -80,14 +82,14 @@ std::vector<ConfidenceImage> filterConfidences(const std::vector<std::vector<glm
                                                const std::vector<ConfidenceImage>& visibilities,
                                                const FilterOptions& options, const Surfaces* surfaces) {
   std::vector<ConfidenceImage> k = visibilities;
-  for (auto& image : k) {
-    if (options.minFilter) image = minFilter(image, 2, surfaces);
-    if (options.lowerSmoothing) image = lowerSmoothing(image, 2, surfaces);
-  }
+  parallelFor(k.size(), [&](std::size_t i) { // each photo's on its own
+    if (options.minFilter) k[i] = minFilter(k[i], 2, surfaces);
+    if (options.lowerSmoothing) k[i] = lowerSmoothing(k[i], 2, surfaces);
+  });
   std::vector<ConfidenceImage> beforeOutlier = k;
   if (options.outlier) outlierTest(estimates, k, options.outlierConfidence, options.outlierDistance);
   if (options.finalSmoothing)
-    for (std::size_t i = 0; i < k.size(); ++i) {
+    parallelFor(k.size(), [&](std::size_t i) {
       const ConfidenceImage afterOutlier = k[i];
       k[i] = smoothing(k[i], 1, surfaces);
       // OURS: a rejected estimate stays rejected. The paper's smoothing gives the rim of a
@@ -95,7 +97,7 @@ std::vector<ConfidenceImage> filterConfidences(const std::vector<std::vector<glm
       // times the reflectance shows through at that weight.
       for (std::size_t p = 0; p < k[i].k.size(); ++p)
         if (beforeOutlier[i].k[p] > 0.0f && afterOutlier.k[p] == 0.0f) k[i].k[p] = 0.0f;
-    }
+    });
   return k;
 }
 

@@ -8,6 +8,7 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "core/parallel_for.h"
 #include "recover/recovery_scene.h"
 #include "render/gpu_ray_batch.h"
 #include "render/scene_data/camera_grid.h"
@@ -302,13 +303,14 @@ PhotoGather PhotoGather::onDevice(const gpu::Context& context, const scene::Scen
 std::vector<std::vector<glm::vec3>> PhotoGather::indirect(const std::vector<Shot>& shots,
                                                           const std::vector<glm::vec3>& objectReflectance,
                                                           const std::vector<Cut>& cut, std::vector<Cut>* settled) const {
-  std::vector<std::vector<glm::vec3>> out;
+  std::vector<std::vector<glm::vec3>> out(shots_);
   if (settled) settled->assign(shots_, Cut());
-  for (std::size_t i = 0; i < shots_; ++i) {
+  // The shots' gathers are independent re-sums of the same paths: one per core.
+  parallelFor(shots_, [&](std::size_t i) {
     std::vector<glm::vec3> lampColour(shots_, glm::vec3(0.0f));
     lampColour[i] = shots[i].color;
-    out.push_back(gather(shots[i].radiance, lampColour, objectReflectance, cut.at(i), settled ? &(*settled)[i] : nullptr));
-  }
+    out[i] = gather(shots[i].radiance, lampColour, objectReflectance, cut.at(i), settled ? &(*settled)[i] : nullptr);
+  });
   return out;
 }
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/luminance.h"
+#include "core/parallel_for.h"
 
 namespace obscura::recover {
 namespace {
@@ -108,8 +109,10 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
   const float eB2 = options.indirectUncertainty * options.indirectUncertainty;
   std::vector<double> weightSum(n, 0.0);
   std::vector<glm::dvec3> sum(n, glm::dvec3(0.0));
+  std::vector<std::vector<float>> noiseOf(shots);
+  parallelFor(shots, [&](std::size_t i) { noiseOf[i] = photoNoise(photos[i], pixels); });
   for (std::size_t i = 0; i < shots; ++i) {
-    const std::vector<float> noise = photoNoise(photos[i], pixels);
+    const std::vector<float>& noise = noiseOf[i];
     forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
       const float c = luminance(photos[i][p]), d = luminance(direct[i][p]), b = luminance(indirect[i][p]);
       if (!(c > 0.0f) || !(d + b > 0.0f)) return;
