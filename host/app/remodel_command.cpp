@@ -223,6 +223,9 @@ void addRemodelCommand(CLI::App& app) {
   cmd->add_option("--gather-smoothing", o->remodel.gatherSmoothing, "indirect light: smoothing radius on each surface")
       ->check(CLI::Range(0, 32));
   cmd->add_option("--bounces", o->remodel.bounces, "indirect light: gathers (bounces)")->check(CLI::Range(0u, 64u));
+  cmd->add_option("--hidden-bounces", o->remodel.hiddenBounces,
+                  "indirect light: path vertices through surfaces the camera does not see before the cut")
+      ->check(CLI::Range(0u, recover::kMaxHiddenBounces));
   cmd->add_option("--exposure", o->exposure, "PNG exposure in stops");
   addDeviceOptions(*cmd, o->device);
   cmd->callback([o] { runRemodel(*o); });

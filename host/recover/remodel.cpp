@@ -106,7 +106,7 @@ RemodelledFrame renderRemodelled(const gpu::Context& context, const RecoveredRoo
 
   // B by successive gathers of the relit radiance (remodel.h).
   const PhotoGather gather = PhotoGather::onDevice(context, edited, editedBvh, camera, view, lamps, options.gatherRays,
-                                                   options.seed, options.gatherSmoothing);
+                                                   options.seed, options.gatherSmoothing, options.hiddenBounces);
   std::vector<glm::vec3> lampColour;
   for (const Shot& lamp : lamps) lampColour.push_back(lamp.color);
   out.indirect.assign(pixels, glm::vec3(0.0f));

@@ -185,7 +185,7 @@ def remodel(recovered: Union[Recovery, PathLike], edits: Union[PathLike, Sequenc
     """Relights and remodels a photographed room with its recovered reflectance, as `obscura
     remodel DIR --edits EDITS -o OUTPUT` does. `edits`: an edits file, or its list of dicts
     (inserted files relative to the working directory). Options as keywords (spp, seed,
-    gather_rays, gather_smoothing, bounces). Returns the frame's layers as arrays: rgb (the
+    gather_rays, gather_smoothing, bounces, hidden_bounces). Returns the frame's layers as arrays: rgb (the
     relit radiance), reflectance, direct, indirect, synthesized; `output` (an .exr) keeps the
     file too."""
     folder = recovered.folder if isinstance(recovered, Recovery) else _os.fspath(recovered)

@@ -95,7 +95,7 @@ TEST_F(CliRecover, WritesReflectanceWithConfidenceAndThePerPhotoImages) {
                                   {{"remove", "cube_1"}}});
   std::ofstream(path("edits.json")) << edits.dump();
   const auto remodel = runObscura("remodel " + path("out") + " --edits " + path("edits.json") + " -o " +
-                                  path("remodel.exr") + " --spp 1 --gather-rays 8 --bounces 2");
+                                  path("remodel.exr") + " --spp 1 --gather-rays 8 --bounces 2 --hidden-bounces 2");
   ASSERT_EQ(remodel.exitCode, 0) << remodel.output;
   const io::Image frame = io::readImage(path("remodel.exr"));
   const int synthesized = frame.channelIndex("synthesized.id");
@@ -124,6 +124,11 @@ TEST_F(CliRecover, WritesReflectanceWithConfidenceAndThePerPhotoImages) {
   refused(json::array({{{"add_light", {{"type", "point"}, {"name", "lamp"}, {"position", {0.33, 0.3, 0.37}},
                                        {"color", {1, 1, 1}}, {"intensity", 1}}}}}),
           "inside geometry");
+  const auto tooDeep = runObscura("remodel " + path("out") + " --edits " + path("edits.json") + " -o " + path("x.exr") +
+                                  " --hidden-bounces 9");
+  EXPECT_NE(tooDeep.exitCode, 0) << tooDeep.output;
+  EXPECT_CONTAINS(tooDeep.output, "--hidden-bounces");
+  EXPECT_FALSE(fs::exists(path("x.exr")));
   fs::create_directories(path("notrecovered"));
   const auto notRecovered = runObscura("remodel " + path("notrecovered") + " --edits " + path("e.json") + " -o " + path("x.exr"));
   EXPECT_EQ(notRecovered.exitCode, 2) << notRecovered.output;
