@@ -170,7 +170,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
     glm::vec3 lit, normal;
   };
   std::vector<Active> active;
-  // The gather rays start where camera rays through random points of their pixel meet the room
+  // The gather rays start where camera rays through jittered points of their pixel meet the room
   // (kPointsPerPixel of them, each ray from point k mod that), so B is the mean over the pixel's
   // footprint, as the rendered direct light D is. The pixel's mean point (the position AOV) is no
   // surface point where the footprint is curved or crosses an edge: on a chair's tubular frame it
@@ -181,14 +181,14 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
   view.up = glm::cross(glm::normalize(glm::cross(view.forward, camera.up)), view.forward); // as projectToPixel
   std::vector<bvh::Ray> cameraRays;
   const std::uint32_t points = std::min(raysPerPixel, kPointsPerPixel);
+  // Each point jittered in a cell of a grid over the pixel (2 x 2 for 4 points).
+  const auto cells = static_cast<std::uint32_t>(std::ceil(std::sqrt(float(points))));
   for (std::size_t first = 0; first < pixels_; first += pixelsPerChunk) {
     const std::size_t last = std::min(pixels_, first + pixelsPerChunk);
     cameraRays.clear();
     for (std::size_t p = first; p < last; ++p) {
       if (pixels.object[p] < 0) continue;
       const float x = float(p % std::size_t(pixels.width)), y = float(p / std::size_t(pixels.width));
-      // Jittered in the cells of a grid over the pixel (2 x 2 for 4 points).
-      const auto cells = static_cast<std::uint32_t>(std::ceil(std::sqrt(float(points))));
       for (std::uint32_t k = 0; k < points; ++k) {
         const std::uint32_t hp = hash((static_cast<std::uint32_t>(p) * points + k) ^ hash(seed + 7u));
         const float jx = (float(k % cells) + unit(hp)) / float(cells);
