@@ -117,7 +117,7 @@ scene::Scene tubeOverAFloor(float radius, float height, std::uint32_t segments) 
       const glm::vec3 left(-1.0f, 0.0f, 0.0f), right(1.0f, 0.0f, 0.0f);
       const std::uint32_t p = vertex(c + radius * n0 + left, n0), q = vertex(c + radius * n1 + left, n1),
                           r = vertex(c + radius * n1 + right, n1), t = vertex(c + radius * n0 + right, n0);
-      s.triangles.push_back({p, q, r}); // outward: n0 x ... faces away from the axis
+      s.triangles.push_back({p, q, r}); // either winding: the gather turns normals to the ray
       s.triangles.push_back({p, r, t});
     }
   });

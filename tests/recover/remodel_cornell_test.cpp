@@ -67,18 +67,20 @@ Agreement agreement(const std::vector<glm::vec3>& ours, const std::vector<glm::v
 // The round trip: recover from the six photographs, relight with the lamp at (0.45, 1.55, -0.1),
 // which no photograph used, and compare with Cycles' photograph of it (1024 spp, full GI) and
 // with Cycles' direct-only photograph (0 bounces), so that direct and indirect light are judged
-// apart. Measured (spp 4, seed 1): direct mean ratio 1.008, median |pixel error| 1.1 %, 8x8
-// blocks 1.8 % RMS; total 0.992, 2.4 %, 9.4 %; indirect alone 0.971, 5.5 %, 10.8 % (13 % too
-// bright where the lamp does not reach, a few % too dark where it does); the renderer's
-// obscurance term in its place (what the saved state relights with): 1.225, 29 %.
+// apart. Measured (spp 4, seed 1): direct mean ratio 0.998, median |pixel error| 0.7 %, 8x8
+// blocks 1.2 % RMS; total 1.000, 1.3 %, 2.6 %; the renderer's obscurance term in its place (what
+// the saved state relights with): 1.011, 19 %. (With the gather from each pixel's mean point and
+// 3 hidden vertices the blocks were 2.9 %; with the first gather, cut at once: total 0.992,
+// 2.4 %, 9.4 %, the indirect light 13 % too bright where the lamp does not reach.)
 // Tolerances, from what each part is made of:
 //   direct: R x E. R's error is the recovery's (lit RMSE 0.017 of ~0.7, 2.4 % RMS a pixel, so a
 //     median |error| ~1.6 %), Cycles' lamp is a disc (the point formula is 0.2-0.8 % too bright
 //     at 2-0.45 from it), the photo's noise at 1024 spp is < 1 % median in direct light. Mean
 //     within 2 %, median pixel <= 2.5 %, blocks (where the noise averages out) <= 4 % RMS.
-//   total: direct plus the gathered indirect light, whose own error (above) is 5.5 % median on a
-//     third of the light, and the photo's noise 1.3 % median: mean within 3 %, median pixel
-//     <= 4 %, blocks <= 15 % RMS (dominated by the indirect-only blocks, 13 % bright).
+//   total: direct plus the gathered indirect light (a third of the light; its error was 5.5 %
+//     median before, less now), and the photo's noise 1.3 % median: mean within 3 %, median
+//     pixel <= 4 %, blocks <= 6 % RMS (2.3x the measured; the first gather's indirect-only
+//     blocks, 9.4 %, fail it).
 //   the gather against the obscurance term: the median pixel error at most a third.
 TEST_F(RemodelCornell, RelitUnderANewLampMatchesCyclesPhotograph) {
   const Recovery& recovery = standardRecovery();
@@ -110,7 +112,7 @@ TEST_F(RemodelCornell, RelitUnderANewLampMatchesCyclesPhotograph) {
   EXPECT_LE(d.blockRms, 0.04);
   EXPECT_NEAR(t.meanRatio, 1.0, 0.03);
   EXPECT_LE(t.pixelMedian, 0.04);
-  EXPECT_LE(t.blockRms, 0.15);
+  EXPECT_LE(t.blockRms, 0.06);
   EXPECT_LT(t.pixelMedian, obs.pixelMedian / 3.0);
 }
 
@@ -151,6 +153,7 @@ TEST_F(RemodelCornell, RemovedShortBoxUncoversAFloorWithTheVisibleFloorsStatisti
   const bvh::Bvh editedBvh = bvh::build(render::triangleSoup(edited));
   RemodelOptions o;
   o.spp = 4;
+  o.hiddenBounces = 3; // the fill is judged, not the indirect light: short paths for the suite's time
   const RemodelledFrame frame = renderRemodelled(context(), recoveredRoom(recovery), edited, editedBvh, camera(),
                                                  {photos_->shots[4]}, o);
   const auto floor = static_cast<std::int32_t>(scene::objectIndex(edited, "rectangle_1", "test"));
@@ -252,6 +255,7 @@ TEST_F(RemodelCornell, InsertedObjectShadowsTheRealFloorByItsDirectLight) {
   RemodelOptions o;
   o.spp = 4;
   o.gatherRays = 32;
+  o.hiddenBounces = 3; // the shadow is judged by the direct light: short paths for the suite's time
   const RemodelledFrame before = renderRemodelled(context(), room, room_->scene, room_->bvh, camera(), {photos_->shots[4]}, o);
   scene::Scene edited = room_->scene;
   const std::size_t inserted = scene::insertObject(edited, plate(glm::vec3(-0.45f, 0.5f, 0.2f), 0.3f), "plate", glm::vec3(0.0f));
