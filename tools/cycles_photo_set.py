@@ -14,6 +14,13 @@
 #   DIR/repeat/photo-00k.exr   shots 0 and 1 again with other seeds: the photographs' own noise
 #   DIR/noisy/lights.json, DIR/noisy/photo-00k.exr   (with --noisy-spp N) every shot at N samples
 #
+# Bounces: 16 by default, where the light has converged (the recipe of the Cornell box's photographs
+# stops at 6). A room lit mostly by bounces loses a lot to 6: the staircase's new-lamp photograph at
+# 16 bounces is 2.5 % brighter overall and 8.4 % where the lamp lights nothing directly (32 bounces
+# add nothing more within 0.5 %), and the recovery and remodel model every bounce, so a truncated
+# photograph reads as their error (BENCHMARKS, "The photographs' bounces").
+# --positions-from OLD/lights.json renders the lamps that set chose (the choice takes minutes).
+#
 # Lamp positions are chosen as for the Cornell box's photographs: a 13 x 13 grid over the middle
 # 70 % of the extent of the floor the camera sees, at 70 / 77.5 / 85 % of the floor-to-ceiling
 # height above each grid point; a candidate is kept if it stays at least 8 % of that height from
@@ -25,6 +32,7 @@
 # Needs Blender 3.4 (Debian 12: apt-get install blender):
 #   blender -b -P tools/cycles_photo_set.py -- SCENE.gltf -o DIR [--width 320] [--height 180]
 #       [--spp 512] [--shots 6] [--noisy-spp 64] [--power 30] [--radius 0.04] [--threads 2]
+#       [--bounces 16] [--positions-from OLD/lights.json]
 import argparse
 import json
 import math
@@ -50,16 +58,23 @@ def parse_args():
     p.add_argument("--noisy-spp", type=int, default=0, help="also render every shot at this many samples")
     p.add_argument("--power", type=float, default=30.0, help="Blender point-light power, W")
     p.add_argument("--radius", type=float, default=0.04, help="lamp radius")
-    p.add_argument("--bounces", type=int, default=6)
+    p.add_argument("--bounces", type=int, default=16, help="light bounces (16: converged)")
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--camera", type=int, default=0, help="the glTF camera")
     p.add_argument("--dry-run", action="store_true", help="choose the lamps and write lights.json only")
+    p.add_argument("--positions-from", help="a set's lights.json: its lamps (and their coverages) instead of choosing")
+    p.add_argument("--new-lamp-only", action="store_true", help="render new-lamp.exr only (with --positions-from: "
+                   "what another bounce count or sample count changes)")
     return p.parse_args(argv)
 
 
 def to_gltf(v):
     """Blender (x, y, z) with Z up is glTF (x, z, -y) with Y up."""
     return [v.x, v.z, -v.y]
+
+
+def from_gltf(p):
+    return Vector((p[0], -p[2], p[1]))
 
 
 def cast(scene, depsgraph, origin, direction, distance=1.0e9):
@@ -196,19 +211,31 @@ def main():
     scene, lamp = cycles_photo.setup_scene(a.scene, a.camera, a.power, a.radius, a.bounces, a.threads, a.spp, 0)
     scene.render.resolution_x = a.width
     scene.render.resolution_y = a.height
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    lamp.hide_render = True  # the lamp is no occluder while the positions are chosen
-    depsgraph.update()
-    points = visible_points(scene, depsgraph, scene.camera, a.width, a.height, 64)
-    candidates = lamp_candidates(scene, depsgraph, points)
-    if len(candidates) < a.shots + 1:
-        sys.exit(f"{a.scene}: only {len(candidates)} lamp positions clear of the surfaces")
-    coverages = [coverage(scene, depsgraph, c, points) for c in candidates]
-    chosen = choose_lamps(candidates, coverages, a.shots + 1)
-    if len(chosen) < a.shots + 1:
-        sys.exit(f"{a.scene}: only {len(chosen)} lamp positions to choose from")
-    lamp.hide_render = False
-    print(f"cycles_photo_set: {len(points)} visible points, {len(candidates)} candidates, coverage of the chosen "
+    if a.positions_from:
+        # The lamps of another set, in its order (its shots, then its new lamp).
+        with open(a.positions_from) as f:
+            old = json.load(f)
+        entries = old["shots"] + [old["new_lamp"]]
+        candidates = [from_gltf(e["position"]) for e in entries]
+        coverages = [e["coverage"] for e in entries]
+        chosen = list(range(len(entries)))
+        a.shots = len(old["shots"])
+        visible = old["visible_points"]
+    else:
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        lamp.hide_render = True  # the lamp is no occluder while the positions are chosen
+        depsgraph.update()
+        points = visible_points(scene, depsgraph, scene.camera, a.width, a.height, 64)
+        candidates = lamp_candidates(scene, depsgraph, points)
+        if len(candidates) < a.shots + 1:
+            sys.exit(f"{a.scene}: only {len(candidates)} lamp positions clear of the surfaces")
+        coverages = [coverage(scene, depsgraph, c, points) for c in candidates]
+        chosen = choose_lamps(candidates, coverages, a.shots + 1)
+        if len(chosen) < a.shots + 1:
+            sys.exit(f"{a.scene}: only {len(chosen)} lamp positions to choose from")
+        lamp.hide_render = False
+        visible = len(points)
+    print(f"cycles_photo_set: {visible} visible points, {len(candidates)} candidates, coverage of the chosen "
           + ", ".join(f"{coverages[k]:.2f}" for k in chosen), flush=True)
 
     # The vertical field of view Cycles renders with at this size (the importer's sensor fit).
@@ -229,7 +256,7 @@ def main():
         "positions_chosen": "tools/cycles_photo_set.py: 13x13 grid over the middle 70 % of the visible floor, heights "
                             "0.7/0.775/0.85 of floor-to-ceiling, clearance >= 8 % of that height, coverage >= 0.5 "
                             "preferred, farthest-point spread; new_lamp is the next farthest point",
-        "visible_points": len(points),
+        "visible_points": visible,
         "shots": [shot_entry(f"photo-{k:03d}.exr", candidates[c], a, k, coverages[c]) for k, c in enumerate(chosen[:-1])],
         "new_lamp": shot_entry("new-lamp.exr", candidates[chosen[-1]], a, 99, coverages[chosen[-1]]),
         "repeats": [{"image": f"repeat/photo-{k:03d}.exr", "of": f"photo-{k:03d}.exr", "seed": 100 + k}
@@ -238,6 +265,10 @@ def main():
     with open(os.path.join(a.output, "lights.json"), "w") as f:
         json.dump(meta, f, indent=1)
     if a.dry_run:
+        return
+    if a.new_lamp_only:
+        lamp.location = candidates[chosen[-1]]
+        render(scene, os.path.join(a.output, "new-lamp.exr"), 99, a.spp)
         return
 
     for k, c in enumerate(chosen[:-1]):
