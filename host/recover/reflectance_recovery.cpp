@@ -114,6 +114,22 @@ std::vector<float> inverseVariance(const WeightedMerge& m) {
   return w;
 }
 
+// The object means the next gather uses, from `used` (this gather's), `before` (the previous
+// gather's) and `next` (what this gather gave): where a mean turned back (its step from `used`
+// against its step to `used`), halfway (under-relaxation), else as it came. The iteration R -> B
+// -> R can swing: high means light the hidden vertices more, so B is higher and R lower, so the
+// next means are lower (classroom: the objects' mean 0.69, 0.50, 0.63, 0.55, 0.60, 0.57 over six
+// iterations), and the last gather's phase decided R: the staircase's RMSE was 0.086 / 0.065 /
+// 0.079 after 5 / 6 / 7 iterations, now 0.072 / 0.071 / 0.072. Where it converges without swinging
+// (the Cornell box), the means are taken as they come, as fast as before.
+void dampSwings(const std::vector<glm::vec3>& before, const std::vector<glm::vec3>& used, std::vector<glm::vec3>& next) {
+  for (std::size_t o = 0; o < next.size() && o < used.size() && o < before.size(); ++o)
+    for (int c = 0; c < 3; ++c) {
+      const float step = next[o][c] - used[o][c], last = used[o][c] - before[o][c];
+      if (step * last < 0.0f) next[o][c] = used[o][c] + 0.5f * step;
+    }
+}
+
 } // namespace
 
 std::vector<glm::vec3> estimateReflectance(const std::vector<glm::vec3>& photo, const std::vector<glm::vec3>& direct,
@@ -338,9 +354,10 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
         }
       merged = std::move(next);
       const double change = n > 0 ? std::sqrt(sum / double(n)) : 0.0;
-      out.iterations.push_back({it, secondsSince(stepStart), change,
-                                objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object,
-                                            objects, &objectMaterial)});
+      std::vector<glm::vec3> nextMeans = objectMeans(merged.reflectance, inverseVariance(merged),
+                                                     lighting.geometry.object, objects, &objectMaterial);
+      if (out.iterations.size() >= 2) dampSwings(out.iterations[out.iterations.size() - 2].objectReflectance, means, nextMeans);
+      out.iterations.push_back({it, secondsSince(stepStart), change, std::move(nextMeans)});
       if (log) log(fmt::format("recover: iteration {}: RMS change of R {:.5f}, {:.1f} s", it, change, secondsSince(stepStart)));
     }
   }
