@@ -123,7 +123,7 @@ std::vector<float> inverseVariance(const WeightedMerge& m) {
 // 0.079 after 5 / 6 / 7 iterations, now 0.072 / 0.071 / 0.072. Where it converges without swinging
 // (the Cornell box), the means are taken as they come, as fast as before.
 void dampSwings(const std::vector<glm::vec3>& before, const std::vector<glm::vec3>& used, std::vector<glm::vec3>& next) {
-  for (std::size_t o = 0; o < next.size() && o < used.size() && o < before.size(); ++o)
+  for (std::size_t o = 0; o < next.size(); ++o) // one mean per object in all three
     for (int c = 0; c < 3; ++c) {
       const float step = next[o][c] - used[o][c], last = used[o][c] - before[o][c];
       if (step * last < 0.0f) next[o][c] = used[o][c] + 0.5f * step;

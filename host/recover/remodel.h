@@ -54,8 +54,9 @@ struct RemodelOptions {
   std::uint32_t bounces = 8;     // gathers (L has bounces + 1 reflections at most)
   // Path vertices through hidden surfaces per gather (photo_gather.h). Longer than recover's 3:
   // there the photographs end most paths, here nothing measures the new light, and the cut's
-  // bias shrinks with each vertex (new lamp, median 8x8 block error 3 / 5 / 8 vertices:
-  // classroom 4.6 / 3.9 / 3.7 %, staircase 3.9 / 3.9 / 3.4 %; ~1.5x the time).
+  // bias shrinks with each vertex (new lamp, median 8x8 block error 3 / 5 / 8 vertices, on the
+  // first, 6-bounce photographs: classroom 4.6 / 3.9 / 3.7 %, staircase 3.9 / 3.9 / 3.4 %; ~1.5x
+  // the time).
   std::uint32_t hiddenBounces = kMaxHiddenBounces;
 };
 
