@@ -88,6 +88,28 @@ std::vector<float> photoNoise(const std::vector<glm::vec3>& photo, const PixelGe
   return variance;
 }
 
+std::vector<float> shotNoise(const std::vector<std::vector<glm::vec3>>& photos, std::size_t shot,
+                             const PixelGeometry& pixels) {
+  const std::vector<glm::vec3>& photo = photos.at(shot);
+  std::vector<float> plain = photoNoise(photo, pixels);
+  if (photos.size() < 2) return plain;
+  const std::size_t n = photo.size();
+  std::vector<glm::vec3> ratio(n, glm::vec3(0.0f));
+  for (std::size_t p = 0; p < n; ++p) {
+    float others = 0.0f;
+    for (std::size_t j = 0; j < photos.size(); ++j)
+      if (j != shot) others += luminance(photos[j][p]);
+    if (others > 0.0f) ratio[p] = glm::vec3(luminance(photo[p]) / others);
+  }
+  const std::vector<float> ratioNoise = photoNoise(ratio, pixels);
+  for (std::size_t p = 0; p < n; ++p) {
+    // (sigma_r / r)^2 is C_i's relative variance: times C_i^2 in the photograph's units.
+    const float r = ratio[p].x, c = luminance(photo[p]);
+    if (r > 0.0f) plain[p] = std::min(plain[p], ratioNoise[p] / (r * r) * c * c);
+  }
+  return plain;
+}
+
 WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
                             const std::vector<std::vector<glm::vec3>>& direct,
                             const std::vector<std::vector<glm::vec3>>& indirect,
@@ -110,7 +132,7 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
   std::vector<double> weightSum(n, 0.0);
   std::vector<glm::dvec3> sum(n, glm::dvec3(0.0));
   std::vector<std::vector<float>> noiseOf(shots);
-  parallelFor(shots, [&](std::size_t i) { noiseOf[i] = photoNoise(photos[i], pixels); });
+  parallelFor(shots, [&](std::size_t i) { noiseOf[i] = shotNoise(photos, i, pixels); });
   for (std::size_t i = 0; i < shots; ++i) {
     const std::vector<float>& noise = noiseOf[i];
     forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {

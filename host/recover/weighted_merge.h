@@ -8,8 +8,9 @@
 //
 //   v_i = (sigma_i / C_i)^2 + (e_B B_i / (D_i + B_i))^2
 //
-//   sigma_i  the photograph's noise at the pixel, estimated from the photograph itself
-//            (photoNoise: the spread of the pixel about its neighbours on the same surface);
+//   sigma_i  the photograph's noise at the pixel, estimated from the photographs themselves
+//            (shotNoise: the spread of the pixel about its neighbours on the same surface, in
+//            the photograph over the other shots' sum, where a texture cancels);
 //   e_B      the relative uncertainty of the modelled indirect light B (options below). The
 //            direct light D is traced exactly (a point lamp, exact visibility), so a directly lit
 //            estimate is as good as its photograph; one lit only indirectly is as good as B.
@@ -48,8 +49,19 @@ struct WeightedMergeOptions {
 
 // sigma^2 per pixel of a photograph (luminance), from the squared differences between each pixel
 // and the mean of its same-surface 3x3 neighbours, averaged over its same-surface 5x5 window.
-// A texture's own variation counts as noise here: it lowers every photo's weight alike.
+// A texture's own variation counts as noise here (shotNoise below takes it out).
 std::vector<float> photoNoise(const std::vector<glm::vec3>& photo, const PixelGeometry& pixels);
+
+// sigma^2 per pixel of photograph `shot` of `photos` (luminance), with the reflectance's texture
+// taken out: photoNoise of the ratio C_i / S, S = the sum of the other shots' photographs, where
+// the texture (a factor of every shot alike) cancels and what varies between neighbours is the
+// lighting's ratio, smooth on a surface, and the noise, scaled back to C_i's units (S's own
+// noise adds to it: an overestimate where the other shots are dim). The smaller of that and
+// photoNoise(C_i): at a shadow edge the ratio steps and the photograph alone is the better
+// measure. On a flat wall the two agree; on the staircase's wallpaper photoNoise counted the
+// pattern as noise, and the smoothing by noise then blurred it (BENCHMARKS).
+std::vector<float> shotNoise(const std::vector<std::vector<glm::vec3>>& photos, std::size_t shot,
+                             const PixelGeometry& pixels);
 
 struct WeightedMerge {
   std::vector<glm::vec3> reflectance;       // merged (smoothed when asked); 0 where nothing informs
