@@ -8,6 +8,7 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "core/luminance.h"
 #include "core/parallel_for.h"
 #include "recover/recovery_scene.h"
 #include "render/gpu_ray_batch.h"
@@ -302,14 +303,17 @@ PhotoGather PhotoGather::onDevice(const gpu::Context& context, const scene::Scen
 
 std::vector<std::vector<glm::vec3>> PhotoGather::indirect(const std::vector<Shot>& shots,
                                                           const std::vector<glm::vec3>& objectReflectance,
-                                                          const std::vector<Cut>& cut, std::vector<Cut>* settled) const {
+                                                          const std::vector<Cut>& cut, std::vector<Cut>* settled,
+                                                          std::vector<std::vector<float>>* modelled) const {
   std::vector<std::vector<glm::vec3>> out(shots_);
   if (settled) settled->assign(shots_, Cut());
+  if (modelled) modelled->assign(shots_, {});
   // The shots' gathers are independent re-sums of the same paths: one per core.
   parallelFor(shots_, [&](std::size_t i) {
     std::vector<glm::vec3> lampColour(shots_, glm::vec3(0.0f));
     lampColour[i] = shots[i].color;
-    out[i] = gather(shots[i].radiance, lampColour, objectReflectance, cut.at(i), settled ? &(*settled)[i] : nullptr);
+    out[i] = gather(shots[i].radiance, lampColour, objectReflectance, cut.at(i), settled ? &(*settled)[i] : nullptr,
+                    modelled ? &(*modelled)[i] : nullptr);
   });
   return out;
 }
@@ -317,20 +321,39 @@ std::vector<std::vector<glm::vec3>> PhotoGather::indirect(const std::vector<Shot
 std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radiance,
                                            const std::vector<glm::vec3>& lampColour,
                                            const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
-                                           Cut* settled) const {
+                                           Cut* settled, std::vector<float>* modelled) const {
   std::vector<glm::dvec3> incoming;
   std::vector<double> paths;
   const std::vector<glm::vec3> hidden = hiddenRadiance(radiance, lampColour, objectReflectance, cut,
                                                        settled ? &incoming : nullptr, settled ? &paths : nullptr);
-  std::vector<glm::vec3> out(pixels_, glm::vec3(0.0f));
+  std::vector<glm::vec3> out(pixels_, glm::vec3(0.0f)), deep;
+  if (modelled) deep.assign(pixels_, glm::vec3(0.0f));
   const float perRay = 1.0f / float(raysPerPixel_);
   for (std::size_t p = 0; p < pixels_; ++p) {
-    glm::vec3 sum(0.0f);
+    glm::vec3 sum(0.0f), deeper(0.0f);
     for (std::uint32_t k = seenStart_[p]; k < seenStart_[p + 1]; ++k) sum += radiance[seen_[k]];
-    for (std::uint32_t k = hiddenStart_[p]; k < hiddenEnd_[p]; ++k) sum += hidden[k];
+    for (std::uint32_t k = hiddenStart_[p]; k < hiddenEnd_[p]; ++k) {
+      sum += hidden[k];
+      if (!modelled) continue;
+      // What the hidden hit passes on beyond its own direct light (a shadow ray per lamp).
+      glm::vec3 direct(0.0f);
+      for (std::size_t i = 0; i < shots_; ++i) direct += hiddenDirect_[std::size_t(k) * shots_ + i] * lampColour[i];
+      deeper += hidden[k] - direct * objectReflectance[hiddenObject_[k]];
+    }
     out[p] = sum * perRay;
+    if (modelled) deep[p] = deeper * perRay;
   }
-  if (smoothRadius_ > 0) out = smoothOnSurfaces(out, *geometry_, smoothRadius_);
+  if (smoothRadius_ > 0) {
+    out = smoothOnSurfaces(out, *geometry_, smoothRadius_);
+    if (modelled) deep = smoothOnSurfaces(deep, *geometry_, smoothRadius_);
+  }
+  if (modelled) {
+    modelled->assign(pixels_, 0.0f);
+    for (std::size_t p = 0; p < pixels_; ++p) {
+      const float all = luminance(out[p]);
+      if (all > 0.0f) (*modelled)[p] = std::clamp(luminance(deep[p]) / all, 0.0f, 1.0f);
+    }
+  }
   if (settled) {
     // The prior an object with few vertices of its own leans on: the pixels' mean B now.
     glm::dvec3 sumB(0.0);

@@ -88,12 +88,13 @@ std::vector<std::vector<glm::vec3>> estimatesWith(const PhotoSet& photos, const 
 WeightedMerge mergeShots(const PhotoSet& photos, const Lighting& lighting,
                          const std::vector<std::vector<glm::vec3>>& indirect,
                          const std::vector<std::vector<glm::vec3>>& estimates,
-                         const std::vector<ConfidenceImage>& confidences, const RecoveryOptions& options) {
+                         const std::vector<ConfidenceImage>& confidences, const RecoveryOptions& options,
+                         const std::vector<std::vector<float>>* modelled = nullptr) {
   if (options.merge == MergeModel::Weighted) {
     std::vector<std::vector<glm::vec3>> radiance;
     for (const auto& shot : photos.shots) radiance.push_back(shot.radiance);
     return weightedMerge(radiance, lighting.direct, indirect, estimates, confidences, lighting.visibility,
-                         lighting.geometry, options.weighted);
+                         lighting.geometry, options.weighted, modelled);
   }
   const Merged paper = mergeEstimates(estimates, confidences);
   WeightedMerge out;
@@ -325,6 +326,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   }
   if (options.indirect != IndirectModel::Constant) {
     std::vector<PhotoGather::Cut> cuts; // per shot
+    std::vector<std::vector<float>> modelled; // [shot][pixel] B_i's share resting on its longer paths
     for (std::uint32_t it = 1; it <= options.iterations; ++it) {
       stepStart = Clock::now();
       const std::vector<glm::vec3>& means = out.iterations.back().objectReflectance;
@@ -335,7 +337,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
           for (const auto& b : out.indirect)
             cuts.push_back(PhotoGather::uniformCut(objects, constantAmbient(b, lighting.geometry.object, 1.0f).front()));
         std::vector<PhotoGather::Cut> settled;
-        out.indirect = gather->indirect(photos.shots, means, cuts, &settled);
+        out.indirect = gather->indirect(photos.shots, means, cuts, &settled, &modelled);
         cuts = std::move(settled);
       } else {
         lighting = traceLighting(context, room, bvh, camera, photos, means, options);
@@ -343,7 +345,8 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       }
       out.estimates = estimatesWith(photos, lighting, out.indirect);
       out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters, surfaces);
-      WeightedMerge next = mergeShots(photos, lighting, out.indirect, out.estimates, out.confidences, options);
+      WeightedMerge next = mergeShots(photos, lighting, out.indirect, out.estimates, out.confidences, options,
+                                      modelled.empty() ? nullptr : &modelled);
       double sum = 0.0;
       std::size_t n = 0;
       for (std::size_t p = 0; p < next.reflectance.size(); ++p)

@@ -6,7 +6,7 @@
 //
 // v_i is R_i's relative variance by first-order error propagation:
 //
-//   v_i = (sigma_i / C_i)^2 + (e_B B_i / (D_i + B_i))^2
+//   v_i = (sigma_i / C_i)^2 + (e_B m_i B_i / (D_i + B_i))^2
 //
 //   sigma_i  the photograph's noise at the pixel, estimated from the photographs themselves
 //            (shotNoise: the spread of the pixel about its neighbours on the same surface, in
@@ -14,6 +14,11 @@
 //   e_B      the relative uncertainty of the modelled indirect light B (options below). The
 //            direct light D is traced exactly (a point lamp, exact visibility), so a directly lit
 //            estimate is as good as its photograph; one lit only indirectly is as good as B.
+//   m_i      the share of B_i that rests on the gather's longer reach (PhotoGather::gather's
+//            `modelled`: what its hidden hits pass on beyond their own direct light); 1 where
+//            the caller has none (the constant and obscurance models). A shot whose light
+//            reaches the pixel through the photographs or one hidden bounce outweighs one
+//            whose light comes the long way round.
 //
 // K_i is the paper's filtered confidence where lamp i lights the pixel (confidence_filters.h).
 // Where the pixel and its whole (2 r + 1)^2 window lie in lamp i's shadow (V_i = 0 there, the
@@ -24,7 +29,8 @@
 // is what is wrong there (a pixel that mixes surfaces, a hotspot the point lamp misses). A sliver of a surface (less than two thirds of its
 // 3x3 window on it: a face seen edge-on) gets none: its mean point and normal mix two faces.
 //
-// The merged R is then smoothed along surfaces by its noise (smoothByNoise): each pixel averages
+// The merged R is then smoothed along surfaces by its noise (smoothByNoise, with e_B on all of B,
+// m_i = 1, as its tolerance): each pixel averages
 // the pixels of its window that see the same object with the same normal and whose R agrees with
 // its own within `agreement` standard deviations (a sigma filter, Lee 1983), weighted by their
 // inverse variances. A flat wall's noise averages out; a texture edge, larger than the noise,
@@ -65,21 +71,23 @@ std::vector<float> shotNoise(const std::vector<std::vector<glm::vec3>>& photos, 
 
 struct WeightedMerge {
   std::vector<glm::vec3> reflectance;       // merged (smoothed when asked); 0 where nothing informs
-  std::vector<float> relativeVariance;      // of the merged R (1 / sum w_i); 0 where nothing informs
+  std::vector<float> relativeVariance;      // of the merged R with e_B on all of B (1 / sum w_i at m_i = 1); 0 where nothing informs
   std::vector<float> directConfidence;      // sum of the paper's K_i over the lit estimates
   std::vector<float> indirectShots;         // how many indirect-only estimates the pixel has
   std::vector<std::vector<float>> weights;  // [shot][pixel] w_i (direct or indirect-only)
 };
 
 // `photos[i]` the photographs, `direct[i]` / `indirect[i]` D_i and B_i per unit reflectance,
-// `estimates[i]` R_i, `confidences[i]` the paper's filtered K_i, `visibility[i]` the raw V_i.
+// `estimates[i]` R_i, `confidences[i]` the paper's filtered K_i, `visibility[i]` the raw V_i,
+// `modelled[i]` m_i (none: 1).
 WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
                             const std::vector<std::vector<glm::vec3>>& direct,
                             const std::vector<std::vector<glm::vec3>>& indirect,
                             const std::vector<std::vector<glm::vec3>>& estimates,
                             const std::vector<ConfidenceImage>& confidences,
                             const std::vector<ConfidenceImage>& visibility, const PixelGeometry& pixels,
-                            const WeightedMergeOptions& options);
+                            const WeightedMergeOptions& options,
+                            const std::vector<std::vector<float>>* modelled = nullptr);
 
 // The sigma filter above on `reflectance` with relative variances `variance`.
 std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,

@@ -224,6 +224,37 @@ TEST(WeightedMerge, APixelInEveryLampsShadowIsRecoveredFromItsIndirectLightAlone
   }
 }
 
+TEST(WeightedMerge, AShotWhoseLightComesTheLongWayRoundWeighsLess) {
+  // Two shots of a wall in both lamps' shadow: shot 0's indirect light comes a fifth through the
+  // gather's longer paths (m = 0.2) and gives 0.5, shot 1's all of it (m = 1) and gives 0.8.
+  // Noise-free photographs: the weights are 1 / (e_B m)^2 (+ the floor), 25 : 1.
+  const int w = 9, h = 9;
+  const PixelGeometry g = wall(w, h);
+  const std::size_t n = std::size_t(w) * h;
+  std::vector<std::vector<glm::vec3>> photos(2, std::vector<glm::vec3>(n)), direct(2, std::vector<glm::vec3>(n, glm::vec3(0.0f))),
+      indirect(2, std::vector<glm::vec3>(n, glm::vec3(0.1f))), estimates(2);
+  for (std::size_t p = 0; p < n; ++p) {
+    photos[0][p] = glm::vec3(0.05f);
+    photos[1][p] = glm::vec3(0.08f);
+  }
+  for (int i = 0; i < 2; ++i) {
+    estimates[i] = photos[i];
+    for (auto& r : estimates[i]) r /= 0.1f;
+  }
+  const std::vector<std::vector<float>> modelled{std::vector<float>(n, 0.2f), std::vector<float>(n, 1.0f)};
+  const std::vector<ConfidenceImage> none(2, filled(w, h, 0.0f));
+  WeightedMergeOptions options;
+  options.smoothingRadius = 0;
+  const WeightedMerge m = weightedMerge(photos, direct, indirect, estimates, none, none, g, options, &modelled);
+  const WeightedMerge alike = weightedMerge(photos, direct, indirect, estimates, none, none, g, options);
+  const float eB2 = options.indirectUncertainty * options.indirectUncertainty;
+  const float w0 = 1.0f / (eB2 * 0.04f + 1e-6f), w1 = 1.0f / (eB2 + 1e-6f);
+  for (std::size_t p = 0; p < n; ++p) {
+    EXPECT_NEAR(m.reflectance[p].x, (0.5f * w0 + 0.8f * w1) / (w0 + w1), 1e-4f);
+    EXPECT_NEAR(alike.reflectance[p].x, 0.65f, 1e-4f); // without m, the plain mean
+  }
+}
+
 TEST(WeightedMerge, SmoothingByNoiseFlattensAWallAndKeepsATextureEdge) {
   // A wall whose left half has reflectance 0.3 and right half 0.6 (a texture edge inside one
   // object), with 5 % relative noise per pixel, and that variance known.

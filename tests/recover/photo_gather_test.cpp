@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/luminance.h"
 #include "recover/photo_gather.h"
 #include "recover/recovery_scene.h"
 #include "recover_cornell_fixture.h"
@@ -202,6 +203,38 @@ TEST(PhotoGather, RaysStartOnTheSurfacesAPixelSeesNotAtItsMeanPoint) {
   // Both are means over the tube's ~270 pixels of 64 and 1,024 rays each: their noise is ~0.3 %.
   // From the pixels' mean points (inside the tube, or in the air at its edges): 0.17 of this.
   EXPECT_NEAR(gathered / expected, 1.0, 0.03) << "gathered " << gathered / tubePixels << ", expected " << expected / tubePixels;
+}
+
+TEST(PhotoGather, TheModelledShareIsWhatHiddenHitsPassOnBeyondTheirOwnDirectLight) {
+  // The tube over the floor, a lamp over them, and paths cut at the first hidden vertex: the cut
+  // enters B once, times the floor's reflectance, so the light that rests on the model's longer
+  // reach is B with the cut less B without it. The hidden hits' own direct light (a shadow ray)
+  // and the photograph's radiance are the measured rest.
+  const scene::Scene room = tubeOverAFloor(0.02f, 0.05f, 32);
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(room));
+  constexpr int kSize = 32;
+  const scene::Camera camera = lookCamera({0.0f, 1.0f, 0.0f}, {0.0f, -1.0f, 0.0f}, {0.0f, 0.0f, -1.0f},
+                                          2.0f * std::atan(0.3f));
+  const recover::PixelGeometry pixels = pixelGeometry(room, tree, camera, kSize, kSize);
+  recover::Shot lamp{.position = {0.3f, 0.4f, 0.2f}, .intensity = 0.5f};
+  lamp.radiance.assign(kSize * kSize, glm::vec3(0.2f));
+  render::CpuRayBatch rays(tree);
+  const recover::PhotoGather gather(room, rays, camera, pixels, {lamp}, 16, 5, 1, 0);
+  const std::vector<glm::vec3> reflectance{glm::vec3(0.6f), glm::vec3(0.3f)};
+  std::vector<float> modelled;
+  const std::vector<glm::vec3> withCut =
+      gather.gather(lamp.radiance, {glm::vec3(1.0f)}, reflectance, {glm::vec3(0.1f), glm::vec3(0.1f)}, nullptr, &modelled);
+  const std::vector<glm::vec3> withoutCut =
+      gather.gather(lamp.radiance, {glm::vec3(1.0f)}, reflectance, {glm::vec3(0.0f), glm::vec3(0.0f)});
+  ASSERT_EQ(modelled.size(), pixels.object.size());
+  int partly = 0;
+  for (std::size_t p = 0; p < modelled.size(); ++p) {
+    if (pixels.object[p] < 0 || !(luminance(withCut[p]) > 0.0f)) continue;
+    const float expected = luminance(withCut[p] - withoutCut[p]) / luminance(withCut[p]);
+    EXPECT_NEAR(modelled[p], expected, 1e-4f) << p;
+    if (modelled[p] > 0.05f && modelled[p] < 0.95f) ++partly;
+  }
+  EXPECT_GT(partly, 50); // the tube's and the floor's pixels near it see hidden floor
 }
 
 } // namespace
