@@ -61,7 +61,8 @@ def main():
     surface = objects >= 0
     out = {"seconds": report.get("seconds"), "accuracy": report.get("accuracy"),
            "lit_pixels": report.get("lit_pixels"), "indirect_only_pixels": report.get("indirect_only_pixels"),
-           "filled": (report.get("filled_from_visibility", 0), report.get("filled_from_object_mean", 0)),
+           "filled": (report.get("filled_from_surface", 0), report.get("filled_from_visibility", 0),
+                      report.get("filled_from_object_mean", 0)),
            "surface_pixels": int(surface.sum())}
     d = recovered[surface] - truth[surface]
     out["rmse_all"] = float(np.sqrt(np.mean(d * d)))
@@ -103,7 +104,8 @@ def main():
     acc = out["accuracy"] or {}
     print(f"recovery_report: {a.recovered} against {meta['albedo']['image']}: {out['surface_pixels']} surface pixels, "
           f"{out['lit_pixels']} from lit estimates, {out['indirect_only_pixels']} from indirect light only, filled "
-          f"{out['filled'][0]} + {out['filled'][1]}; {out['seconds']:.1f} s")
+          f"{out['filled'][0]} (surface) + {out['filled'][1]} (visibility) + {out['filled'][2]} (object); "
+          f"{out['seconds']:.1f} s")
     if acc:
         print(f"  RMSE all {acc['all']['rmse']:.4f} (goal 0.04), lit in some photo {acc['direct']['rmse']:.4f} "
               f"(goal 0.02), shadow {acc['shadow']['rmse']:.4f} ({acc['shadow']['pixels']} px)")

@@ -148,6 +148,7 @@ void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const rec
                                  {"surface_pixels", surface},
                                  {"lit_pixels", r.litPixels},
                                  {"indirect_only_pixels", r.indirectOnlyPixels},
+                                 {"filled_from_surface", r.filledFromSurface},
                                  {"filled_from_visibility", r.filledFromVisibility},
                                  {"filled_from_object_mean", r.filledFromObject},
                                  {"gather_rays_seen", r.gatherSeen},
@@ -204,9 +205,10 @@ void runRecover(RecoverOptions& o) {
              photos.shots.size() - 1,
              std::chrono::duration<double>(std::chrono::steady_clock::now() - stateStart).count(), o.output);
   fmt::print(stderr, "recover: {} photos, {}x{}, {} iterations; {} pixels from lit estimates, {} from indirect light "
-                     "only; {} filled from visibility, {} from their object's mean; {:.1f} s -> {}\n",
+                     "only; {} filled from their surface nearby, {} from visibility, {} from their object's mean; "
+                     "{:.1f} s -> {}\n",
              photos.shots.size(), r.width, r.height, r.iterations.size() - 1, r.litPixels, r.indirectOnlyPixels,
-             r.filledFromVisibility, r.filledFromObject, r.seconds, o.output);
+             r.filledFromSurface, r.filledFromVisibility, r.filledFromObject, r.seconds, o.output);
 }
 
 } // namespace

@@ -365,9 +365,11 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
     }
   }
 
-  // Pixels no filtered confidence reaches: first the photos' raw visibilities (the filters
-  // removed a pixel some lamp still lights), less the estimates the outlier test rejects on them,
-  // then, lit by no lamp at all, the object's mean.
+  // Pixels no filtered confidence reaches, where some lamp still lights them (the filters removed
+  // them): the merged pixels of their own surface nearby (surfaceFill), else the photos' raw
+  // visibilities, less the estimates the outlier test rejects on them; lit by no lamp at all, the
+  // object's mean (measured better there than the surface's nearby pixels, themselves lit only
+  // indirectly: the classroom's shadow RMSE 0.093 against 0.112).
   std::vector<ConfidenceImage> fillWeights = lighting.visibility;
   if (options.filters.outlier)
     outlierTest(out.estimates, fillWeights, options.filters.outlierConfidence, options.filters.outlierDistance);
@@ -394,7 +396,13 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       sum += fillWeights[i].k[p] * r;
       weight += fillWeights[i].k[p];
     }
-    if (weight > 0.0f) {
+    const std::optional<glm::vec3> surface =
+        weight > 0.0f && options.merge == MergeModel::Weighted ? surfaceFill(merged, lighting.geometry, p) : std::nullopt;
+    if (surface) {
+      out.reflectance[p] = *surface;
+      out.filled[p] = 3;
+      ++out.filledFromSurface;
+    } else if (weight > 0.0f) {
       out.reflectance[p] = sum / weight;
       out.filled[p] = 1;
       ++out.filledFromVisibility;

@@ -182,6 +182,22 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
   return out;
 }
 
+std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeometry& pixels, std::size_t p) {
+  const int x = int(p % std::size_t(pixels.width)), y = int(p / std::size_t(pixels.width));
+  glm::dvec3 sum(0.0);
+  double weight = 0.0;
+  int support = 0;
+  forSurfaceWindow(pixels, x, y, kSurfaceFillRadius, [&](std::size_t q) {
+    if (merged.relativeVariance[q] <= 0.0f) return;
+    const double w = 1.0 / merged.relativeVariance[q];
+    sum += w * glm::dvec3(merged.reflectance[q]);
+    weight += w;
+    ++support;
+  });
+  if (support < kSurfaceFillSupport) return std::nullopt;
+  return glm::vec3(sum / weight);
+}
+
 std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,
                                      const PixelGeometry& pixels, int radius, float agreement) {
   std::vector<glm::vec3> out = reflectance;

@@ -37,6 +37,7 @@
 // stays sharp.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -88,6 +89,18 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
                             const std::vector<ConfidenceImage>& visibility, const PixelGeometry& pixels,
                             const WeightedMergeOptions& options,
                             const std::vector<std::vector<float>>* modelled = nullptr);
+
+// A pixel the merge left without an estimate (relativeVariance 0) that some lamp still lights:
+// the inverse-variance mean of the merged pixels within kSurfaceFillRadius that see its surface
+// (its object, normals within dot 0.95), when there are at least kSurfaceFillSupport of them.
+// The paper's filters leave such a pixel without confidence by a shadow edge or on a sliver of
+// its surface, where its own estimates are the lighting model's worst (a partly visible lamp, a
+// mean point and normal that mix two faces: the classroom's filled from visibility had RMSE 0.22
+// against 0.066 overall); its surface's merged pixels beside it are the better guess, and they
+// follow a texture, as its object's mean would not (BENCHMARKS).
+inline constexpr int kSurfaceFillRadius = 3;
+inline constexpr int kSurfaceFillSupport = 3;
+std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeometry& pixels, std::size_t p);
 
 // The sigma filter above on `reflectance` with relative variances `variance`.
 std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,

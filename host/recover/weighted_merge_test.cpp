@@ -2,6 +2,7 @@
 // estimates, and the smoothing by noise, on small synthetic images with known answers.
 #include "recover/weighted_merge.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -253,6 +254,37 @@ TEST(WeightedMerge, AShotWhoseLightComesTheLongWayRoundWeighsLess) {
     EXPECT_NEAR(m.reflectance[p].x, (0.5f * w0 + 0.8f * w1) / (w0 + w1), 1e-4f);
     EXPECT_NEAR(alike.reflectance[p].x, 0.65f, 1e-4f); // without m, the plain mean
   }
+}
+
+TEST(WeightedMerge, AnUnmergedPixelIsFilledFromTheMergedPixelsOfItsOwnSurfaceNearby) {
+  // Two walls side by side (objects 0 and 1, split at column 6), merged to 0.2 and 0.9, with a
+  // hole of unmerged pixels on wall 0 along the split; the merged pixels' variances differ.
+  const int w = 12, h = 12;
+  const PixelGeometry g = wall(w, h, 6);
+  WeightedMerge m;
+  m.reflectance.assign(std::size_t(w) * h, glm::vec3(0.0f));
+  m.relativeVariance.assign(m.reflectance.size(), 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t p = std::size_t(y) * w + x;
+      if (x >= 4 && x < 6) continue; // the hole, beside the other wall
+      // Wall 0: 0.2 at variance 0.01 in even rows, 0.3 at 0.04 in odd ones (weights 4 : 1).
+      m.reflectance[p] = glm::vec3(x < 6 ? (y % 2 == 0 ? 0.2f : 0.3f) : 0.9f);
+      m.relativeVariance[p] = x < 6 && y % 2 == 1 ? 0.04f : 0.01f;
+    }
+  for (int y = 0; y < h; ++y) {
+    const auto filled = surfaceFill(m, g, std::size_t(y) * w + 5);
+    ASSERT_TRUE(filled) << y;
+    // Only wall 0's pixels (columns 2-3 of the 7 x 7 window) count, never wall 1's 0.9; the
+    // weighted mean of 0.2 and 0.3 lies between 0.2 and the plain mean 0.25.
+    EXPECT_GT(filled->x, 0.2f) << y;
+    EXPECT_LT(filled->x, 0.25f) << y;
+  }
+  // A pixel with fewer than kSurfaceFillSupport merged pixels of its surface nearby gets none.
+  WeightedMerge lone = m;
+  std::fill(lone.relativeVariance.begin(), lone.relativeVariance.end(), 0.0f);
+  lone.relativeVariance[0] = lone.relativeVariance[1] = 0.01f;
+  EXPECT_FALSE(surfaceFill(lone, g, std::size_t(1) * w + 1));
 }
 
 TEST(WeightedMerge, SmoothingByNoiseFlattensAWallAndKeepsATextureEdge) {

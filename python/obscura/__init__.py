@@ -138,7 +138,7 @@ class Session(_obscura.Session):
 class Recovery:
     """What obscura.recover found: reflectance (H x W x 3), confidence (H x W x 1, the sum of the
     filtered K_i), filled (H x W x 1: 0 measured, 1 filled from visibility, 2 from the object's
-    mean), object (H x W x 1, the object each pixel sees, -1 none), report (recover.json) and
+    mean, 3 from the measured pixels of its surface nearby), object (H x W x 1, the object each pixel sees, -1 none), report (recover.json) and
     the folder, whose `state` sub-folder obscura.load_state reads."""
 
     def __init__(self, folder: str) -> None:

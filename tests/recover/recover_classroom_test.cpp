@@ -56,7 +56,8 @@ TEST_F(RecoverClassroom, ALargerRoomIsRecoveredToItsMeasuredAccuracyWithEveryRef
   // light (measured 2,516-2,562), and the fills are counted: few from visibility.
   EXPECT_GT(r.indirectOnlyPixels, 2000u);
   EXPECT_LT(r.filledFromVisibility, 1500u);
-  EXPECT_EQ(r.litPixels + r.indirectOnlyPixels + r.filledFromVisibility + r.filledFromObject, a.all.pixels);
+  EXPECT_EQ(r.litPixels + r.indirectOnlyPixels + r.filledFromSurface + r.filledFromVisibility + r.filledFromObject,
+            a.all.pixels);
   // Every reflectance is a reflectance: finite, in [0, 1] (the first design had 24 pixels at 3 to 45).
   for (const glm::vec3& v : r.reflectance) {
     ASSERT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z));
