@@ -23,17 +23,12 @@ import os
 import sys
 
 import numpy as np
-import OpenImageIO as oiio
+
+from exr_image import read_image
 
 
 def read(path, channels=None):
-    image = oiio.ImageInput.open(path)
-    if image is None:
-        sys.exit(f"{path}: cannot open: {oiio.geterror()}")
-    spec = image.spec()
-    pixels = image.read_image(oiio.FLOAT)
-    image.close()
-    names = list(spec.channelnames)
+    pixels, names = read_image(path)
     if channels is None:
         return pixels[:, :, :3]
     return {c: pixels[:, :, names.index(c)] for c in channels}

@@ -15,17 +15,8 @@ import sys
 import tempfile
 
 import numpy as np
-import OpenImageIO as oiio
 
-
-def read(path):
-    image = oiio.ImageInput.open(path)
-    if image is None:
-        sys.exit(f"{path}: cannot open: {oiio.geterror()}")
-    spec = image.spec()
-    pixels = image.read_image(oiio.FLOAT)
-    image.close()
-    return pixels, list(spec.channelnames)
+from exr_image import read_image
 
 
 def main():
@@ -47,10 +38,10 @@ def main():
             json.dump(edits, f)
         out = os.path.join(work, "relit.exr")
         subprocess.run([obscura, "remodel", rec, "--edits", edit_file, "-o", out] + sys.argv[4:], check=True)
-        relit, names = read(out)
+        relit, names = read_image(out)
     relit = relit[:, :, [names.index(c) for c in ("R", "G", "B")]] if "R" in names else relit[:, :, :3]
-    photo = read(os.path.join(folder, lamp["image"]))[0][:, :, :3]
-    reflectance, channels = read(os.path.join(rec, "reflectance.exr"))
+    photo = read_image(os.path.join(folder, lamp["image"]))[0][:, :, :3]
+    reflectance, channels = read_image(os.path.join(rec, "reflectance.exr"))
     surface = reflectance[:, :, channels.index("object.id")] >= 0
     lum = np.array([0.2126, 0.7152, 0.0722])
     a, b = relit @ lum, photo @ lum
