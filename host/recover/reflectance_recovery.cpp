@@ -396,13 +396,14 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       sum += fillWeights[i].k[p] * r;
       weight += fillWeights[i].k[p];
     }
+    const bool lamplit = weight > 0.0f;
     const std::optional<glm::vec3> surface =
-        weight > 0.0f && options.merge == MergeModel::Weighted ? surfaceFill(merged, lighting.geometry, p) : std::nullopt;
+        lamplit && options.merge == MergeModel::Weighted ? surfaceFill(merged, lighting.geometry, p) : std::nullopt;
     if (surface) {
       out.reflectance[p] = *surface;
       out.filled[p] = 3;
       ++out.filledFromSurface;
-    } else if (weight > 0.0f) {
+    } else if (lamplit) {
       out.reflectance[p] = sum / weight;
       out.filled[p] = 1;
       ++out.filledFromVisibility;

@@ -29,12 +29,11 @@
 // is what is wrong there (a pixel that mixes surfaces, a hotspot the point lamp misses). A sliver of a surface (less than two thirds of its
 // 3x3 window on it: a face seen edge-on) gets none: its mean point and normal mix two faces.
 //
-// The merged R is then smoothed along surfaces by its noise (smoothByNoise, with e_B on all of B,
-// m_i = 1, as its tolerance): each pixel averages
-// the pixels of its window that see the same object with the same normal and whose R agrees with
-// its own within `agreement` standard deviations (a sigma filter, Lee 1983), weighted by their
-// inverse variances. A flat wall's noise averages out; a texture edge, larger than the noise,
-// stays sharp.
+// The merged R is then smoothed along surfaces by its noise (smoothByNoise, its tolerance with
+// e_B on all of B, m_i = 1): each pixel averages the pixels of its window that see the same
+// object with the same normal and whose R agrees with its own within `agreement` standard
+// deviations (a sigma filter, Lee 1983), weighted by their inverse variances. A flat wall's noise
+// averages out; a texture edge, larger than the noise, stays sharp.
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -72,7 +71,8 @@ std::vector<float> shotNoise(const std::vector<std::vector<glm::vec3>>& photos, 
 
 struct WeightedMerge {
   std::vector<glm::vec3> reflectance;       // merged (smoothed when asked); 0 where nothing informs
-  std::vector<float> relativeVariance;      // of the merged R with e_B on all of B (1 / sum w_i at m_i = 1); 0 where nothing informs
+  std::vector<float> relativeVariance;      // of the merged R with e_B on all of B (1 / sum w_i at m_i = 1);
+                                            // 0 where nothing informs
   std::vector<float> directConfidence;      // sum of the paper's K_i over the lit estimates
   std::vector<float> indirectShots;         // how many indirect-only estimates the pixel has
   std::vector<std::vector<float>> weights;  // [shot][pixel] w_i (direct or indirect-only)

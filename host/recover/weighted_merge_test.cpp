@@ -232,8 +232,9 @@ TEST(WeightedMerge, AShotWhoseLightComesTheLongWayRoundWeighsLess) {
   const int w = 9, h = 9;
   const PixelGeometry g = wall(w, h);
   const std::size_t n = std::size_t(w) * h;
-  std::vector<std::vector<glm::vec3>> photos(2, std::vector<glm::vec3>(n)), direct(2, std::vector<glm::vec3>(n, glm::vec3(0.0f))),
-      indirect(2, std::vector<glm::vec3>(n, glm::vec3(0.1f))), estimates(2);
+  std::vector<std::vector<glm::vec3>> photos(2, std::vector<glm::vec3>(n)),
+      direct(2, std::vector<glm::vec3>(n, glm::vec3(0.0f))), indirect(2, std::vector<glm::vec3>(n, glm::vec3(0.1f))),
+      estimates(2);
   for (std::size_t p = 0; p < n; ++p) {
     photos[0][p] = glm::vec3(0.05f);
     photos[1][p] = glm::vec3(0.08f);

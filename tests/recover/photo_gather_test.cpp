@@ -222,8 +222,8 @@ TEST(PhotoGather, TheModelledShareIsWhatHiddenHitsPassOnBeyondTheirOwnDirectLigh
   const recover::PhotoGather gather(room, rays, camera, pixels, {lamp}, 16, 5, 1, 0);
   const std::vector<glm::vec3> reflectance{glm::vec3(0.6f), glm::vec3(0.3f)};
   std::vector<float> modelled;
-  const std::vector<glm::vec3> withCut =
-      gather.gather(lamp.radiance, {glm::vec3(1.0f)}, reflectance, {glm::vec3(0.1f), glm::vec3(0.1f)}, nullptr, &modelled);
+  const std::vector<glm::vec3> withCut = gather.gather(lamp.radiance, {glm::vec3(1.0f)}, reflectance,
+                                                       {glm::vec3(0.1f), glm::vec3(0.1f)}, nullptr, &modelled);
   const std::vector<glm::vec3> withoutCut =
       gather.gather(lamp.radiance, {glm::vec3(1.0f)}, reflectance, {glm::vec3(0.0f), glm::vec3(0.0f)});
   ASSERT_EQ(modelled.size(), pixels.object.size());

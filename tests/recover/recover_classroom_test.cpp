@@ -71,7 +71,9 @@ TEST_F(RecoverClassroom, ALargerRoomIsRecoveredToItsMeasuredAccuracyWithEveryRef
     ASSERT_LE(std::max({v.x, v.y, v.z}), 1.0f);
   }
   // The largest object (walls and ceiling, 43 % of the surface pixels): its mean within 2 % of
-  // the truth's (issue 36's goal for large flat surfaces; measured 1.001 (0.997 before this session's merge changes); 0.994 on the 6-bounce photographs; 0.986 with the gather from the pixels' mean points).
+  // the truth's (issue 36's goal for large flat surfaces; measured 1.001, 0.997 before the merge's
+  // noise without texture and weights by the longer paths; 0.994 on the 6-bounce photographs;
+  // 0.986 with the gather from the pixels' mean points).
   std::vector<std::size_t> count(room.scene.objects.size(), 0);
   for (std::int32_t o : r.object)
     if (o >= 0) ++count[static_cast<std::size_t>(o)];
