@@ -141,7 +141,8 @@ std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, cons
 
 // The confidence-weighted mean reflectance of each object's pixels; objects with no confident
 // pixel get the mean over the confident pixels of the objects of their material
-// (`objectMaterial`), or, with none, over all confident pixels.
+// (`objectMaterial`), or, with none, a grey of the luminance of the mean over all confident
+// pixels (an unknown colour: not the room's dominant one).
 std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
                                    const std::vector<std::int32_t>& object, std::size_t objects,
                                    const std::vector<std::uint32_t>* objectMaterial = nullptr);
