@@ -128,13 +128,17 @@ scene::Scene tubeOverAFloor(float radius, float height, std::uint32_t segments) 
   return s;
 }
 
+// tubeOverAFloor's view: from 1 m above the floor straight down, 0.6 m across.
+scene::Camera lookingDownAtTheTube() {
+  return lookCamera({0.0f, 1.0f, 0.0f}, {0.0f, -1.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, 2.0f * std::atan(0.3f));
+}
+
 TEST(PhotoGather, RaysStartOnTheSurfacesAPixelSeesNotAtItsMeanPoint) {
   const scene::Scene room = tubeOverAFloor(0.02f, 0.05f, 32);
   const bvh::Bvh tree = bvh::build(render::triangleSoup(room));
   constexpr int kSize = 64;
   // 0.6 m across at 1 m: a pixel is 9.4 mm, the tube 4.3 pixels wide.
-  const scene::Camera camera = lookCamera({0.0f, 1.0f, 0.0f}, {0.0f, -1.0f, 0.0f}, {0.0f, 0.0f, -1.0f},
-                                          2.0f * std::atan(0.3f));
+  const scene::Camera camera = lookingDownAtTheTube();
   const render::GridCamera view{camera.position, camera.forward, camera.up, camera.yfov, 1.0f};
   auto throughPixel = [&](int x, int y, float jx, float jy) {
     const bvh::Ray ray = render::gridRay(view, (float(x) + jx) / kSize, (float(y) + jy) / kSize, 1);
@@ -213,8 +217,7 @@ TEST(PhotoGather, TheModelledShareIsWhatHiddenHitsPassOnBeyondTheirOwnDirectLigh
   const scene::Scene room = tubeOverAFloor(0.02f, 0.05f, 32);
   const bvh::Bvh tree = bvh::build(render::triangleSoup(room));
   constexpr int kSize = 32;
-  const scene::Camera camera = lookCamera({0.0f, 1.0f, 0.0f}, {0.0f, -1.0f, 0.0f}, {0.0f, 0.0f, -1.0f},
-                                          2.0f * std::atan(0.3f));
+  const scene::Camera camera = lookingDownAtTheTube();
   const recover::PixelGeometry pixels = pixelGeometry(room, tree, camera, kSize, kSize);
   recover::Shot lamp{.position = {0.3f, 0.4f, 0.2f}, .intensity = 0.5f};
   lamp.radiance.assign(kSize * kSize, glm::vec3(0.2f));
