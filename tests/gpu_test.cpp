@@ -21,4 +21,13 @@ int largestChannelDifference(const std::vector<std::uint32_t>& a, const std::vec
 
 std::string repoPath(const std::string& relative) { return std::string(OBSCURA_SOURCE_DIR) + "/" + relative; }
 
+io::Image channelsOf(const io::Image& all, const std::string& first) {
+  io::Image out{.width = all.width, .height = all.height, .channels = {"combined.R", "combined.G", "combined.B"}, .pixels = {}};
+  const int c = all.channelIndex(first);
+  for (int y = 0; y < all.height; ++y)
+    for (int x = 0; x < all.width; ++x)
+      for (int k = 0; k < 3; ++k) out.pixels.push_back(all.at(x, y, c + k));
+  return out;
+}
+
 } // namespace obscura::test

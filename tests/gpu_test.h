@@ -2,11 +2,13 @@
 // fails the test that caused it.
 #pragma once
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "gpu/context.h"
+#include "io/image_io.h"
 
 namespace obscura::test {
 
@@ -30,6 +32,10 @@ private:
 // The largest difference, in levels of 255, between the R, G or B bytes of two displays (RGBA8
 // words of the same size, such as ObscuranceRenderer::display()).
 int largestChannelDifference(const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b);
+
+// Three channels of an image from channel `first` on, named combined.R/G/B (what
+// analysis::imageError compares): a layer of a renderer's image() set beside another image.
+io::Image channelsOf(const io::Image& all, const std::string& first = "combined.R");
 
 // Path of a scene in ../shared/scenes (the real test scenes nobody here wrote).
 std::string sharedScene(const std::string& relative);

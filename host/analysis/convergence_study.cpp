@@ -49,6 +49,11 @@ const std::vector<StudyMethod> kMethods = {
      "as obscurance, 1 spp, denoised (a-trous on demodulated terms)", 0.0f, true, kDefaults.obscuranceRays},
     {"obscurance-realtime-denoised", false, render::LightSampling::Spatial, 1, 1,
      "spatial, 1+1 rays per hit, denoised, 1 spp", 0.0f, true},
+    // The defaults' frame corrected by paths (render --pt-correction N): the curve's spp is N; it
+    // converges to path tracing's image, so its noise is measured against path tracing's reference.
+    {"obscurance-corrected", false, render::LightSampling::Spatial, kDefaults.shadowRays, 16,
+     "the defaults (8 spp) corrected by N paths per pixel filtered along surfaces (render --pt-correction N)", 0.0f,
+     false, kDefaults.obscuranceRays, 0, true, kPaperSpp},
     {"pathtrace", true, render::LightSampling::Spatial, 0, 1, "path tracing, NEE with spatial light sampling + MIS"},
 };
 
@@ -88,14 +93,19 @@ ConvergenceStudy::ConvergenceStudy(const StudySettings& o, const scene::Scene& s
   if (!o.pathReferenceFile.empty()) farmReference_ = farmReference();
 }
 
+render::PathTraceSettings ConvergenceStudy::pathSettings(const StudyMethod& m, std::uint32_t spp,
+                                                        std::uint32_t seed) const {
+  return {.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_,
+          .lightSampling = m.lightSampling, .emissionSamples = o_.pathEmissionSamples,
+          .emissionAtEdges = o_.pathEmissionAtEdges};
+}
+
 StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, std::uint32_t seed) {
   if (warmedUp_.insert(m.name).second) render(m, 1, seed);
   StudyRender r;
   const render::RenderStats* stats = nullptr;
   if (m.pathTrace) {
-    render::PathTraceSettings s{.width = width_, .height = height_, .spp = spp, .seed = seed, .camera = camera_,
-                                .lightSampling = m.lightSampling, .emissionSamples = o_.pathEmissionSamples,
-                                .emissionAtEdges = o_.pathEmissionAtEdges};
+    const render::PathTraceSettings s = pathSettings(m, spp, seed);
     if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, scene_, bvh_, s);
     pathTracer_->configure(s);
     pathTracer_->render();
@@ -106,7 +116,7 @@ StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, st
     s.editableGeometry = false;
     s.width = width_;
     s.height = height_;
-    s.spp = spp;
+    s.spp = m.correctedSpp ? m.correctedSpp : spp;
     s.emissionSamples = m.emissionSamples ? m.emissionSamples : o_.emissionSamples;
     s.emissionAtEdges = m.emissionSamples ? false : o_.emissionAtEdges;
     s.seed = seed;
@@ -131,6 +141,20 @@ StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, st
       denoiser_->denoise(*obscurance_);
       r.image = denoiser_->image();
       r.gpuMs += denoiser_->lastGpuMs();
+    }
+    if (m.correctedSpp) {
+      // The paths with a seed stream of their own; their time and rays count with the frame's.
+      const render::PathTraceSettings ps = pathSettings(m, spp, seed + 0x9e3779b9u);
+      if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, scene_, bvh_, ps);
+      pathTracer_->configure(ps);
+      pathTracer_->render();
+      if (!correction_) correction_ = std::make_unique<render::PathCorrection>(context_, *obscurance_, *pathTracer_);
+      correction_->correct(*obscurance_, *pathTracer_);
+      r.image = correction_->image();
+      r.gpuMs += correction_->lastGpuMs();
+      const render::RenderStats paths = pathTracer_->stats();
+      for (const auto& [name, pass] : paths.passes) statsCopy_.passes["correction." + name] = pass;
+      statsCopy_.truncatedTraversals += paths.truncatedTraversals;
     }
   }
   stats = &statsCopy_;

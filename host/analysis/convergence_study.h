@@ -20,6 +20,7 @@
 #include "bvh/bvh.h"
 #include "gpu/context.h"
 #include "io/image_io.h"
+#include "render/correction/path_correction.h"
 #include "render/denoise/denoiser.h"
 #include "render/obscurance_renderer.h"
 #include "render/path_tracer.h"
@@ -35,6 +36,7 @@ struct StudySettings {
   std::uint32_t width = 256; // per-pixel noise as a user sees it
   std::uint32_t obscuranceMaxSpp = 16;
   std::uint32_t pathMaxSpp = 256;
+  std::uint32_t correctionMaxPaths = 32; // the corrected method's curve: paths per pixel up to this
   std::uint32_t referenceFactor = 64;   // a reference has this many times the largest curve's spp
   std::uint32_t pathReferenceSpp = 0;   // 0: referenceFactor x pathMaxSpp
   // A merged farm render (`obscura merge`'s EXR of --method pathtrace parts) to take as the path
@@ -69,6 +71,9 @@ struct StudyMethod {
   std::uint32_t obscuranceRays = 0; // obscurance rays per hit; 0: raysPerHit
   std::uint32_t emissionSamples = 0; // camera rays per sample for the seen emission; 0: the study's
   bool vertexRaysByThroughput = true; // specular path vertices: rays scaled by throughput, or N per hit
+  // > 0: the obscurance frame at this many spp corrected by paths (render --pt-correction): the
+  // curve's spp is the paths per pixel, and the method converges to path tracing's image.
+  std::uint32_t correctedSpp = 0;
 };
 
 using render::kPaperSpp;
@@ -113,6 +118,7 @@ public:
   const std::string& stem() const { return stem_; }
 
 private:
+  render::PathTraceSettings pathSettings(const StudyMethod& m, std::uint32_t spp, std::uint32_t seed) const;
   // The path tracing reference from a merged farm render, checked to be of this study's image:
   // the same scene (hash), camera, size, depth and sky.
   io::Image farmReference() const;
@@ -128,6 +134,7 @@ private:
   std::unique_ptr<render::ObscuranceRenderer> obscurance_;
   std::unique_ptr<render::Denoiser> denoiser_; // bound to obscurance_'s frame
   std::unique_ptr<render::PathTracer> pathTracer_;
+  std::unique_ptr<render::PathCorrection> correction_; // bound to obscurance_'s frame and pathTracer_'s sums
   std::set<std::string> warmedUp_; // methods rendered once, untimed
   scene::Camera camera_;
   std::uint32_t width_ = 0, height_ = 0;

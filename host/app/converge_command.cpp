@@ -85,14 +85,17 @@ void runConverge(const ConvergeOptions& o) {
   std::map<std::string, io::Image> reflectorReferences;
   for (const analysis::StudyMethod& m : methods)
     if (m.secondaryReflectors > 0.0f) reflectorReferences[m.name] = study.reference(m);
+  // The corrected method converges to path tracing's image: its noise is measured against that.
   auto noiseReference = [&](const analysis::StudyMethod& m) -> const io::Image& {
-    if (m.pathTrace) return ptReference;
+    if (m.pathTrace || m.correctedSpp) return ptReference;
     return m.secondaryReflectors > 0.0f ? reflectorReferences.at(m.name) : obscuranceReference;
   };
   // How converged each reference is (the difference of its two halves): noise measured against it
   // cannot fall below that.
   auto noiseFloor = [&](const analysis::StudyMethod& m) {
-    return study.referenceNoise(m.pathTrace ? pathMethod.name : m.secondaryReflectors > 0.0f ? m.name : best.name);
+    return study.referenceNoise(m.pathTrace || m.correctedSpp ? pathMethod.name
+                                : m.secondaryReflectors > 0.0f ? m.name
+                                                               : best.name);
   };
   nlohmann::json referenceNoiseJson = nlohmann::json::object();
   for (const analysis::StudyMethod* m : {&best, &pathMethod}) {
@@ -117,7 +120,7 @@ void runConverge(const ConvergeOptions& o) {
          "rmse_vs_pathtrace,relmse_vs_pathtrace,mae_vs_pathtrace,rmse_trimmed_vs_pathtrace,noise_at_reference_floor\n";
   for (const auto& m : methods) {
     analysis::Curve curve{.method = m.name, .points = {}};
-    std::uint32_t maxSpp = m.pathTrace ? o.pathMaxSpp : o.obscuranceMaxSpp;
+    std::uint32_t maxSpp = m.pathTrace ? o.pathMaxSpp : m.correctedSpp ? o.correctionMaxPaths : o.obscuranceMaxSpp;
     for (std::uint32_t spp = 1; spp <= maxSpp; spp *= 2) {
       analysis::StudyRender r = study.render(m, spp, o.seed + spp);
       analysis::CurvePoint p{.spp = spp, .raysPerPixel = r.rays, .gpuMs = r.gpuMs,
@@ -229,6 +232,31 @@ void runConverge(const ConvergeOptions& o) {
                     {"total_error", total}, {"pathtrace_ms_to_equal_total_error", equalTotal.ms},
                     {"equal_total_extrapolated", equalTotal.extrapolated}};
     }
+    // Total error (bias and noise) against path tracing's at the same GPU time, at every point of the
+    // curve (path tracing's curve read there, log-log; past its last point extrapolated): where the
+    // method is worth its bias. A ratio above 1 says path tracing is nearer the truth by then.
+    {
+      double worst = 0.0, worstMs = 0.0;
+      bool extrapolated = false;
+      for (const auto& p : curves[i].points) {
+        const analysis::ErrorAt ptThen = analysis::errorAtTime(pt, p.gpuMs, analysis::ErrorKind::AgainstReference,
+                                                               analysis::Metric::Rmse);
+        if (ptThen.error <= 0.0) continue;
+        const double ratio = p.total.rmse / ptThen.error;
+        if (ratio > worst) {
+          worst = ratio;
+          worstMs = p.gpuMs;
+          extrapolated = ptThen.extrapolated;
+        }
+      }
+      const double lastMs = curves[i].points.empty() ? 0.0 : curves[i].points.back().gpuMs;
+      fmt::print("  total error against path tracing's at equal time, worst over the curve (to {:.0f} ms): {:.3f} at "
+                 "{:.1f} ms{} ({})\n",
+                 lastMs, worst, worstMs, extrapolated ? " (path tracing extrap.)" : "",
+                 worst <= 1.0 ? "below path tracing's at every point" : "path tracing is nearer there");
+      entry["worst_total_error_ratio_at_equal_time"] = {{"ratio", worst}, {"gpu_ms", worstMs}, {"curve_to_ms", lastMs},
+                                                        {"pathtrace_extrapolated", extrapolated}};
+    }
     // A denoised frame against the same rays undenoised at the same GPU time (its curve read there):
     // what the denoiser's time buys, in RMSE against the converged reference (noise and bias alike).
     if (m.denoise) {
@@ -288,6 +316,10 @@ void addConvergeCommand(CLI::App& app) {
   cmd->add_option("--max-spp", o->obscuranceMaxSpp, "largest obscurance sample count (powers of 2 up to it)")
       ->check(CLI::Range(8u, 4096u));
   cmd->add_option("--pt-max-spp", o->pathMaxSpp, "largest path-tracing sample count")->check(CLI::Range(1u, 1u << 20));
+  cmd->add_option("--correction-max-paths", o->correctionMaxPaths,
+                  "the corrected method's curve (obscurance-corrected: the defaults' 8 spp and N paths per pixel, "
+                  "render --pt-correction N): N in powers of 2 up to this")
+      ->check(CLI::Range(1u, 4096u));
   cmd->add_option("--reference-factor", o->referenceFactor, "reference spp = factor x largest curve spp (>= 64 per SPEC)")
       ->check(CLI::Range(1u, 4096u));
   cmd->add_option("--pt-reference-spp", o->pathReferenceSpp, "path-tracing reference spp (default: factor x --pt-max-spp)");

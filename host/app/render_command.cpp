@@ -67,10 +67,13 @@ void writeOutputs(const RenderOptions& o, const io::Image& image, const render::
   io::Image selected = render::selectAovs(image, o.aovs);
   if (io::extensionOf(o.output) == "exr") {
     io::writeExr(o.output, selected);
-  } else if (display && (o.aovs.empty() || o.aovs.front() == "combined" || o.aovs.front() == "denoised")) {
+  } else if (display && !display->empty() &&
+             (o.aovs.empty() || o.aovs.front() == "combined" || o.aovs.front() == "denoised")) {
     io::writePngRgba8(o.output, image.width, image.height, *display);
   } else {
+    // A corrected frame (--pt-correction) shows its corrected layer where combined is asked for.
     std::string first = o.aovs.empty() ? "combined" : o.aovs.front();
+    if (first == "combined" && image.channelIndex("corrected.R") >= 0) first = "corrected";
     const auto channels = render::aovChannels(first);
     io::writePng(o.output, image, image.channelIndex(channels.front()), o.exposure,
                  static_cast<int>(channels.size()));

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "render/aovs.h"
+#include "render/correction/path_correction.h"
 #include "render/denoise/denoiser.h"
 #include "render/path_tracer.h"
 
@@ -17,11 +18,19 @@ void checkFrameOptions(const RenderOptions& o) {
                      "ambient terms divided by the albedo, which path tracing does not keep; use --method obscurance");
   static const std::vector<std::string> pathAovs = {"combined"};
   std::vector<std::string> known = o.method == render::Method::PathTrace ? pathAovs : render::obscuranceAovNames();
+  if (o.pathCorrection > 0 && o.method == render::Method::PathTrace)
+    throw InputError("--pt-correction with --method pathtrace: the paths correct the obscurance frame; use --method "
+                     "obscurance");
+  if (o.pathCorrection > 0 && o.denoise)
+    throw InputError("--pt-correction with --denoise: the correction's filter already takes the paths' noise; use one");
   if (o.denoise) known.push_back("denoised");
+  if (o.pathCorrection > 0) known.push_back("corrected");
   for (const auto& aov : o.aovs)
     if (std::find(known.begin(), known.end(), aov) == known.end())
       throw InputError(fmt::format("--aov {}: unknown AOV (known: {}){}", aov, fmt::join(known, ", "),
-                                   aov == "denoised" ? "; it needs --denoise" : ""));
+                                   aov == "denoised"    ? "; it needs --denoise"
+                                   : aov == "corrected" ? "; it needs --pt-correction"
+                                                        : ""));
   checkRenderOptions(o);
 }
 
@@ -74,6 +83,13 @@ void addFrameOptions(CLI::App& cmd, RenderOptions& o) {
                "denoise the obscurance frame (render/denoise/: demodulated direct and ambient terms, edge-aware "
                "a-trous filter; at 1 spp, the pixels an edge crosses resolved from camera rays of their own): the PNG "
                "of combined shows it, the EXR gets a `denoised` layer");
+  cmd.add_option("--pt-correction", o.pathCorrection,
+                 "N: trace N paths per pixel too and correct the obscurance frame by their difference to it, "
+                 "filtered along surfaces (render/correction/): the ambient model's bias goes, the direct light, "
+                 "contact shadows and textures stay the obscurances'; with more paths the filter narrows and the "
+                 "frame converges to path tracing's. The PNG of combined shows it, the EXR gets a `corrected` "
+                 "layer (not relightable: the paths have no per-light transport). Default 0: none")
+      ->check(CLI::Range(0u, 1u << 20));
 }
 
 RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh::Bvh& bvh, const gpu::Context& context,
@@ -93,7 +109,7 @@ RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh
   const std::vector<std::string> wanted =
       o.aovs.empty() ? (outputs.allAovs ? render::obscuranceAovNames() : std::vector<std::string>{"combined"}) : o.aovs;
   // The denoiser's guides and terms are the primary and composed AOVs.
-  const bool keepAll = o.denoise;
+  const bool keepAll = o.denoise || o.pathCorrection > 0;
   const auto& primaryNames = render::aovNames();
   settings.primaryAovs = keepAll || std::any_of(wanted.begin(), wanted.end(), [&](const std::string& a) {
     return a != "emission" && std::find(primaryNames.begin(), primaryNames.end(), a) != primaryNames.end();
@@ -126,6 +142,30 @@ RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh
     std::string passes;
     for (const auto& [name, ms] : denoiser.lastPassMs()) passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", name, ms);
     frame.summary += fmt::format("denoise: {:.1f} ms GPU ({})\n", denoiser.lastGpuMs(), passes);
+  }
+  nlohmann::json correctionJson = nullptr;
+  if (o.pathCorrection > 0) {
+    // The paths with the path tracer's own seed stream (another seed than the obscurance frame's).
+    render::PathTraceSettings pt = pathTraceSettings(settings);
+    pt.spp = o.pathCorrection;
+    pt.seed = settings.seed + 0x9e3779b9u;
+    render::PathTracer paths(context, scene, bvh, pt);
+    paths.render();
+    render::PathCorrection correction(context, renderer, paths);
+    correction.correct(renderer, paths);
+    io::Image corrected = correction.image();
+    corrected.channels = render::aovChannels("corrected");
+    appendChannels(frame.image, corrected);
+    frame.display.clear(); // the PNG tonemaps the corrected layer (render_command.cpp)
+    for (const auto& [name, pass] : paths.stats().passes) frame.stats.passes["correction." + name] = pass;
+    for (const auto& [name, ms] : correction.lastPassMs()) frame.stats.passes["correction." + name] = {.gpuMs = ms};
+    frame.stats.truncatedTraversals += paths.stats().truncatedTraversals;
+    correctionJson = {{"paths", o.pathCorrection}, {"filter_iterations", correction.lastIterations()},
+                      {"gpu_ms", correction.lastGpuMs()}, {"paths_gpu_ms", paths.stats().passes.at("pathtrace").gpuMs}};
+    frame.summary += fmt::format("path-traced correction: {} paths per pixel in {:.1f} ms GPU, filter {} iterations "
+                                 "in {:.1f} ms\n",
+                                 o.pathCorrection, paths.stats().passes.at("pathtrace").gpuMs,
+                                 correction.lastIterations(), correction.lastGpuMs());
   }
   const glm::vec3 ia = renderer.ambientIntensity(), rAve = renderer.ambient().averageReflectance;
   const glm::vec3 iaGlobal = renderer.ambient().globalIntensity(renderer.emissions());
@@ -164,7 +204,7 @@ RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh
                   {"emission_samples", settings.emissionSamples}, {"emission_at_edges", settings.emissionAtEdges},
                   {"r_ave", {rAve.x, rAve.y, rAve.z}},
                   {"ambient_intensity", {ia.x, ia.y, ia.z}}, {"lights", renderer.lights().names},
-                  {"bands", renderer.layout().bandCount()}, {"denoise", denoiseJson}};
+                  {"bands", renderer.layout().bandCount()}, {"denoise", denoiseJson}, {"path_correction", correctionJson}};
   return frame;
 }
 

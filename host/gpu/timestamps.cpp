@@ -46,4 +46,22 @@ void Timestamps::collect() {
   labels_.clear();
 }
 
+std::map<std::string, double> Timestamps::msSince(const std::map<std::string, double>& before,
+                                                 const std::string& prefix) const {
+  std::map<std::string, double> added;
+  for (const auto& [label, ms] : totalsMs_) {
+    if (label.compare(0, prefix.size(), prefix) != 0) continue;
+    const auto it = before.find(label);
+    const double delta = ms - (it == before.end() ? 0.0 : it->second);
+    if (delta > 0.0) added[label.substr(prefix.size())] = delta;
+  }
+  return added;
+}
+
+double sumMs(const std::map<std::string, double>& ms) {
+  double total = 0.0;
+  for (const auto& [label, value] : ms) total += value;
+  return total;
+}
+
 } // namespace obscura::gpu

@@ -33,6 +33,9 @@ public:
   void collect();
   // Milliseconds per label, summed over everything collected so far.
   const std::map<std::string, double>& totalsMs() const { return totalsMs_; }
+  // What each label starting with `prefix` added since `before` (an earlier totalsMs()), the
+  // prefix taken off its name: one submission's passes. Labels that added nothing are left out.
+  std::map<std::string, double> msSince(const std::map<std::string, double>& before, const std::string& prefix) const;
   bool available() const { return available_; }
 
 private:
@@ -43,5 +46,8 @@ private:
   std::vector<std::string> labels_; // label of query pair i
   std::map<std::string, double> totalsMs_;
 };
+
+// The sum of a map of milliseconds (msSince's).
+double sumMs(const std::map<std::string, double>& ms);
 
 } // namespace obscura::gpu

@@ -77,6 +77,10 @@ public:
   std::uint64_t nonFiniteSamples() const;
   RenderStats stats() const;
   std::uint32_t samples() const { return samples_; }
+  // The frame's bands and each band's radiance sums on the device (vec4 accumulator pairs per
+  // pixel: rgb, w = dropped samples), for passes that read the paths (render/correction/).
+  const FrameLayout& layout() const { return layout_; }
+  const gpu::Buffer& radiance(std::uint32_t band) const { return radiance_.at(band); }
 
 private:
   const gpu::Context* context_;

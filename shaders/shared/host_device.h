@@ -844,6 +844,39 @@ struct DenoiseEdgesPush {
   uint unused0, unused1, unused2;
 };                        // 32 bytes
 
+// ---- The path-traced correction (host/render/correction/, shaders/correction_*.comp): the
+// obscurance frame plus its difference to a path-traced frame of the same view, that difference
+// divided by the albedo and filtered along surfaces (a-trous steps over the guide of
+// lib/denoise.glsl), so the frame converges to path tracing's as the paths grow. Whole-frame
+// buffers; binding 0 of both passes is a DenoiseParams (camera, frame size, sigma plane).
+struct CorrectionPush {
+  uint firstRow;      // residual: the band's rows and the composed slots per pixel
+  uint rows;
+  uint composedSlots;
+  uint pathSamples;   // residual: the paths the path tracer's sums hold
+  uint step;          // filter: the a-trous step (2^iteration); 0: the residual as it is
+  uint lastStep;      // filter: 1 on the last step, which also writes the corrected image
+  uint unused0, unused1;
+};                    // 32 bytes
+OBS_CONST uint kBindingCorrectionParams = 0;
+// correction_residual.comp (per band of the obscurance frame and the path tracer's, which match)
+OBS_CONST uint kBindingResidualComposed = 1;     // vec4[pixel * slots] (compose.comp)
+OBS_CONST uint kBindingResidualAovs = 2;         // vec4 pairs [pixel * kAovSlots + slot] (primary.comp)
+OBS_CONST uint kBindingResidualSampleCounts = 3; // uint[pixel]
+OBS_CONST uint kBindingResidualPaths = 4;        // vec4 pairs [pixel]: the path tracer's radiance sums
+OBS_CONST uint kBindingResidualGuide = 5;        // uvec4[frame pixel] out: guide
+OBS_CONST uint kBindingResidualBase = 6;         // vec4[frame pixel] out: the obscurance frame's combined
+OBS_CONST uint kBindingResidualOut = 7;          // vec4[frame pixel] out: (paths - base) / albedo, w = 1
+                                                 // where filtered, 0 where kept (no hit, seen emission)
+OBS_CONST uint kResidualBindingCount = 8;
+// correction_filter.comp: one a-trous step of the residual
+OBS_CONST uint kBindingCorrectionGuide = 1;  // uvec4[pixel]
+OBS_CONST uint kBindingCorrectionBase = 2;   // vec4[pixel]
+OBS_CONST uint kBindingCorrectionIn = 3;     // vec4[pixel]: residual
+OBS_CONST uint kBindingCorrectionOut = 4;    // vec4[pixel] out: residual filtered
+OBS_CONST uint kBindingCorrectionImage = 5;  // vec4[pixel] out (last step): base + residual x albedo
+OBS_CONST uint kCorrectionBindingCount = 6;
+
 // ---- Accumulators (shaders/lib/accumulate.glsl): every summed vec4 is a PAIR of vec4 (the sum,
 // then its Kahan compensation), so accumulation buffers hold kAccumulatorVec4s vec4 per entry.
 OBS_CONST uint kAccumulatorVec4s = 2;

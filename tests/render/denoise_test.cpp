@@ -45,16 +45,6 @@ render::ObscuranceSettings settingsFor(const scene::Scene& scene, std::uint32_t 
   return s;
 }
 
-// Three channels of an image from `first` on (named combined.R/G/B, what imageError compares).
-io::Image channelsOf(const io::Image& all, const std::string& first = "combined.R") {
-  io::Image out{.width = all.width, .height = all.height, .channels = {"combined.R", "combined.G", "combined.B"}, .pixels = {}};
-  const int c = all.channelIndex(first);
-  for (int y = 0; y < all.height; ++y)
-    for (int x = 0; x < all.width; ++x)
-      for (int k = 0; k < 3; ++k) out.pixels.push_back(all.at(x, y, c + k));
-  return out;
-}
-
 // `image` with the pixels where `mask` is true set to `reference`'s: they are left out of the error.
 io::Image withPixelsOf(io::Image image, const io::Image& reference, const std::vector<bool>& mask) {
   for (std::size_t p = 0; p < mask.size(); ++p)

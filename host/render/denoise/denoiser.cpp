@@ -157,12 +157,7 @@ void Denoiser::denoise(const ObscuranceRenderer& renderer, float exposureStops) 
     d.timestamps.end(cmd, "denoise.tonemap");
   });
   d.timestamps.collect();
-  d.lastMs.clear();
-  for (const auto& [label, ms] : d.timestamps.totalsMs()) {
-    const auto it = before.find(label);
-    const double delta = ms - (it == before.end() ? 0.0 : it->second);
-    if (delta > 0.0) d.lastMs[label.substr(std::string("denoise.").size())] = delta;
-  }
+  d.lastMs = d.timestamps.msSince(before, "denoise.");
   // The carry stays while the camera does: the renderer's accumulation goes on with the same view.
   if (clearCarry && settings_.temporal) d.carryStale = false;
   d.previousCamera = camera;
@@ -206,11 +201,7 @@ io::Image Denoiser::reprojectedHistory() const {
   return image;
 }
 
-double Denoiser::lastGpuMs() const {
-  double total = 0.0;
-  for (const auto& [label, ms] : impl_->lastMs) total += ms;
-  return total;
-}
+double Denoiser::lastGpuMs() const { return gpu::sumMs(impl_->lastMs); }
 
 std::map<std::string, double> Denoiser::lastPassMs() const { return impl_->lastMs; }
 
