@@ -28,10 +28,15 @@ std::string emissionName(std::uint32_t samples, bool atEdges) {
 const render::ObscuranceSettings kDefaults;
 
 const std::vector<StudyMethod> kMethods = {
-    // What `obscura render` does: its light sampling and its split of the paper's ten rays per hit.
+    // What `obscura render` does: its light sampling, its split of the paper's ten rays per hit, and
+    // past the paper's 8 spp the paths that correct the frame (--pt-correction auto).
     {"obscurance", false, render::LightSampling::Spatial, kDefaults.shadowRays, kPaperSpp,
-     "the defaults: spatial light sampling, 8 shadow + 2 obscurance rays per hit, 8 spp", 0.0f, false,
-     kDefaults.obscuranceRays},
+     "the defaults: spatial light sampling, 8 shadow + 2 obscurance rays per hit, 8 spp; past 8 spp corrected by "
+     "spp - 8 paths (at least 4)",
+     0.0f, false, kDefaults.obscuranceRays, 0, true, true},
+    // The same without the paths (--pt-correction 0): the obscurances alone, down to their bias.
+    {"obscurance-uncorrected", false, render::LightSampling::Spatial, kDefaults.shadowRays, kPaperSpp,
+     "as obscurance, never corrected by paths (--pt-correction 0)", 0.0f, false, kDefaults.obscuranceRays},
     // The paper's budget as the paper splits it, and with the paper's light sampling too.
     {"obscurance-5+5", false, render::LightSampling::Spatial, render::kPaperShadowRays, kPaperSpp,
      "spatial light sampling, 5 + 5 rays per hit, 8 spp (the paper's budget)", 0.0f, false,
@@ -49,15 +54,14 @@ const std::vector<StudyMethod> kMethods = {
      "as obscurance, 1 spp, denoised (a-trous on demodulated terms)", 0.0f, true, kDefaults.obscuranceRays},
     {"obscurance-realtime-denoised", false, render::LightSampling::Spatial, 1, 1,
      "spatial, 1+1 rays per hit, denoised, 1 spp", 0.0f, true},
-    // The defaults' frame corrected by paths (render --pt-correction N): the curve's spp is N; it
-    // converges to path tracing's image, so its noise is measured against path tracing's reference.
-    {"obscurance-corrected", false, render::LightSampling::Spatial, kDefaults.shadowRays, 16,
-     "the defaults (8 spp) corrected by N paths per pixel filtered along surfaces (render --pt-correction N)", 0.0f,
-     false, kDefaults.obscuranceRays, 0, true, kPaperSpp},
     {"pathtrace", true, render::LightSampling::Spatial, 0, 1, "path tracing, NEE with spatial light sampling + MIS"},
 };
 
 } // namespace
+
+std::uint32_t StudyMethod::correctionPaths(std::uint32_t spp) const {
+  return defaultCorrection ? render::PathCorrection::defaultPaths(spp) : 0u;
+}
 
 // The methods a study runs: kMethods, and with --secondary-reflectors the best obscurance method
 // with them too (before path tracing, which stays last).
@@ -65,6 +69,7 @@ std::vector<StudyMethod> studyMethods(const StudySettings& o) {
   std::vector<StudyMethod> methods = kMethods;
   if (o.secondaryReflectors > 0.0f) {
     StudyMethod m = methods.front();
+    m.defaultCorrection = false; // its bias floor is what it is for
     m.name = "obscurance-reflectors";
     m.what = fmt::format("as obscurance, with secondary reflectors marked at {:g} x mean direct irradiance",
                          o.secondaryReflectors);
@@ -73,6 +78,7 @@ std::vector<StudyMethod> studyMethods(const StudySettings& o) {
   }
   if (o.emissionSamples > 1) { // what the emission rays change, in the same run (default: at the edges)
     StudyMethod m = methods.front();
+    m.defaultCorrection = false;
     m.name = "obscurance-primary-emission";
     m.what = "as obscurance, the seen emission from the primary rays alone (--emission-samples 1)";
     m.emissionSamples = 1;
@@ -116,7 +122,7 @@ StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, st
     s.editableGeometry = false;
     s.width = width_;
     s.height = height_;
-    s.spp = m.correctedSpp ? m.correctedSpp : spp;
+    s.spp = spp;
     s.emissionSamples = m.emissionSamples ? m.emissionSamples : o_.emissionSamples;
     s.emissionAtEdges = m.emissionSamples ? false : o_.emissionAtEdges;
     s.seed = seed;
@@ -142,9 +148,9 @@ StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, st
       r.image = denoiser_->image();
       r.gpuMs += denoiser_->lastGpuMs();
     }
-    if (m.correctedSpp) {
+    if (const std::uint32_t paths = m.correctionPaths(spp); paths > 0) {
       // The paths with a seed stream of their own; their time and rays count with the frame's.
-      const render::PathTraceSettings ps = pathSettings(m, spp, seed + 0x9e3779b9u);
+      const render::PathTraceSettings ps = pathSettings(m, paths, seed + 0x9e3779b9u);
       if (!pathTracer_) pathTracer_ = std::make_unique<render::PathTracer>(context_, scene_, bvh_, ps);
       pathTracer_->configure(ps);
       pathTracer_->render();
@@ -152,9 +158,9 @@ StudyRender ConvergenceStudy::render(const StudyMethod& m, std::uint32_t spp, st
       correction_->correct(*obscurance_, *pathTracer_);
       r.image = correction_->image();
       r.gpuMs += correction_->lastGpuMs();
-      const render::RenderStats paths = pathTracer_->stats();
-      for (const auto& [name, pass] : paths.passes) statsCopy_.passes["correction." + name] = pass;
-      statsCopy_.truncatedTraversals += paths.truncatedTraversals;
+      const render::RenderStats pathStats = pathTracer_->stats();
+      for (const auto& [name, pass] : pathStats.passes) statsCopy_.passes["correction." + name] = pass;
+      statsCopy_.truncatedTraversals += pathStats.truncatedTraversals;
     }
   }
   stats = &statsCopy_;
@@ -241,9 +247,12 @@ io::Image ConvergenceStudy::reference(const StudyMethod& m) {
     std::map<std::string, io::Image> other; // model -> image
     double gpuMs = 0.0;
   };
+  // An obscurance method's reference is the obscurances' own converged image: no paths correct it.
+  StudyMethod uncorrected = m;
+  uncorrected.defaultCorrection = false;
   auto renderHalf = [&](std::uint32_t seed) {
     Half h;
-    StudyRender r = render(m, std::max(1u, spp / 2), seed);
+    StudyRender r = render(uncorrected, std::max(1u, spp / 2), seed);
     h.seen = combinedOnly(r.image);
     h.gpuMs = r.gpuMs;
     if (!m.pathTrace) {

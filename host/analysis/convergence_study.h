@@ -34,9 +34,8 @@ struct StudySettings {
   std::string scenePath;
   std::string outputDir;
   std::uint32_t width = 256; // per-pixel noise as a user sees it
-  std::uint32_t obscuranceMaxSpp = 16;
+  std::uint32_t obscuranceMaxSpp = 32; // past the paper's 8, the defaults' points are corrected by paths
   std::uint32_t pathMaxSpp = 256;
-  std::uint32_t correctionMaxPaths = 32; // the corrected method's curve: paths per pixel up to this
   std::uint32_t referenceFactor = 64;   // a reference has this many times the largest curve's spp
   std::uint32_t pathReferenceSpp = 0;   // 0: referenceFactor x pathMaxSpp
   // A merged farm render (`obscura merge`'s EXR of --method pathtrace parts) to take as the path
@@ -71,9 +70,11 @@ struct StudyMethod {
   std::uint32_t obscuranceRays = 0; // obscurance rays per hit; 0: raysPerHit
   std::uint32_t emissionSamples = 0; // camera rays per sample for the seen emission; 0: the study's
   bool vertexRaysByThroughput = true; // specular path vertices: rays scaled by throughput, or N per hit
-  // > 0: the obscurance frame at this many spp corrected by paths (render --pt-correction): the
-  // curve's spp is the paths per pixel, and the method converges to path tracing's image.
-  std::uint32_t correctedSpp = 0;
+  // Corrected by paths past the paper's budget as `render` is by default (--pt-correction auto,
+  // PathCorrection::defaultPaths): those points converge to path tracing's image.
+  bool defaultCorrection = false;
+  // The paths a frame of `spp` samples of this method is corrected by (0: none).
+  std::uint32_t correctionPaths(std::uint32_t spp) const;
 };
 
 using render::kPaperSpp;

@@ -85,21 +85,21 @@ void runConverge(const ConvergeOptions& o) {
   std::map<std::string, io::Image> reflectorReferences;
   for (const analysis::StudyMethod& m : methods)
     if (m.secondaryReflectors > 0.0f) reflectorReferences[m.name] = study.reference(m);
-  // The corrected method converges to path tracing's image: its noise is measured against that.
-  auto noiseReference = [&](const analysis::StudyMethod& m) -> const io::Image& {
-    if (m.pathTrace || m.correctedSpp) return ptReference;
+  // A frame corrected by paths converges to path tracing's image: its noise is measured against that.
+  auto noiseReference = [&](const analysis::StudyMethod& m, std::uint32_t spp) -> const io::Image& {
+    if (m.pathTrace || m.correctionPaths(spp) > 0) return ptReference;
     return m.secondaryReflectors > 0.0f ? reflectorReferences.at(m.name) : obscuranceReference;
   };
   // How converged each reference is (the difference of its two halves): noise measured against it
   // cannot fall below that.
-  auto noiseFloor = [&](const analysis::StudyMethod& m) {
-    return study.referenceNoise(m.pathTrace || m.correctedSpp ? pathMethod.name
+  auto noiseFloor = [&](const analysis::StudyMethod& m, std::uint32_t spp) {
+    return study.referenceNoise(m.pathTrace || m.correctionPaths(spp) > 0 ? pathMethod.name
                                 : m.secondaryReflectors > 0.0f ? m.name
                                                                : best.name);
   };
   nlohmann::json referenceNoiseJson = nlohmann::json::object();
   for (const analysis::StudyMethod* m : {&best, &pathMethod}) {
-    const analysis::ImageError* own = noiseFloor(*m);
+    const analysis::ImageError* own = noiseFloor(*m, 1);
     if (!own) {
       fmt::print("reference {}: its own noise is not known (a single image); speed-ups are read without a floor\n",
                  m->name);
@@ -120,11 +120,11 @@ void runConverge(const ConvergeOptions& o) {
          "rmse_vs_pathtrace,relmse_vs_pathtrace,mae_vs_pathtrace,rmse_trimmed_vs_pathtrace,noise_at_reference_floor\n";
   for (const auto& m : methods) {
     analysis::Curve curve{.method = m.name, .points = {}};
-    std::uint32_t maxSpp = m.pathTrace ? o.pathMaxSpp : m.correctedSpp ? o.correctionMaxPaths : o.obscuranceMaxSpp;
+    std::uint32_t maxSpp = m.pathTrace ? o.pathMaxSpp : o.obscuranceMaxSpp;
     for (std::uint32_t spp = 1; spp <= maxSpp; spp *= 2) {
       analysis::StudyRender r = study.render(m, spp, o.seed + spp);
       analysis::CurvePoint p{.spp = spp, .raysPerPixel = r.rays, .gpuMs = r.gpuMs,
-                           .noise = analysis::imageError(r.image, noiseReference(m)),
+                           .noise = analysis::imageError(r.image, noiseReference(m, spp)),
                            .total = analysis::imageError(r.image, ptReference)};
       if (spp == m.budgetSpp) atBudget[m.name] = r.image;
       curve.points.push_back(p);
@@ -132,7 +132,8 @@ void runConverge(const ConvergeOptions& o) {
       std::string atFloor;
       for (const auto& [key, metric] : {std::pair{"rmse", analysis::Metric::Rmse},
                                         std::pair{"trimmed", analysis::Metric::RmseTrimmed}, std::pair{"mae", analysis::Metric::Mae}})
-        if (analysis::errorOf(p, analysis::ErrorKind::Noise, metric) < kReferenceFloorFactor * floorOf(noiseFloor(m), metric))
+        if (analysis::errorOf(p, analysis::ErrorKind::Noise, metric) <
+            kReferenceFloorFactor * floorOf(noiseFloor(m, spp), metric))
           atFloor += atFloor.empty() ? key : std::string("+") + key;
       csv << fmt::format("{},{},{:.2f},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", m.name, spp,
                          p.raysPerPixel, p.gpuMs, p.noise.rmse, p.noise.relMse, p.noise.mae, p.noise.rmseTrimmed,
@@ -201,7 +202,7 @@ void runConverge(const ConvergeOptions& o) {
     for (const auto& [key, metric] : metrics) {
       const double noise = analysis::errorOf(*point, analysis::ErrorKind::Noise, metric);
       const double total = analysis::errorOf(*point, analysis::ErrorKind::AgainstReference, metric);
-      const double floor = floorOf(noiseFloor(m), metric), ptFloor = floorOf(noiseFloor(pathMethod), metric);
+      const double floor = floorOf(noiseFloor(m, point->spp), metric), ptFloor = floorOf(noiseFloor(pathMethod, 1), metric);
       if (noise < kReferenceFloorFactor * floor) {
         // A flat curve is named, not read: the reference is not converged enough to tell.
         fmt::print("  {:13s} noise {:.5f} is within {:g}x of its reference's own noise {:.5f}: no speed-up is read "
@@ -313,13 +314,10 @@ void addConvergeCommand(CLI::App& app) {
   cmd->add_option("scene", o->scenePath, "glTF 2.0 scene")->required();
   cmd->add_option("-o,--output", o->outputDir, "folder for references, CSV, plot and summary")->required();
   cmd->add_option("--width", o->width, "image width (height from the camera's aspect)")->check(CLI::Range(8u, 4096u));
-  cmd->add_option("--max-spp", o->obscuranceMaxSpp, "largest obscurance sample count (powers of 2 up to it)")
+  cmd->add_option("--max-spp", o->obscuranceMaxSpp, "largest obscurance sample count (powers of 2 up to it; default 32: past 8 spp the defaults' "
+                  "frames are corrected by paths, as render's, and reach past a second of GPU time)")
       ->check(CLI::Range(8u, 4096u));
   cmd->add_option("--pt-max-spp", o->pathMaxSpp, "largest path-tracing sample count")->check(CLI::Range(1u, 1u << 20));
-  cmd->add_option("--correction-max-paths", o->correctionMaxPaths,
-                  "the corrected method's curve (obscurance-corrected: the defaults' 8 spp and N paths per pixel, "
-                  "render --pt-correction N): N in powers of 2 up to this")
-      ->check(CLI::Range(1u, 4096u));
   cmd->add_option("--reference-factor", o->referenceFactor, "reference spp = factor x largest curve spp (>= 64 per SPEC)")
       ->check(CLI::Range(1u, 4096u));
   cmd->add_option("--pt-reference-spp", o->pathReferenceSpp, "path-tracing reference spp (default: factor x --pt-max-spp)");

@@ -1,6 +1,7 @@
 #include "app/render_frame.h"
 
 #include <algorithm>
+#include <charconv>
 
 #include <fmt/format.h>
 
@@ -12,24 +13,37 @@
 
 namespace obscura::app {
 
+std::uint32_t correctionPaths(const RenderOptions& o) {
+  if (o.pathCorrection == "auto")
+    return o.method == render::Method::PathTrace || o.denoise ? 0u : render::PathCorrection::defaultPaths(o.spp);
+  std::uint32_t paths = 0;
+  const char* end = o.pathCorrection.data() + o.pathCorrection.size();
+  const auto [last, ec] = std::from_chars(o.pathCorrection.data(), end, paths);
+  if (ec != std::errc() || last != end || paths > (1u << 20))
+    throw InputError(fmt::format("--pt-correction {}: expected auto or a number of paths per pixel (0 to {})",
+                                 o.pathCorrection, 1u << 20));
+  if (paths > 0 && o.method == render::Method::PathTrace)
+    throw InputError("--pt-correction with --method pathtrace: the paths correct the obscurance frame; use --method "
+                     "obscurance");
+  if (paths > 0 && o.denoise)
+    throw InputError("--pt-correction with --denoise: the correction's filter already takes the paths' noise; use one");
+  return paths;
+}
+
 void checkFrameOptions(const RenderOptions& o) {
   if (o.denoise && o.method == render::Method::PathTrace)
     throw InputError("--denoise with --method pathtrace: the denoiser filters the obscurance method's direct and "
                      "ambient terms divided by the albedo, which path tracing does not keep; use --method obscurance");
   static const std::vector<std::string> pathAovs = {"combined"};
   std::vector<std::string> known = o.method == render::Method::PathTrace ? pathAovs : render::obscuranceAovNames();
-  if (o.pathCorrection > 0 && o.method == render::Method::PathTrace)
-    throw InputError("--pt-correction with --method pathtrace: the paths correct the obscurance frame; use --method "
-                     "obscurance");
-  if (o.pathCorrection > 0 && o.denoise)
-    throw InputError("--pt-correction with --denoise: the correction's filter already takes the paths' noise; use one");
+  const std::uint32_t paths = correctionPaths(o);
   if (o.denoise) known.push_back("denoised");
-  if (o.pathCorrection > 0) known.push_back("corrected");
+  if (paths > 0) known.push_back("corrected");
   for (const auto& aov : o.aovs)
     if (std::find(known.begin(), known.end(), aov) == known.end())
       throw InputError(fmt::format("--aov {}: unknown AOV (known: {}){}", aov, fmt::join(known, ", "),
                                    aov == "denoised"    ? "; it needs --denoise"
-                                   : aov == "corrected" ? "; it needs --pt-correction"
+                                   : aov == "corrected" ? "; it needs --pt-correction N (or more than 8 --spp)"
                                                         : ""));
   checkRenderOptions(o);
 }
@@ -84,12 +98,17 @@ void addFrameOptions(CLI::App& cmd, RenderOptions& o) {
                "a-trous filter; at 1 spp, the pixels an edge crosses resolved from camera rays of their own): the PNG "
                "of combined shows it, the EXR gets a `denoised` layer");
   cmd.add_option("--pt-correction", o.pathCorrection,
-                 "N: trace N paths per pixel too and correct the obscurance frame by their difference to it, "
+                 "auto|N: trace N paths per pixel too and correct the obscurance frame by their difference to it, "
                  "filtered along surfaces (render/correction/): the ambient model's bias goes, the direct light, "
                  "contact shadows and textures stay the obscurances'; with more paths the filter narrows and the "
                  "frame converges to path tracing's. The PNG of combined shows it, the EXR gets a `corrected` "
-                 "layer (not relightable: the paths have no per-light transport). Default 0: none")
-      ->check(CLI::Range(0u, 1u << 20));
+                 "layer (not relightable: the paths have no per-light transport). auto (default): none up to the "
+                 "paper's budget of 8 spp, past it one path for each further sample, at least 4 (--spp 16: 8 "
+                 "paths), so a longer render keeps approaching path tracing's image instead of stopping at the "
+                 "obscurances' bias; never with --denoise or in a farm's part (--samples, --tile: merged parts "
+                 "are the obscurances' sums). The window does not correct its frames: they follow a moving "
+                 "camera at one sample each. 0: none")
+      ->default_str("auto");
 }
 
 RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh::Bvh& bvh, const gpu::Context& context,
@@ -109,7 +128,12 @@ RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh
   const std::vector<std::string> wanted =
       o.aovs.empty() ? (outputs.allAovs ? render::obscuranceAovNames() : std::vector<std::string>{"combined"}) : o.aovs;
   // The denoiser's guides and terms are the primary and composed AOVs.
-  const bool keepAll = o.denoise || o.pathCorrection > 0;
+  // The paths correct combined: none where the output shows no combined image.
+  const bool showsCombined = std::any_of(wanted.begin(), wanted.end(), [](const std::string& a) {
+    return a == "combined" || a == "corrected";
+  });
+  const std::uint32_t pathsWanted = showsCombined ? correctionPaths(o) : 0u;
+  const bool keepAll = o.denoise || pathsWanted > 0;
   const auto& primaryNames = render::aovNames();
   settings.primaryAovs = keepAll || std::any_of(wanted.begin(), wanted.end(), [&](const std::string& a) {
     return a != "emission" && std::find(primaryNames.begin(), primaryNames.end(), a) != primaryNames.end();
@@ -144,10 +168,10 @@ RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh
     frame.summary += fmt::format("denoise: {:.1f} ms GPU ({})\n", denoiser.lastGpuMs(), passes);
   }
   nlohmann::json correctionJson = nullptr;
-  if (o.pathCorrection > 0) {
+  if (pathsWanted > 0) {
     // The paths with the path tracer's own seed stream (another seed than the obscurance frame's).
     render::PathTraceSettings pt = pathTraceSettings(settings);
-    pt.spp = o.pathCorrection;
+    pt.spp = pathsWanted;
     pt.seed = settings.seed + 0x9e3779b9u;
     render::PathTracer paths(context, scene, bvh, pt);
     paths.render();
@@ -160,11 +184,11 @@ RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh
     for (const auto& [name, pass] : paths.stats().passes) frame.stats.passes["correction." + name] = pass;
     for (const auto& [name, ms] : correction.lastPassMs()) frame.stats.passes["correction." + name] = {.gpuMs = ms};
     frame.stats.truncatedTraversals += paths.stats().truncatedTraversals;
-    correctionJson = {{"paths", o.pathCorrection}, {"filter_iterations", correction.lastIterations()},
+    correctionJson = {{"paths", pathsWanted}, {"filter_iterations", correction.lastIterations()},
                       {"gpu_ms", correction.lastGpuMs()}, {"paths_gpu_ms", paths.stats().passes.at("pathtrace").gpuMs}};
     frame.summary += fmt::format("path-traced correction: {} paths per pixel in {:.1f} ms GPU, filter {} iterations "
                                  "in {:.1f} ms\n",
-                                 o.pathCorrection, paths.stats().passes.at("pathtrace").gpuMs,
+                                 pathsWanted, paths.stats().passes.at("pathtrace").gpuMs,
                                  correction.lastIterations(), correction.lastGpuMs());
   }
   const glm::vec3 ia = renderer.ambientIntensity(), rAve = renderer.ambient().averageReflectance;

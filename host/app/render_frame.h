@@ -37,6 +37,11 @@ struct FrameOutputs {
   bool allAovs = false;     // every AOV when none is named (an EXR's or an array's), else combined alone
 };
 
+// The paths --pt-correction asks for with these options: auto's count for --spp (none with path
+// tracing or the denoiser, which it does not apply to), or the number given; InputError for
+// anything else, or a count with path tracing or the denoiser.
+std::uint32_t correctionPaths(const RenderOptions& o);
+
 // InputError for options that cannot make a frame (an unknown AOV, --denoise with path tracing).
 void checkFrameOptions(const RenderOptions& o);
 

@@ -38,9 +38,9 @@ struct RenderOptions {
   std::string lightGroups = "node";
   std::vector<float> background; // R,G,B radiance of the sky; empty: none
   bool denoise = false;          // render only: the denoised combined image too (render/denoise/)
-  // render only: paths per pixel whose filtered difference corrects the frame (render/correction/);
-  // 0: none
-  std::uint32_t pathCorrection = 0;
+  // render only: paths per pixel whose filtered difference corrects the frame (render/correction/):
+  // "auto" (PathCorrection::defaultPaths of --spp) or a count, 0 for none; correctionPaths() reads it
+  std::string pathCorrection = "auto";
   // render only: a farm's part (host/farm/part.h): samples "A:B" of --spp and tile "I/T"; empty:
   // the whole frame.
   std::string partSamples, partTile;

@@ -1,6 +1,7 @@
-// `obscura render --pt-correction N`: the corrected frame as the EXR's `corrected` layer and as
-// the PNG, with the paths' and the filter's GPU time in the metrics; and what it refuses (path
-// tracing, the denoiser beside it, the `corrected` AOV without it), naming the flag, no output.
+// `obscura render --pt-correction auto|N`: the corrected frame as the EXR's `corrected` layer and
+// as the PNG, with the paths' and the filter's GPU time in the metrics; the default's paths by
+// --spp; and what it refuses (path tracing, the denoiser beside it, the `corrected` AOV without
+// it, a word it does not know), naming the flag, with no output.
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -39,6 +40,27 @@ TEST_F(CliPathCorrection, WritesTheCorrectedLayerAndPngWithItsTimings) {
   EXPECT_NE(ca, cb);
 }
 
+// The default (auto): none up to the paper's 8 spp, past it one path a further sample, at least 4;
+// none with --pt-correction 0, and none where the output shows no combined image.
+TEST_F(CliPathCorrection, TheDefaultCorrectsOnlyPastThePapersBudget) {
+  auto paths = [&](const std::string& flags) {
+    const auto r = runObscura("render " + cornellBox() + " -o " + path("d.exr") + " --width 12 " + flags + " --metrics " +
+                              path("d.json"));
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    const auto metrics = nlohmann::json::parse(std::ifstream(path("d.json")));
+    const auto& c = metrics["method"]["path_correction"];
+    const bool layer = io::readImage(path("d.exr")).channelIndex("corrected.R") >= 0;
+    EXPECT_EQ(layer, !c.is_null()) << flags;
+    return c.is_null() ? 0 : c["paths"].get<int>();
+  };
+  EXPECT_EQ(paths("--spp 8"), 0);
+  EXPECT_EQ(paths("--spp 9"), 4);
+  EXPECT_EQ(paths("--spp 16"), 8);
+  EXPECT_EQ(paths("--spp 16 --pt-correction 0"), 0);
+  EXPECT_EQ(paths("--spp 16 --aov albedo"), 0);
+  EXPECT_EQ(paths("--spp 4 --pt-correction 3"), 3);
+}
+
 TEST_F(CliPathCorrection, PathTracingAndTheDenoiserAreRefusedWithTheReason) {
   const auto pt = runObscura("render " + cornellBox() + " -o " + path("out.png") +
                              " --width 16 --spp 1 --method pathtrace --pt-correction 2");
@@ -52,6 +74,9 @@ TEST_F(CliPathCorrection, PathTracingAndTheDenoiserAreRefusedWithTheReason) {
   const auto aov = runObscura("render " + cornellBox() + " -o " + path("out.exr") + " --width 16 --spp 1 --aov corrected");
   EXPECT_EQ(aov.exitCode, 2) << aov.output;
   EXPECT_CONTAINS(aov.output, "needs --pt-correction");
+  const auto word = runObscura("render " + cornellBox() + " -o " + path("out.png") + " --width 16 --pt-correction lots");
+  EXPECT_EQ(word.exitCode, 2) << word.output;
+  EXPECT_CONTAINS(word.output, "--pt-correction lots: expected auto or a number");
   EXPECT_EQ(strayFiles(), std::vector<std::string>{});
 }
 

@@ -50,8 +50,8 @@ TEST_F(Cli, RendersTheDefaultSceneToPngAndExrWithMetrics) {
 // that takes both references from the cache. With emission rays, the same method without them too.
 TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   const std::string args = "converge " + cornellBox() + " -o " + path("study") +
-                           " --width 16 --max-spp 8 --pt-max-spp 8 --reference-factor 4 --secondary-reflectors 1"
-                           " --emission-samples 4 --pt-emission-samples 2 --correction-max-paths 16";
+                           " --width 16 --max-spp 16 --pt-max-spp 8 --reference-factor 4 --secondary-reflectors 1"
+                           " --emission-samples 4 --pt-emission-samples 2";
   auto r = runObscura(args);
   ASSERT_EQ(r.exitCode, 0) << r.output;
   for (const char* part : {"equal-noise speed-up", "bias floor", "crossover", "rmse_trimmed", "equal time",
@@ -63,18 +63,17 @@ TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   EXPECT_CONTAINS(line, "mae_noise");
   std::map<std::string, int> rows;
   while (std::getline(csv, line)) ++rows[line.substr(0, line.find(','))];
-  const std::map<std::string, int> expected = {
-      {"obscurance", 4}, {"obscurance-primary-emission", 4}, {"obscurance-paper", 4}, {"obscurance-5+5", 4},
-      {"obscurance-per-hit-vertices", 4}, {"obscurance-realtime", 4}, {"obscurance-reflectors", 4},
-      {"obscurance-denoised", 4}, {"obscurance-realtime-denoised", 4}, {"pathtrace", 4}, // 1, 2, 4, 8 spp
-      {"obscurance-corrected", 5}};                                                       // 1 ... 16 paths
+  const std::map<std::string, int> expected = { // 1 ... 16 spp; path tracing 1 ... 8
+      {"obscurance", 5}, {"obscurance-uncorrected", 5}, {"obscurance-primary-emission", 5}, {"obscurance-paper", 5},
+      {"obscurance-5+5", 5}, {"obscurance-per-hit-vertices", 5}, {"obscurance-realtime", 5},
+      {"obscurance-reflectors", 5}, {"obscurance-denoised", 5}, {"obscurance-realtime-denoised", 5}, {"pathtrace", 4}};
   EXPECT_EQ(rows, expected);
   std::ifstream json(path("study/cornell-box.convergence.json"));
   std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
   for (const char* key : {"\"obscurance-paper\"", "\"obscurance-realtime\"", "\"obscurance-reflectors\"",
                           "\"obscurance-denoised\"", "\"obscurance-realtime-denoised\"",
                           "\"bias_floor_obscurance-reflectors\"", "\"equal_noise_speedup\"",
-                          "\"mean_ratio\"", "\"crossover_ms\"", "\"rmse_trimmed\"", "\"obscurance-corrected\"",
+                          "\"mean_ratio\"", "\"crossover_ms\"", "\"rmse_trimmed\"", "\"obscurance-uncorrected\"",
                           "\"worst_total_error_ratio_at_equal_time\""})
     EXPECT_CONTAINS(text, key);
   for (const char* png : {"study/cornell-box.obscurance-budget.png", "study/cornell-box.pathtrace-equal-time.png",
@@ -98,8 +97,9 @@ TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
     if (line.back() == ',') cells.emplace_back();
     ASSERT_EQ(cells.size(), 13u) << line;
     if (cells[0] == "obscurance-reflectors") continue; // measured against a reference of its own
-    // The corrected method converges to path tracing's image, and is measured against its reference.
-    const bool againstPaths = cells[0] == "pathtrace" || cells[0] == "obscurance-corrected";
+    // The defaults' 16-spp frame is corrected by 8 paths: it converges to path tracing's image, and
+    // is measured against its reference.
+    const bool againstPaths = cells[0] == "pathtrace" || (cells[0] == "obscurance" && cells[1] == "16");
     const nlohmann::json& own = floors.at(againstPaths ? "pathtrace" : "obscurance");
     std::string expected;
     for (const auto& [key, column, measure] : {std::tuple{"rmse", 4, "rmse"}, std::tuple{"trimmed", 7, "rmse_trimmed"},
@@ -113,7 +113,7 @@ TEST_F(Cli, ConvergeReportsEveryMethodInEveryMeasure) {
   // References no more converged than the curves' last points: the budget's noise is named as the
   // reference's, no speed-up read from it.
   const auto flat = runObscura("converge " + cornellBox() + " -o " + path("flat") +
-                               " --width 16 --max-spp 8 --pt-max-spp 8 --reference-factor 1 --correction-max-paths 1");
+                               " --width 16 --max-spp 8 --pt-max-spp 8 --reference-factor 1");
   ASSERT_EQ(flat.exitCode, 0) << flat.output;
   EXPECT_CONTAINS(flat.output, "of its reference's own noise");
   EXPECT_CONTAINS(flat.output, "no speed-up is read");

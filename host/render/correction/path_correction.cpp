@@ -1,5 +1,6 @@
 #include "render/correction/path_correction.h"
 
+#include <algorithm>
 #include <bit>
 #include <stdexcept>
 
@@ -31,6 +32,10 @@ std::uint32_t PathCorrection::iterationsFor(std::uint32_t paths) {
   std::uint32_t quadruplings = 0;
   for (std::uint32_t n = paths; n >= 4; n /= 4) ++quadruplings;
   return quadruplings >= kMaxIterations ? 0u : kMaxIterations - quadruplings;
+}
+
+std::uint32_t PathCorrection::defaultPaths(std::uint32_t spp) {
+  return spp > kPaperSpp ? std::max(kMinDefaultPaths, spp - kPaperSpp) : 0u;
 }
 
 struct PathCorrection::Impl {
