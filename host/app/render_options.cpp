@@ -36,7 +36,13 @@ void addRenderOptions(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--width", o.width, "image width in pixels (default: 512 on the long side)")
       ->check(CLI::Range(1u, 16384u));
   cmd.add_option("--height", o.height, "image height in pixels")->check(CLI::Range(1u, 16384u));
-  cmd.add_option("--spp", o.spp, "primary samples per pixel")->check(CLI::Range(1u, 1u << 20));
+  const bool still = o.obscurance.ambient == render::AmbientModel::Seen; // useStillImageDefaults
+  cmd.add_option("--spp", o.spp,
+                 still ? "primary samples per pixel (past the paper's 8, the frame is corrected by paths as well: "
+                         "--pt-correction)"
+                       : "primary samples per pixel (never corrected by paths, as a still render past 8 spp is: "
+                         "these frames follow a moving camera or edits, and the paths would be traced again for each)")
+      ->check(CLI::Range(1u, 1u << 20));
   addEmissionSamplesOption(cmd, "--emission-samples", o.obscurance.emissionSamples, o.obscurance.emissionAtEdges,
                            "both methods");
   cmd.add_option("--seed", o.seed, "random seed (same seed, same image)");

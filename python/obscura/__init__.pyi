@@ -81,7 +81,7 @@ def render(
     aovs: Optional[Sequence[str]] = None,
     exposure: Optional[float] = None,
     denoise: bool = False,
-    pt_correction: Optional[int] = None,
+    pt_correction: Optional[Union[int, Literal["auto"]]] = None,
     shadow_rays: Optional[int] = None,
     obs_rays: Optional[int] = None,
     emission_samples: Optional[Union[int, Literal["auto"]]] = None,
