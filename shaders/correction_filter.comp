@@ -5,7 +5,7 @@
 //   w = [same material] max(0, n_p . n_q)^128 exp(-|n_p . (x_q - x_p)| / (sigma_z |p - q| s_p)),
 // the denoiser's normal and plane stops (denoise_atrous.comp). No luminance stop: the residual is
 // the ambient model's smooth error plus the paths' noise, and a stop on its value would keep the
-// noise. The last step also writes the corrected image, base + residual x albedo; step 0 takes
+// noise. The last step also writes the corrected image, max(base + residual x albedo, 0); step 0 takes
 // each residual as it is (enough paths that no filter is wanted).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/host_device.h"
@@ -61,5 +61,7 @@ void main() {
     r = sum / weight;
   }
   filtered[pixel] = vec4(r, c.w);
-  if (pc.lastStep != 0u) corrected[pixel] = vec4(base[pixel].rgb + (c.w > 0.0 ? r * demodulationAlbedo(g) : vec3(0.0)), 1.0);
+  // A filtered residual can ask for less than no light where the frame is dark: none is the least.
+  if (pc.lastStep != 0u)
+    corrected[pixel] = vec4(max(base[pixel].rgb + (c.w > 0.0 ? r * demodulationAlbedo(g) : vec3(0.0)), vec3(0.0)), 1.0);
 }

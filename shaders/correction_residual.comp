@@ -1,6 +1,6 @@
 #version 460
 // correction_residual.comp — what the path-traced correction filters, from one band of the
-// obscurance frame and the same band of the path tracer's (dispatched per band) into whole-frame
+// obscurance frame (dispatched per band) and the path tracer's sums (whole-frame) into whole-frame
 // buffers: the guide (as the denoiser's gather makes it: mean normal, depth and albedo, the first
 // sample's material), the obscurance frame's combined image, and the residual
 //   r = (L_paths / n - C) / max(albedo, floor),
@@ -45,7 +45,7 @@ void main() {
   const uint o = local * slots;
   const vec3 c = composed[o + kComposeCombined].rgb;
   base[pixel] = vec4(c, 0.0);
-  const vec3 path = OBS_SUM(paths, local).rgb / float(max(pc.pathSamples, 1u));
+  const vec3 path = OBS_SUM(paths, pixel).rgb / float(max(pc.pathSamples, 1u));
   const bool seesEmission = any(greaterThan(composed[o + kComposeEmission].rgb, vec3(0.0)));
   if (!guideHit(g) || seesEmission) {
     residual[pixel] = vec4(0.0);

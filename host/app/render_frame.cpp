@@ -181,15 +181,19 @@ RenderedFrame renderFrame(RenderOptions& o, const scene::Scene& scene, const bvh
     corrected.channels = render::aovChannels("corrected");
     appendChannels(frame.image, corrected);
     frame.display.clear(); // the PNG tonemaps the corrected layer (render_command.cpp)
-    for (const auto& [name, pass] : paths.stats().passes) frame.stats.passes["correction." + name] = pass;
+    const render::RenderStats pathStats = paths.stats();
+    for (const auto& [name, pass] : pathStats.passes) frame.stats.passes["correction." + name] = pass;
     for (const auto& [name, ms] : correction.lastPassMs()) frame.stats.passes["correction." + name] = {.gpuMs = ms};
-    frame.stats.truncatedTraversals += paths.stats().truncatedTraversals;
+    frame.stats.truncatedTraversals += pathStats.truncatedTraversals;
+    for (const auto& note : pathStats.notes)
+      if (std::find(frame.stats.notes.begin(), frame.stats.notes.end(), note) == frame.stats.notes.end())
+        frame.stats.notes.push_back(note);
+    const double pathMs = pathStats.passes.at("pathtrace").gpuMs;
     correctionJson = {{"paths", pathsWanted}, {"filter_iterations", correction.lastIterations()},
-                      {"gpu_ms", correction.lastGpuMs()}, {"paths_gpu_ms", paths.stats().passes.at("pathtrace").gpuMs}};
+                      {"gpu_ms", correction.lastGpuMs()}, {"paths_gpu_ms", pathMs}};
     frame.summary += fmt::format("path-traced correction: {} paths per pixel in {:.1f} ms GPU, filter {} iterations "
                                  "in {:.1f} ms\n",
-                                 pathsWanted, paths.stats().passes.at("pathtrace").gpuMs,
-                                 correction.lastIterations(), correction.lastGpuMs());
+                                 pathsWanted, pathMs, correction.lastIterations(), correction.lastGpuMs());
   }
   const glm::vec3 ia = renderer.ambientIntensity(), rAve = renderer.ambient().averageReflectance;
   const glm::vec3 iaGlobal = renderer.ambient().globalIntensity(renderer.emissions());

@@ -859,11 +859,12 @@ struct CorrectionPush {
   uint unused0, unused1;
 };                    // 32 bytes
 OBS_CONST uint kBindingCorrectionParams = 0;
-// correction_residual.comp (per band of the obscurance frame and the path tracer's, which match)
+// correction_residual.comp (per band of the obscurance frame)
 OBS_CONST uint kBindingResidualComposed = 1;     // vec4[pixel * slots] (compose.comp)
 OBS_CONST uint kBindingResidualAovs = 2;         // vec4 pairs [pixel * kAovSlots + slot] (primary.comp)
 OBS_CONST uint kBindingResidualSampleCounts = 3; // uint[pixel]
-OBS_CONST uint kBindingResidualPaths = 4;        // vec4 pairs [pixel]: the path tracer's radiance sums
+OBS_CONST uint kBindingResidualPaths = 4;        // vec4 pairs [frame pixel]: the path tracer's radiance
+                                                 // sums, its bands copied into one buffer
 OBS_CONST uint kBindingResidualGuide = 5;        // uvec4[frame pixel] out: guide
 OBS_CONST uint kBindingResidualBase = 6;         // vec4[frame pixel] out: the obscurance frame's combined
 OBS_CONST uint kBindingResidualOut = 7;          // vec4[frame pixel] out: (paths - base) / albedo, w = 1

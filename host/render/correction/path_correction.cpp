@@ -24,6 +24,8 @@ using Usage = vk::BufferUsageFlagBits;
 const auto kStorage = Usage::eStorageBuffer | Usage::eTransferSrc | Usage::eTransferDst;
 // The plane stop in pixel widths off the plane per pixel of distance: the denoiser's sigma_z.
 constexpr float kSigmaPlane = 1.0f;
+// A pixel's radiance sum in the path tracer's buffers: a vec4 accumulator pair.
+constexpr std::uint64_t kPathBytes = gpu::kAccumulatorVec4s * 16;
 // The filter's widest cascade (steps 1..8) and the paths from which it is left out.
 constexpr std::uint32_t kMaxIterations = 4;
 } // namespace
@@ -49,10 +51,11 @@ struct PathCorrection::Impl {
                                                gpu::kCorrectionBindingCount, sizeof(gpu::CorrectionPush), 2)),
         stream(c), timestamps(c) {
     const std::uint64_t px = std::uint64_t(width) * height;
-    if (px * 16 > c.info().maxStorageBufferRange)
-      throw InputError(fmt::format("the path-traced correction keeps whole-frame buffers of 16 bytes per pixel: "
-                                   "{}x{} is more than the device '{}' allows in one buffer",
-                                   width, height, c.info().name));
+    if (px * kPathBytes > c.info().maxStorageBufferRange)
+      throw InputError(fmt::format("the path-traced correction keeps whole-frame buffers of up to {} bytes per "
+                                   "pixel: {}x{} is more than the device '{}' allows in one buffer",
+                                   kPathBytes, width, height, c.info().name));
+    pathSums = gpu::Buffer(c, px * kPathBytes, kStorage, "correction.paths");
     params = gpu::Buffer(c, sizeof(gpu::DenoiseParams), kStorage, "correction.params");
     guide = gpu::Buffer(c, px * 16, kStorage, "correction.guide");
     base = gpu::Buffer(c, px * 16, kStorage, "correction.base");
@@ -66,7 +69,7 @@ struct PathCorrection::Impl {
       residualKernel.bind(gpu::kBindingResidualComposed, band.composed, b);
       residualKernel.bind(gpu::kBindingResidualAovs, band.aovs, b);
       residualKernel.bind(gpu::kBindingResidualSampleCounts, band.sampleCounts, b);
-      residualKernel.bind(gpu::kBindingResidualPaths, paths.radiance(b), b);
+      residualKernel.bind(gpu::kBindingResidualPaths, pathSums, b);
       residualKernel.bind(gpu::kBindingResidualGuide, guide, b);
       residualKernel.bind(gpu::kBindingResidualBase, base, b);
       residualKernel.bind(gpu::kBindingResidualOut, residual[0], b);
@@ -88,6 +91,7 @@ struct PathCorrection::Impl {
   std::uint32_t width, height;
   gpu::Kernel residualKernel, filterKernel;
   gpu::Buffer params, guide, base, residual[2], corrected;
+  gpu::Buffer pathSums; // the path tracer's bands in one buffer: its bands need not be the renderer's
   gpu::CommandStream stream;
   gpu::Timestamps timestamps;
   std::map<std::string, double> lastMs;
@@ -100,13 +104,10 @@ PathCorrection::PathCorrection(const gpu::Context& context, const ObscuranceRend
     throw std::invalid_argument("PathCorrection: the renderer must keep its primary and composed AOVs (the guide, "
                                 "the seen emission)");
   const FrameLayout &a = renderer.layout(), &b = paths.layout();
-  bool same = a.width == b.width && a.height == b.height && a.bandCount() == b.bandCount();
-  for (std::uint32_t i = 0; same && i < a.bandCount(); ++i)
-    same = a.bands[i].firstRow == b.bands[i].firstRow && a.bands[i].rows == b.bands[i].rows;
-  if (!same)
-    throw std::invalid_argument(fmt::format("PathCorrection: the path tracer's frame ({}x{}, {} bands) is not the "
-                                            "renderer's ({}x{}, {} bands)",
-                                            b.width, b.height, b.bandCount(), a.width, a.height, a.bandCount()));
+  if (a.width != b.width || a.height != b.height)
+    throw std::invalid_argument(fmt::format("PathCorrection: the path tracer's frame ({}x{}) is not the renderer's "
+                                            "({}x{})",
+                                            b.width, b.height, a.width, a.height));
   impl_ = std::make_unique<Impl>(context, renderer, paths);
 }
 
@@ -125,9 +126,14 @@ void PathCorrection::correct(const ObscuranceRenderer& renderer, const PathTrace
   d.params.upload(*d.context, &params, sizeof(params));
   const std::uint32_t iterations = iterationsFor(paths.samples());
   const std::map<std::string, double> before = d.timestamps.totalsMs();
+  const FrameLayout& pathLayout = paths.layout();
   d.stream.submit([&](const vk::raii::CommandBuffer& cmd) {
     d.timestamps.reset(cmd);
     d.timestamps.begin(cmd, "correction.residual");
+    for (std::uint32_t b = 0; b < pathLayout.bandCount(); ++b)
+      cmd.copyBuffer(paths.radiance(b).handle(), d.pathSums.handle(),
+                     vk::BufferCopy(0, pathLayout.bandFirstPixel(b) * kPathBytes, pathLayout.bandPixels(b) * kPathBytes));
+    gpu::computeBarrier(cmd);
     for (std::uint32_t b = 0; b < layout.bandCount(); ++b) {
       const gpu::CorrectionPush push{.firstRow = layout.bands[b].firstRow, .rows = layout.bands[b].rows,
                                      .composedSlots = gpu::kComposeSlots, .pathSamples = paths.samples(),

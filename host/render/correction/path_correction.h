@@ -34,7 +34,8 @@ class PathTracer;
 class PathCorrection {
 public:
   // The renderer must keep its primary and composed AOVs (the guide, the seen emission) and the
-  // path tracer must cover the same frame in the same bands; std::invalid_argument otherwise.
+  // path tracer must cover the same frame (in bands of its own); std::invalid_argument otherwise,
+  // and InputError when a whole-frame buffer exceeds the device's limit.
   PathCorrection(const gpu::Context& context, const ObscuranceRenderer& renderer, const PathTracer& paths);
   ~PathCorrection();
   PathCorrection(const PathCorrection&) = delete;
