@@ -20,13 +20,6 @@ layout(std430, binding = kBindingCorrectionIn) readonly buffer ResidualIn { vec4
 layout(std430, binding = kBindingCorrectionOut) writeonly buffer ResidualOut { vec4 filtered[]; };
 layout(std430, binding = kBindingCorrectionImage) writeonly buffer ImageOut { vec4 corrected[]; };
 
-// max(0, d)^128 by seven squarings.
-float normalWeight(float d) {
-  float w = max(d, 0.0);
-  for (int i = 0; i < 7; ++i) w *= w;
-  return w;
-}
-
 void main() {
   const uvec2 size = params.frame.xy;
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);

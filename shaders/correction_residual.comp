@@ -34,11 +34,7 @@ void main() {
   const vec4 normalDepth = OBS_SUM(aov, local * kAovSlots + kAovNormal) * inv;
   const uint material = floatBitsToUint(OBS_SUM(aov, local * kAovSlots + kAovIds).y);
 
-  Guide g;
-  g.depth = albedo.a > 0.0 ? normalDepth.w / albedo.a : 0.0;
-  g.normal = dot(normalDepth.xyz, normalDepth.xyz) > 0.0 ? normalize(normalDepth.xyz) : vec3(0.0, 0.0, 1.0);
-  g.albedo = albedo.rgb;
-  g.material = material == kInvalidIndex ? kDenoiseNoMaterial : min(material, kDenoiseNoMaterial - 1u);
+  const Guide g = pixelGuide(albedo, normalDepth, material);
   const uvec4 packed = encodeGuide(g);
   guide[pixel] = packed;
 

@@ -26,13 +26,6 @@ layout(std430, binding = kBindingAtrousOut) writeonly buffer Out { uvec4 filtere
 // eps of w_l: a relative difference of half precision (2^-11) is no edge.
 const float kLuminanceFloor = 1e-3;
 
-// max(0, d)^128 by seven squarings (pow costs a log and an exp per tap on lavapipe).
-float normalWeight(float d) {
-  float w = max(d, 0.0);
-  for (int i = 0; i < 7; ++i) w *= w;
-  return w;
-}
-
 void main() {
   const uvec2 size = params.frame.xy;
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);

@@ -30,12 +30,7 @@ void main() {
   const vec4 normalDepth = OBS_SUM(aov, local * kAovSlots + kAovNormal) * inv;
   const uint material = floatBitsToUint(OBS_SUM(aov, local * kAovSlots + kAovIds).y);
 
-  Guide g;
-  g.depth = albedo.a > 0.0 ? normalDepth.w / albedo.a : 0.0;
-  g.normal = dot(normalDepth.xyz, normalDepth.xyz) > 0.0 ? normalize(normalDepth.xyz) : vec3(0.0, 0.0, 1.0);
-  g.albedo = albedo.rgb;
-  g.material = material == kInvalidIndex ? kDenoiseNoMaterial : min(material, kDenoiseNoMaterial - 1u);
-  const uvec4 packed = encodeGuide(g);
+  const uvec4 packed = encodeGuide(pixelGuide(albedo, normalDepth, material));
   guide[pixel] = packed;
 
   // Divided by the albedo as remodulation will read it back (halves), so that an unfiltered pixel

@@ -48,6 +48,26 @@ Guide decodeGuide(uvec4 t) {
 
 bool guideHit(Guide g) { return g.depth > 0.0; }
 
+// The guide of a pixel from its primary AOV means (primary.comp's sums over its samples): albedo
+// (a = coverage), normal and depth (w), and the first sample's material id (kInvalidIndex: no hit).
+// The depth is the hits' mean: divided by the coverage.
+Guide pixelGuide(vec4 albedo, vec4 normalDepth, uint material) {
+  Guide g;
+  g.depth = albedo.a > 0.0 ? normalDepth.w / albedo.a : 0.0;
+  g.normal = dot(normalDepth.xyz, normalDepth.xyz) > 0.0 ? normalize(normalDepth.xyz) : vec3(0.0, 0.0, 1.0);
+  g.albedo = albedo.rgb;
+  g.material = material == kInvalidIndex ? kDenoiseNoMaterial : min(material, kDenoiseNoMaterial - 1u);
+  return g;
+}
+
+// The edge-stopping weight of two normals: max(0, d)^128 (Schied et al.'s sigma_n) by seven
+// squarings (pow costs a log and an exp per tap on lavapipe).
+float normalWeight(float d) {
+  float w = max(d, 0.0);
+  for (int i = 0; i < 7; ++i) w *= w;
+  return w;
+}
+
 // What demodulation divides by and remodulation multiplies by.
 vec3 demodulationAlbedo(Guide g) { return max(g.albedo, vec3(kDenoiseAlbedoFloor)); }
 
