@@ -1,6 +1,8 @@
 // obscura recover — reflectance from photographs of one view, one lamp per shot [IVR §4]:
 //   obscura recover SCENE --photos lights.json -o DIR [--camera N] [--debug] [--png]
-// writes DIR/reflectance.exr (R, G, B, confidence.K = sum of the filtered K_i, filled.id, object.id),
+// writes DIR/reflectance.exr (R, G, B, confidence.K = sum of the filtered K_i, filled.id (0 merged,
+// 1-3 filled, 4 mixed from its footprint's surfaces), object.id, surface.RGB: the reflectance
+// before that mix, of the surface the pixel's centre sees, which remodel re-lights),
 // DIR/recover.json (the scene, camera and lamps, how the estimate converged, what was filled,
 // times; with reflectance.exr what `obscura remodel DIR` reads), DIR/state (a relighting
 // state of the photographed room with the recovered albedo, for `obscura relight`), with --debug one
@@ -87,7 +89,8 @@ void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const rec
                   const nlohmann::json& accuracy) {
   const fs::path dir(o.output);
   io::Image out = rgbImage(r.width, r.height,
-                           {"R", "G", "B", "confidence.K", "filled.id", "object.id", "indirect.shots", "variance.rel"});
+                           {"R", "G", "B", "confidence.K", "filled.id", "object.id", "indirect.shots", "variance.rel",
+                            "surface.R", "surface.G", "surface.B"});
   for (std::size_t p = 0; p < r.reflectance.size(); ++p) {
     put(out, p, 0, r.reflectance[p]);
     put(out, p, 3, r.confidence[p]);
@@ -95,6 +98,7 @@ void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const rec
     put(out, p, 5, float(r.object[p]));
     put(out, p, 6, r.indirectShots[p]);
     put(out, p, 7, r.relativeVariance[p]);
+    put(out, p, 8, r.surfaceReflectance[p]);
   }
   io::writeExr((dir / "reflectance.exr").string(), out);
   if (o.png) {
@@ -151,6 +155,7 @@ void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const rec
                                  {"filled_from_surface", r.filledFromSurface},
                                  {"filled_from_visibility", r.filledFromVisibility},
                                  {"filled_from_object_mean", r.filledFromObject},
+                                 {"mixed_from_footprint", r.mixedFromFootprint},
                                  {"gather_rays_seen", r.gatherSeen},
                                  {"gather_rays_hidden", r.gatherHidden},
                                  {"iterations", iterations},
@@ -206,9 +211,10 @@ void runRecover(RecoverOptions& o) {
              std::chrono::duration<double>(std::chrono::steady_clock::now() - stateStart).count(), o.output);
   fmt::print(stderr, "recover: {} photos, {}x{}, {} iterations; {} pixels from lit estimates, {} from indirect light "
                      "only; {} filled from their surface nearby, {} from visibility, {} from their object's mean; "
-                     "{:.1f} s -> {}\n",
+                     "{} mixed from the surfaces their footprint covers; {:.1f} s -> {}\n",
              photos.shots.size(), r.width, r.height, r.iterations.size() - 1, r.litPixels, r.indirectOnlyPixels,
-             r.filledFromSurface, r.filledFromVisibility, r.filledFromObject, r.seconds, o.output);
+             r.filledFromSurface, r.filledFromVisibility, r.filledFromObject, r.mixedFromFootprint, r.seconds,
+             o.output);
 }
 
 } // namespace

@@ -103,17 +103,25 @@ void readReflectance(const std::string& dir, recover::RecoveredRoom& room, std::
             o = image.channelIndex("object.id");
   if (r < 0 || k < 0 || f < 0 || o < 0 || image.channelIndex("G") != r + 1 || image.channelIndex("B") != r + 2)
     throw InputError(fmt::format("{}: needs the channels R, G, B, confidence.K, filled.id, object.id", path));
+  // The reflectance of the surface each pixel's centre sees, before recover's footprint mix
+  // (recover/reflectance_recovery.h: an edit changes what a footprint covers); a folder written
+  // before that mix has R, G, B alone.
+  const int surface = image.channelIndex("surface.R") >= 0 ? image.channelIndex("surface.R") : r;
+  if (image.channelIndex("surface.G") != surface + 1 && surface != r)
+    throw InputError(fmt::format("{}: surface.R without surface.G and surface.B after it", path));
   room.width = image.width;
   room.height = image.height;
   const std::size_t n = image.channels.size();
   for (std::size_t p = 0; p < std::size_t(image.width) * image.height; ++p) {
     const float* v = &image.pixels[p * n];
-    room.reflectance.emplace_back(v[r], v[r + 1], v[r + 2]);
+    room.reflectance.emplace_back(v[surface], v[surface + 1], v[surface + 2]);
     const auto object = static_cast<std::int32_t>(std::lround(v[o]));
     if (object >= static_cast<std::int32_t>(objects))
       throw InputError(fmt::format("{}: object.id {} but the scene has {} objects", path, object, objects));
     room.object.push_back(object);
-    room.measured.push_back(v[k] > 0.0f && std::lround(v[f]) == 0 ? 1 : 0);
+    // Merged from the photographs: 0, and 4 (mixed, but measured on its own surface before).
+    const long filled = std::lround(v[f]);
+    room.measured.push_back(v[k] > 0.0f && (filled == 0 || filled == 4) ? 1 : 0);
   }
 }
 

@@ -10,6 +10,7 @@
 
 #include "core/luminance.h"
 #include "core/parallel_for.h"
+#include "recover/pixel_footprint.h"
 #include "recover/recovery_scene.h"
 #include "render/gpu_ray_batch.h"
 #include "render/scene_data/camera_grid.h"
@@ -177,9 +178,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
   // surface point where the footprint is curved or crosses an edge: on a chair's tubular frame it
   // lies inside the tube, and rays from there lit it from the tube's inside (classroom: 57 % of a
   // frame pixel's hidden hits were its own tube, B 0.6 of path tracing's).
-  render::GridCamera view{camera.position, glm::normalize(camera.forward), camera.up, camera.yfov,
-                          float(pixels.width) / float(pixels.height)};
-  view.up = glm::cross(glm::normalize(glm::cross(view.forward, camera.up)), view.forward); // as projectToPixel
+  const render::GridCamera view = pixelCamera(camera, pixels.width, pixels.height);
   std::vector<bvh::Ray> cameraRays;
   const std::uint32_t points = std::min(raysPerPixel, kPointsPerPixel);
   // Each point jittered in a cell of a grid over the pixel (2 x 2 for 4 points).

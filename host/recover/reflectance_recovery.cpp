@@ -12,9 +12,12 @@
 
 #include "core/error.h"
 #include "core/luminance.h"
+#include "recover/pixel_footprint.h"
 #include "recover/recovery_scene.h"
 #include "relight/relight_state.h"
+#include "render/gpu_ray_batch.h"
 #include "render/obscurance_renderer.h"
+#include "render/scene_data/scene_buffers.h"
 
 namespace obscura::recover {
 namespace {
@@ -318,12 +321,14 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
                                         &objectMaterial)});
   if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
 
+  // The device's rays through the renderer's traversal: the gather's and the pixels' footprints.
+  const render::SceneBuffers buffers(context, room, bvh);
+  render::GpuRayBatch rays(context, buffers, render::TraceShape::forDevice(context, buffers.traversal()));
   std::unique_ptr<PhotoGather> gather;
   if (options.indirect == IndirectModel::Gather) {
     stepStart = Clock::now();
-    gather = std::make_unique<PhotoGather>(PhotoGather::onDevice(context, room, bvh, camera, lighting.geometry,
-                                                                 photos.shots, options.gatherRays, options.seed,
-                                                                 options.gatherSmoothing, options.hiddenBounces));
+    gather = std::make_unique<PhotoGather>(room, rays, camera, lighting.geometry, photos.shots, options.gatherRays,
+                                           options.seed, options.gatherSmoothing, options.hiddenBounces);
     out.gatherSeen = gather->seenFraction();
     out.gatherHidden = gather->hiddenFraction();
     if (log)
@@ -419,6 +424,20 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       ++out.filledFromObject;
     }
   }
+  // Pixels whose footprint covers several surfaces: the mix of those surfaces' reflectances
+  // (pixel_footprint.h). The paper's merge keeps its own estimate there.
+  if (options.merge == MergeModel::Weighted) {
+    stepStart = Clock::now();
+    const PixelFootprints footprints = traceFootprints(room, rays, camera, photos.width, photos.height);
+    out.surfaceReflectance = out.reflectance;
+    out.mixedFromFootprint = mixFootprints(footprints, out.object, means, out.reflectance);
+    for (std::size_t p = 0; p < out.reflectance.size(); ++p)
+      if (out.object[p] >= 0 && !footprints.whole(p)) out.filled[p] = 4;
+    if (log)
+      log(fmt::format("recover: {} pixels whose footprint covers several surfaces, mixed from theirs: {:.1f} s",
+                      out.mixedFromFootprint, secondsSince(stepStart)));
+  }
+  if (out.surfaceReflectance.empty()) out.surfaceReflectance = out.reflectance;
   out.seconds = secondsSince(start);
   return out;
 }

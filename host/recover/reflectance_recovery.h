@@ -90,12 +90,17 @@ struct IterationReport {
 
 struct Recovery {
   int width = 0, height = 0;
-  std::vector<glm::vec3> reflectance;            // merged and filled
+  std::vector<glm::vec3> reflectance;            // merged and filled, mixed where a footprint covers several surfaces
+  // The same before the footprints' mix (filled 4 there): the reflectance of the surface each
+  // pixel's centre sees. What remodel re-lights: an edit changes what a footprint covers (a removed
+  // object's neighbours would keep its share of their mix).
+  std::vector<glm::vec3> surfaceReflectance;
   std::vector<float> confidence;                 // sum of the filtered K_i of the lit estimates
   std::vector<float> indirectShots;              // how many indirect-only estimates the pixel has (weighted merge)
   std::vector<float> relativeVariance;           // of the merged R (weighted merge; 1 / sum K_i for the paper's)
   std::vector<std::uint8_t> filled;              // 0 merged, 1 filled from visibility, 2 from the object's mean,
-                                                 // 3 from the merged pixels of its surface nearby
+                                                 // 3 from the merged pixels of its surface nearby,
+                                                 // 4 mixed from the surfaces its footprint covers
   std::vector<std::vector<glm::vec3>> estimates; // [shot] R_i
   std::vector<ConfidenceImage> visibility;       // [shot] V_i
   std::vector<std::vector<glm::vec3>> direct;    // [shot] F V E_i of the last render
@@ -106,6 +111,7 @@ struct Recovery {
   double gatherSeen = 0.0, gatherHidden = 0.0; // Gather: fractions of its rays (photo_gather.h)
   std::vector<IterationReport> iterations;
   std::size_t filledFromSurface = 0, filledFromVisibility = 0, filledFromObject = 0;
+  std::size_t mixedFromFootprint = 0; // pixels whose footprint covers several surfaces (pixel_footprint.h)
   std::size_t litPixels = 0, indirectOnlyPixels = 0; // merged from a lit estimate / from indirect-only ones alone
   double seconds = 0.0;
 };

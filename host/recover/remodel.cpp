@@ -19,12 +19,12 @@ RecoveredRoom recoveredRoom(const Recovery& recovery) {
   RecoveredRoom room;
   room.width = recovery.width;
   room.height = recovery.height;
-  room.reflectance = recovery.reflectance;
+  room.reflectance = recovery.surfaceReflectance; // the edit decides what each footprint covers now
   room.object = recovery.object;
   room.objectReflectance = recovery.iterations.back().objectReflectance;
   room.measured.assign(recovery.reflectance.size(), 0);
   for (std::size_t p = 0; p < recovery.reflectance.size(); ++p)
-    room.measured[p] = recovery.filled[p] == 0 && recovery.confidence[p] > 0.0f ? 1 : 0;
+    room.measured[p] = (recovery.filled[p] == 0 || recovery.filled[p] == 4) && recovery.confidence[p] > 0.0f ? 1 : 0; // 4: as readReflectance
   return room;
 }
 
