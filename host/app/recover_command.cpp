@@ -1,8 +1,8 @@
 // obscura recover — reflectance from photographs of one view, one lamp per shot [IVR §4]:
 //   obscura recover SCENE --photos lights.json -o DIR [--camera N] [--debug] [--png]
-// writes DIR/reflectance.exr (R, G, B, confidence.K = sum of the filtered K_i, filled.id (0 merged,
-// 1-3 filled, 4 mixed from its footprint's surfaces), object.id, surface.RGB: the reflectance
-// before that mix, of the surface the pixel's centre sees, which remodel re-lights),
+// writes DIR/reflectance.exr (R, G, B, confidence.K = sum of the filtered K_i, filled.id, object.id,
+// surface.RGB: the reflectance before the footprints' mix, of the surface each pixel's centre sees,
+// which remodel re-lights),
 // DIR/recover.json (the scene, camera and lamps, how the estimate converged, what was filled,
 // times; with reflectance.exr what `obscura remodel DIR` reads), DIR/state (a relighting
 // state of the photographed room with the recovered albedo, for `obscura relight`), with --debug one

@@ -107,7 +107,7 @@ void readReflectance(const std::string& dir, recover::RecoveredRoom& room, std::
   // (recover/reflectance_recovery.h: an edit changes what a footprint covers); a folder written
   // before that mix has R, G, B alone.
   const int surface = image.channelIndex("surface.R") >= 0 ? image.channelIndex("surface.R") : r;
-  if (image.channelIndex("surface.G") != surface + 1 && surface != r)
+  if (surface != r && (image.channelIndex("surface.G") != surface + 1 || image.channelIndex("surface.B") != surface + 2))
     throw InputError(fmt::format("{}: surface.R without surface.G and surface.B after it", path));
   room.width = image.width;
   room.height = image.height;
@@ -119,9 +119,7 @@ void readReflectance(const std::string& dir, recover::RecoveredRoom& room, std::
     if (object >= static_cast<std::int32_t>(objects))
       throw InputError(fmt::format("{}: object.id {} but the scene has {} objects", path, object, objects));
     room.object.push_back(object);
-    // Merged from the photographs: 0, and 4 (mixed, but measured on its own surface before).
-    const long filled = std::lround(v[f]);
-    room.measured.push_back(v[k] > 0.0f && (filled == 0 || filled == 4) ? 1 : 0);
+    room.measured.push_back(v[k] > 0.0f && std::lround(v[f]) == 0 ? 1 : 0);
   }
 }
 

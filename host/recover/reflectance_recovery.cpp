@@ -424,20 +424,17 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       ++out.filledFromObject;
     }
   }
+  out.surfaceReflectance = out.reflectance;
   // Pixels whose footprint covers several surfaces: the mix of those surfaces' reflectances
   // (pixel_footprint.h). The paper's merge keeps its own estimate there.
   if (options.merge == MergeModel::Weighted) {
     stepStart = Clock::now();
     const PixelFootprints footprints = traceFootprints(room, rays, camera, photos.width, photos.height);
-    out.surfaceReflectance = out.reflectance;
     out.mixedFromFootprint = mixFootprints(footprints, out.object, means, out.reflectance);
-    for (std::size_t p = 0; p < out.reflectance.size(); ++p)
-      if (out.object[p] >= 0 && !footprints.whole(p)) out.filled[p] = 4;
     if (log)
       log(fmt::format("recover: {} pixels whose footprint covers several surfaces, mixed from theirs: {:.1f} s",
                       out.mixedFromFootprint, secondsSince(stepStart)));
   }
-  if (out.surfaceReflectance.empty()) out.surfaceReflectance = out.reflectance;
   out.seconds = secondsSince(start);
   return out;
 }

@@ -91,7 +91,7 @@ struct IterationReport {
 struct Recovery {
   int width = 0, height = 0;
   std::vector<glm::vec3> reflectance;            // merged and filled, mixed where a footprint covers several surfaces
-  // The same before the footprints' mix (filled 4 there): the reflectance of the surface each
+  // The same before the footprints' mix: the reflectance of the surface each
   // pixel's centre sees. What remodel re-lights: an edit changes what a footprint covers (a removed
   // object's neighbours would keep its share of their mix).
   std::vector<glm::vec3> surfaceReflectance;
@@ -99,8 +99,8 @@ struct Recovery {
   std::vector<float> indirectShots;              // how many indirect-only estimates the pixel has (weighted merge)
   std::vector<float> relativeVariance;           // of the merged R (weighted merge; 1 / sum K_i for the paper's)
   std::vector<std::uint8_t> filled;              // 0 merged, 1 filled from visibility, 2 from the object's mean,
-                                                 // 3 from the merged pixels of its surface nearby,
-                                                 // 4 mixed from the surfaces its footprint covers
+                                                 // 3 from the merged pixels of its surface nearby
+                                                 // (of surfaceReflectance: the footprints' mix comes after)
   std::vector<std::vector<glm::vec3>> estimates; // [shot] R_i
   std::vector<ConfidenceImage> visibility;       // [shot] V_i
   std::vector<std::vector<glm::vec3>> direct;    // [shot] F V E_i of the last render

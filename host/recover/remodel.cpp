@@ -24,7 +24,7 @@ RecoveredRoom recoveredRoom(const Recovery& recovery) {
   room.objectReflectance = recovery.iterations.back().objectReflectance;
   room.measured.assign(recovery.reflectance.size(), 0);
   for (std::size_t p = 0; p < recovery.reflectance.size(); ++p)
-    room.measured[p] = (recovery.filled[p] == 0 || recovery.filled[p] == 4) && recovery.confidence[p] > 0.0f ? 1 : 0; // 4: as readReflectance
+    room.measured[p] = recovery.filled[p] == 0 && recovery.confidence[p] > 0.0f ? 1 : 0;
   return room;
 }
 

@@ -109,6 +109,21 @@ TEST_F(CliRecover, WritesReflectanceWithConfidenceAndThePerPhotoImages) {
     }
   EXPECT_GT(filled, 3000); // what the short box covered
   EXPECT_GT(lit, 30000);   // the new lamp lights the room
+  // Pixels whose footprint covers two surfaces: R is their mix, surface.RGB the estimate of the
+  // centre's surface, and remodel re-lights the latter (an edit changes what a footprint covers).
+  const int surface = image.channelIndex("surface.R"), reflectance = frame.channelIndex("reflectance.R");
+  ASSERT_GE(surface, 0);
+  EXPECT_GT(report["mixed_from_footprint"].get<int>(), 500);
+  int mixed = 0, relitAsSurface = 0;
+  for (int y = 0; y < 256; ++y)
+    for (int x = 0; x < 256; ++x) {
+      const float own = image.at(x, y, surface);
+      if (frame.at(x, y, synthesized) > 0.5f || std::abs(own - image.at(x, y, 0)) < 0.01f) continue;
+      ++mixed;
+      relitAsSurface += std::abs(frame.at(x, y, reflectance) - own) <= 1e-3f * own + 1e-6f ? 1 : 0;
+    }
+  EXPECT_GT(mixed, 100);
+  EXPECT_EQ(relitAsSurface, mixed);
 
   // Bad remodel input, on the same folder: a clear error naming it, exit 2, nothing written.
   auto refused = [&](const json& bad, const std::string& mention) {

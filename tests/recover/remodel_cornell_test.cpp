@@ -160,10 +160,7 @@ TEST_F(RemodelCornell, RemovedShortBoxUncoversAFloorWithTheVisibleFloorsStatisti
   const int W = frame.width, H = frame.height;
   auto at = [W](int x, int y) { return std::size_t(y) * W + x; };
   auto visibleFloor = [&](std::size_t p) {
-    // Merged from the photographs on the floor itself: filled 0, or 4 (mixed for recover's own
-    // report with a neighbour its footprint touches; remodel re-lights the floor's own estimate).
-    return frame.object[p] == floor && !frame.synthesized[p] && recovery.object[p] == floor &&
-           (recovery.filled[p] == 0 || recovery.filled[p] == 4);
+    return frame.object[p] == floor && !frame.synthesized[p] && recovery.object[p] == floor && recovery.filled[p] == 0;
   };
   std::vector<std::size_t> fill, interior;
   for (int y = 0; y < H; ++y)
