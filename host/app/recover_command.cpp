@@ -156,6 +156,7 @@ void writeOutputs(const RecoverOptions& o, const recover::Recovery& r, const rec
                                  {"filled_from_visibility", r.filledFromVisibility},
                                  {"filled_from_object_mean", r.filledFromObject},
                                  {"mixed_from_footprint", r.mixedFromFootprint},
+                                 {"textured_pixels", r.texturedPixels},
                                  {"gather_rays_seen", r.gatherSeen},
                                  {"gather_rays_hidden", r.gatherHidden},
                                  {"iterations", iterations},
@@ -211,10 +212,11 @@ void runRecover(RecoverOptions& o) {
              std::chrono::duration<double>(std::chrono::steady_clock::now() - stateStart).count(), o.output);
   fmt::print(stderr, "recover: {} photos, {}x{}, {} iterations; {} pixels from lit estimates, {} from indirect light "
                      "only; {} filled from their surface nearby, {} from visibility, {} from their object's mean; "
-                     "{} mixed from the surfaces their footprint covers; {:.1f} s -> {}\n",
+                     "{} mixed from the surfaces their footprint covers; {} on textured objects (smoothed within the "
+                     "photographs' noise); {:.1f} s -> {}\n",
              photos.shots.size(), r.width, r.height, r.iterations.size() - 1, r.litPixels, r.indirectOnlyPixels,
-             r.filledFromSurface, r.filledFromVisibility, r.filledFromObject, r.mixedFromFootprint, r.seconds,
-             o.output);
+             r.filledFromSurface, r.filledFromVisibility, r.filledFromObject, r.mixedFromFootprint, r.texturedPixels,
+             r.seconds, o.output);
 }
 
 } // namespace

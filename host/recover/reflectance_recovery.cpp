@@ -395,6 +395,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   const std::vector<glm::vec3> means = out.iterations.back().objectReflectance;
   for (std::size_t p = 0; p < out.reflectance.size(); ++p) {
     if (out.object[p] < 0) continue;
+    if (!merged.texturedObjects.empty() && merged.texturedObjects[std::size_t(out.object[p])]) ++out.texturedPixels;
     if (out.confidence[p] > 0.0f) ++out.litPixels;
     else if (out.relativeVariance[p] > 0.0f) ++out.indirectOnlyPixels;
     if (out.relativeVariance[p] > 0.0f) continue;

@@ -112,6 +112,7 @@ struct Recovery {
   std::vector<IterationReport> iterations;
   std::size_t filledFromSurface = 0, filledFromVisibility = 0, filledFromObject = 0;
   std::size_t mixedFromFootprint = 0; // pixels whose footprint covers several surfaces (pixel_footprint.h)
+  std::size_t texturedPixels = 0;     // pixels of textured objects, smoothed within the photographs' noise (weighted_merge.h)
   std::size_t litPixels = 0, indirectOnlyPixels = 0; // merged from a lit estimate / from indirect-only ones alone
   double seconds = 0.0;
 };

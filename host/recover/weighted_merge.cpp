@@ -54,6 +54,22 @@ bool onSurfacePatch(const PixelGeometry& g, int x, int y) {
   return 3 * support >= 2 * window;
 }
 
+// Whether p's whole clipped 3x3 window sees p's surface: not at an edge, where a pixel's
+// footprint may mix two surfaces.
+bool insideSurface(const PixelGeometry& g, int x, int y) {
+  int support = 0;
+  forSurfaceWindow(g, x, y, 1, [&](std::size_t) { ++support; });
+  const int window = (std::min(g.width - 1, x + 1) - std::max(0, x - 1) + 1) *
+                     (std::min(g.height - 1, y + 1) - std::max(0, y - 1) + 1);
+  return support == window;
+}
+
+double median(std::vector<double>& v) {
+  const auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
 } // namespace
 
 std::vector<float> photoNoise(const std::vector<glm::vec3>& photo, const PixelGeometry& pixels) {
@@ -125,11 +141,12 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
   WeightedMerge out;
   out.reflectance.assign(n, glm::vec3(0.0f));
   out.relativeVariance.assign(n, 0.0f);
+  out.independentVariance.assign(n, 0.0f);
   out.directConfidence.assign(n, 0.0f);
   out.indirectShots.assign(n, 0.0f);
   out.weights.assign(shots, std::vector<float>(n, 0.0f));
   const float eB2 = options.indirectUncertainty * options.indirectUncertainty;
-  std::vector<double> weightSum(n, 0.0), wholeSum(n, 0.0);
+  std::vector<double> weightSum(n, 0.0), wholeSum(n, 0.0), independentSum(n, 0.0);
   std::vector<glm::dvec3> sum(n, glm::dvec3(0.0));
   std::vector<std::vector<float>> noiseOf(shots);
   parallelFor(shots, [&](std::size_t i) { noiseOf[i] = shotNoise(photos, i, pixels); });
@@ -142,14 +159,15 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
       // of it without `modelled`); the floor: half-float photographs and float lighting, 0.1 %
       // at best.
       const float bShare = b / (d + b), modelShare = bShare * (modelled ? (*modelled)[i][p] : 1.0f);
-      const float v = noise[p] / (c * c) + eB2 * modelShare * modelShare + 1e-6f;
+      const float photoShare = noise[p] / (c * c);
+      const float v = photoShare + eB2 * modelShare * modelShare + 1e-6f;
       // The merged R's variance keeps e_B on all of B (relativeVariance below): what the
       // smoothing tolerates between neighbours, whose estimates differ by B's sampling noise too,
       // most where its hidden paths are (with the weights' variance the Cornell box's faces
       // towards the open front came out blotchy: RMSE 0.0199 against 0.0171), and what weighs a
       // pixel in its object's mean (with the weights' variance a few pixels decided it: the
       // Cornell box's short box 0.769 against 0.729 at 4 spp).
-      const float whole = noise[p] / (c * c) + eB2 * bShare * bShare + 1e-6f;
+      const float whole = photoShare + eB2 * bShare * bShare + 1e-6f;
       // No diffuse surface reflects more than it receives: an estimate above 1 by more than
       // three of its own standard deviations says the lighting model is wrong at this pixel,
       // not the surface. (Within them it stays: cutting a noisy estimate's upper tail alone
@@ -168,6 +186,7 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
       out.weights[i][p] = w;
       weightSum[p] += w;
       wholeSum[p] += k / whole;
+      independentSum[p] += double(w) * w * photoShare;
       sum[p] += double(w) * glm::dvec3(estimates[i][p]);
     });
   }
@@ -175,10 +194,16 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
     if (weightSum[p] > 0.0) {
       out.reflectance[p] = glm::min(glm::vec3(sum[p] / weightSum[p]), glm::vec3(1.0f));
       out.relativeVariance[p] = static_cast<float>(1.0 / wholeSum[p]);
+      out.independentVariance[p] = static_cast<float>(independentSum[p] / (weightSum[p] * weightSum[p]));
     }
-  if (options.smoothingRadius > 0)
+  if (options.smoothingRadius > 0) {
+    out.texturedObjects = texturedObjects(out.reflectance, out.independentVariance, pixels);
+    std::vector<float> tolerance = out.relativeVariance;
+    for (std::size_t p = 0; p < n; ++p)
+      if (pixels.object[p] >= 0 && out.texturedObjects[std::size_t(pixels.object[p])]) tolerance[p] = out.independentVariance[p];
     out.reflectance = smoothByNoise(out.reflectance, out.relativeVariance, pixels, options.smoothingRadius,
-                                    options.agreement);
+                                    options.agreement, &tolerance);
+  }
   return out;
 }
 
@@ -198,20 +223,56 @@ std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeo
   return glm::vec3(sum / weight);
 }
 
+std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, const std::vector<float>& independentVariance,
+                                  const PixelGeometry& pixels) {
+  std::int32_t objects = 0;
+  for (const std::int32_t o : pixels.object) objects = std::max(objects, o + 1);
+  const auto count = static_cast<std::size_t>(objects);
+  std::vector<std::vector<double>> differences(count), noise(count);
+  std::vector<char> inside(pixels.object.size(), 0);
+  forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
+    inside[p] = independentVariance[p] > 0.0f && insideSurface(pixels, x, y);
+  });
+  forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
+    if (!inside[p]) return;
+    const double lp = luminance(reflectance[p]);
+    const auto pair = [&](int qx, int qy) {
+      if (qx >= pixels.width || qy >= pixels.height) return;
+      const std::size_t q = std::size_t(qy) * pixels.width + qx;
+      if (!inside[q] || !sameSurface(pixels, p, q)) return;
+      const double lq = luminance(reflectance[q]);
+      const auto o = std::size_t(pixels.object[p]);
+      differences[o].push_back((lq - lp) * (lq - lp));
+      noise[o].push_back(independentVariance[p] * lp * lp + independentVariance[q] * lq * lq);
+    };
+    pair(x + 1, y);
+    pair(x, y + 1);
+  });
+  std::vector<bool> textured(count, false);
+  for (std::size_t o = 0; o < textured.size(); ++o) {
+    if (differences[o].size() < kTexturePairs) continue;
+    const double expected = median(noise[o]);
+    textured[o] = expected > 0.0 && median(differences[o]) > kTextureRatio * expected;
+  }
+  return textured;
+}
+
 std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,
-                                     const PixelGeometry& pixels, int radius, float agreement) {
+                                     const PixelGeometry& pixels, int radius, float agreement,
+                                     const std::vector<float>* tolerance) {
   std::vector<glm::vec3> out = reflectance;
   const float a2 = agreement * agreement;
+  const std::vector<float>& within = tolerance ? *tolerance : variance;
   forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
     if (variance[p] <= 0.0f) return;
     const glm::vec3 rp = reflectance[p];
-    const glm::vec3 sp = variance[p] * rp * rp; // per channel sigma^2
+    const glm::vec3 sp = within[p] * rp * rp; // per channel sigma^2
     glm::dvec3 sum(0.0);
     double weight = 0.0;
     forSurfaceWindow(pixels, x, y, radius, [&](std::size_t q) {
       if (variance[q] <= 0.0f) return;
       const glm::vec3 rq = reflectance[q];
-      const glm::vec3 d = rq - rp, s = sp + variance[q] * rq * rq;
+      const glm::vec3 d = rq - rp, s = sp + within[q] * rq * rq;
       for (int c = 0; c < 3; ++c)
         if (d[c] * d[c] > a2 * s[c]) return;
       // Relative variances weigh: absolute ones would favour the darker of two noisy pixels.

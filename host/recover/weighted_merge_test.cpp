@@ -315,5 +315,61 @@ TEST(WeightedMerge, SmoothingByNoiseFlattensAWallAndKeepsATextureEdge) {
   }
 }
 
+TEST(WeightedMerge, TheSmoothingKeepsAnIndirectlyLitTextureAndFlattensAPlainWallBesideIt) {
+  // Two walls side by side (objects 0 and 1), lit only indirectly in three shots (D = 0, V = 0:
+  // every estimate is indirect-only, its tolerance in the smoothing wide with B's error): the left
+  // a granite (each pixel's reflectance uniform in [0.4, 0.8]), the right plain 0.6; 3 % noise.
+  const int w = 40, h = 40, split = 20, shots = 3;
+  const PixelGeometry g = wall(w, h, split);
+  const std::size_t n = std::size_t(w) * h;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> granite(0.4f, 0.8f);
+  std::normal_distribution<float> noise(0.0f, 0.03f);
+  std::vector<float> truth(n);
+  std::vector<std::vector<glm::vec3>> photos(shots, std::vector<glm::vec3>(n)), direct(shots, std::vector<glm::vec3>(n, glm::vec3(0.0f))),
+      indirect(shots, std::vector<glm::vec3>(n)), estimates(shots, std::vector<glm::vec3>(n));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t p = std::size_t(y) * w + x;
+      truth[p] = x < split ? granite(rng) : 0.6f;
+      for (int i = 0; i < shots; ++i) {
+        indirect[i][p] = glm::vec3(0.2f * float(i + 1) * (1.0f + 0.01f * float(x)));
+        photos[i][p] = truth[p] * indirect[i][p] * (1.0f + noise(rng));
+        estimates[i][p] = photos[i][p] / indirect[i][p];
+      }
+    }
+  const std::vector<ConfidenceImage> none(shots, filled(w, h, 0.0f));
+  const WeightedMerge m = weightedMerge(photos, direct, indirect, estimates, none, none, g, WeightedMergeOptions{});
+  ASSERT_EQ(m.texturedObjects.size(), 2u);
+  EXPECT_TRUE(m.texturedObjects[0]);
+  EXPECT_FALSE(m.texturedObjects[1]);
+  // The same merge smoothed as before objects were judged: every estimate's tolerance is ~50 %,
+  // so the granite's levels pool.
+  WeightedMergeOptions unsmoothed;
+  unsmoothed.smoothingRadius = 0;
+  const WeightedMerge raw = weightedMerge(photos, direct, indirect, estimates, none, none, g, unsmoothed);
+  const std::vector<glm::vec3> pooled = smoothByNoise(raw.reflectance, raw.relativeVariance, g, 3, 2.5f);
+  double kept = 0.0, blurred = 0.0;
+  int count = 0;
+  std::vector<glm::vec3> plainIn, plainOut;
+  for (int y = 3; y < h - 3; ++y)
+    for (int x = 3; x < w - 3; ++x) {
+      const std::size_t p = std::size_t(y) * w + x;
+      if (x < split - 3) {
+        kept += std::pow(m.reflectance[p].x / truth[p] - 1.0, 2);
+        blurred += std::pow(pooled[p].x / truth[p] - 1.0, 2);
+        ++count;
+      } else if (x > split + 3) {
+        plainIn.push_back(raw.reflectance[p]);
+        plainOut.push_back(m.reflectance[p]);
+      }
+    }
+  // Three shots merge the noise to 3 % / sqrt 3 = 1.7 %, and the granite is smoothed only within
+  // that (measured: 1.6 %); pooled within B's error, it is near its window's mean.
+  EXPECT_LT(std::sqrt(kept / count), 0.025);
+  EXPECT_GT(std::sqrt(blurred / count), 0.08);
+  EXPECT_LT(spread(plainOut, 0), spread(plainIn, 0) / 4.0);
+}
+
 } // namespace
 } // namespace obscura::recover
