@@ -35,5 +35,29 @@ TEST(ObjectMeans, AnUnseenObjectTakesItsMaterialsSeenMeanElseTheGreyOfEverySeenP
   EXPECT_NEAR(coloured[1].z, grey, 1e-6f);
 }
 
+TEST(ObjectMeans, AnObjectSeenButNeverMergedTakesWhatItsPhotographsSayNotTheUnknownGrey) {
+  // Object 0 merged at 0.5; object 1 seen in two pixels, neither merged (a sliver in a penumbra),
+  // nearly black; object 2 seen in one pixel nothing lights.
+  const std::vector<std::int32_t> object{0, 1, 1, 2};
+  const std::vector<glm::vec3> reflectance{glm::vec3(0.5f), glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
+  const std::vector<float> confidence{1.0f, 0.0f, 0.0f, 0.0f};
+  // Two shots: the photographs' sums over object 1 are 0.01 + 0.03 and 0.02 + 0.02; its light's
+  // (D + B) 0.2 + 0.6 and 0.4 + 0.4: the ratio 0.08 / 1.6 = 0.05, whatever the split.
+  const std::vector<std::vector<glm::vec3>> photos{{glm::vec3(0.6f), glm::vec3(0.01f), glm::vec3(0.03f), glm::vec3(0.0f)},
+                                                   {glm::vec3(0.6f), glm::vec3(0.02f), glm::vec3(0.02f), glm::vec3(0.0f)}};
+  const std::vector<std::vector<glm::vec3>> direct{{glm::vec3(0.8f), glm::vec3(0.1f), glm::vec3(0.0f), glm::vec3(0.0f)},
+                                                   {glm::vec3(0.8f), glm::vec3(0.0f), glm::vec3(0.4f), glm::vec3(0.0f)}};
+  const std::vector<std::vector<glm::vec3>> indirect{{glm::vec3(0.2f), glm::vec3(0.1f), glm::vec3(0.6f), glm::vec3(0.0f)},
+                                                     {glm::vec3(0.2f), glm::vec3(0.4f), glm::vec3(0.0f), glm::vec3(0.0f)}};
+  const auto ratios = photographedRatios(photos, direct, indirect, object, 3);
+  ASSERT_TRUE(ratios[1]);
+  EXPECT_NEAR(ratios[1]->x, 0.05f, 1e-6f);
+  EXPECT_FALSE(ratios[2]); // nothing lights it: the photographs say nothing
+  const std::vector<glm::vec3> means = objectMeans(reflectance, confidence, object, 3, nullptr, &ratios);
+  EXPECT_FLOAT_EQ(means[0].x, 0.5f);                 // its merged pixel, not its ratio (0.6)
+  EXPECT_NEAR(means[1].x, 0.05f, 1e-6f);             // without the ratio: the grey of all, 0.5
+  EXPECT_NEAR(means[2].x, 0.5f, 1e-6f);              // the unknown grey
+}
+
 } // namespace
 } // namespace obscura::recover

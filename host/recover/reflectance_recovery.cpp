@@ -163,7 +163,8 @@ std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, cons
 
 std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
                                    const std::vector<std::int32_t>& object, std::size_t objects,
-                                   const std::vector<std::uint32_t>* objectMaterial) {
+                                   const std::vector<std::uint32_t>* objectMaterial,
+                                   const std::vector<std::optional<glm::vec3>>* photographed) {
   std::vector<glm::dvec3> sum(objects, glm::dvec3(0.0));
   std::vector<double> weight(objects, 0.0);
   glm::dvec3 all(0.0);
@@ -196,6 +197,10 @@ std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, co
       means[o] = glm::vec3(sum[o] / weight[o]);
       continue;
     }
+    if (photographed && (*photographed)[o]) {
+      means[o] = *(*photographed)[o];
+      continue;
+    }
     means[o] = fallback;
     if (objectMaterial) {
       const auto& m = byMaterial[(*objectMaterial)[o]];
@@ -203,6 +208,25 @@ std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, co
     }
   }
   return means;
+}
+
+std::vector<std::optional<glm::vec3>> photographedRatios(const std::vector<std::vector<glm::vec3>>& photos,
+                                                         const std::vector<std::vector<glm::vec3>>& direct,
+                                                         const std::vector<std::vector<glm::vec3>>& indirect,
+                                                         const std::vector<std::int32_t>& object, std::size_t objects) {
+  std::vector<glm::dvec3> photographed(objects, glm::dvec3(0.0)), light(objects, glm::dvec3(0.0));
+  for (std::size_t i = 0; i < photos.size(); ++i)
+    for (std::size_t p = 0; p < object.size(); ++p) {
+      if (object[p] < 0) continue;
+      const auto o = static_cast<std::size_t>(object[p]);
+      photographed[o] += glm::dvec3(photos[i][p]);
+      light[o] += glm::dvec3(direct[i][p] + indirect[i][p]);
+    }
+  std::vector<std::optional<glm::vec3>> ratios(objects);
+  for (std::size_t o = 0; o < objects; ++o)
+    if (light[o].x > 0.0 && light[o].y > 0.0 && light[o].z > 0.0)
+      ratios[o] = glm::min(glm::vec3(photographed[o] / light[o]), glm::vec3(1.0f));
+  return ratios;
 }
 
 Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
@@ -316,9 +340,20 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.indirect = ambient;
   out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters, surfaces);
   WeightedMerge merged = mergeShots(photos, lighting, ambient, out.estimates, out.confidences, options);
+  // What the photographs say of the objects none of whose pixels merged (the weighted merge's;
+  // the paper's gives them their material's mean as it did).
+  std::vector<std::vector<glm::vec3>> radiance;
+  for (const auto& shot : photos.shots) radiance.push_back(shot.radiance);
+  const auto photographed = [&](const std::vector<std::vector<glm::vec3>>& indirect) {
+    std::vector<std::optional<glm::vec3>> ratios(objects);
+    if (options.merge == MergeModel::Weighted)
+      ratios = photographedRatios(radiance, lighting.direct, indirect, lighting.geometry.object, objects);
+    return ratios;
+  };
+  std::vector<std::optional<glm::vec3>> ratios = photographed(ambient);
   out.iterations.push_back({0, secondsSince(stepStart), 0.0,
                             objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects,
-                                        &objectMaterial)});
+                                        &objectMaterial, &ratios)});
   if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
 
   // The device's rays through the renderer's traversal: the gather's and the pixels' footprints.
@@ -368,8 +403,9 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
         }
       merged = std::move(next);
       const double change = n > 0 ? std::sqrt(sum / double(n)) : 0.0;
+      ratios = photographed(out.indirect);
       std::vector<glm::vec3> nextMeans = objectMeans(merged.reflectance, inverseVariance(merged),
-                                                     lighting.geometry.object, objects, &objectMaterial);
+                                                     lighting.geometry.object, objects, &objectMaterial, &ratios);
       if (out.iterations.size() >= 2) dampSwings(out.iterations[out.iterations.size() - 2].objectReflectance, means, nextMeans);
       out.iterations.push_back({it, secondsSince(stepStart), change, std::move(nextMeans)});
       if (log) log(fmt::format("recover: iteration {}: RMS change of R {:.5f}, {:.1f} s", it, change, secondsSince(stepStart)));

@@ -19,6 +19,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -147,11 +148,23 @@ std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, cons
                                        float k);
 
 // The confidence-weighted mean reflectance of each object's pixels; objects with no confident
-// pixel get the mean over the confident pixels of the objects of their material
-// (`objectMaterial`), or, with none, a grey of the luminance of the mean over all confident
-// pixels (an unknown colour: not the room's dominant one).
+// pixel get their `photographed` ratio where it has one (the camera sees them, but no estimate
+// of theirs merged: slivers and penumbrae), else the mean over the confident pixels of the
+// objects of their material (`objectMaterial`), or, with none, a grey of the luminance of the
+// mean over all confident pixels (an unknown colour: not the room's dominant one).
 std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
                                    const std::vector<std::int32_t>& object, std::size_t objects,
-                                   const std::vector<std::uint32_t>* objectMaterial = nullptr);
+                                   const std::vector<std::uint32_t>* objectMaterial = nullptr,
+                                   const std::vector<std::optional<glm::vec3>>* photographed = nullptr);
+
+// Per object, sum_i sum_p C_i(p) / sum_i sum_p (D_i + B_i)(p) per channel over its pixels p and
+// the shots i (at most 1): the ratio estimate of its reflectance, the light weighting each
+// estimate. What the photographs say of an object none of whose pixels merged; the classroom's
+// ceiling bar (16 px, 2 rows, in a penumbra in every shot; true 0.02) took the unknown grey, 0.62.
+// None where nothing lights the object's pixels.
+std::vector<std::optional<glm::vec3>> photographedRatios(const std::vector<std::vector<glm::vec3>>& photos,
+                                                         const std::vector<std::vector<glm::vec3>>& direct,
+                                                         const std::vector<std::vector<glm::vec3>>& indirect,
+                                                         const std::vector<std::int32_t>& object, std::size_t objects);
 
 } // namespace obscura::recover
