@@ -70,7 +70,8 @@ struct RecoveryOptions {
   render::AmbientModel ambient = render::AmbientModel::Reached; // of kRecoveryAmbientNames
   FilterOptions filters;
   MergeModel merge = MergeModel::Weighted;
-  WeightedMergeOptions weighted;
+  // The weighted merge's; the kept merge smoothed over a 65 x 65 window (the iterations' over 7 x 7).
+  WeightedMergeOptions weighted{.smoothingRadius = 32};
 };
 
 // One render's lighting per photo, per unit reflectance, and what the pixels see.

@@ -12,6 +12,7 @@ namespace {
 
 constexpr int kTile = 16;             // tile side, pixels
 constexpr int kStep = kTile / 2;     // tiles overlap by half: the raised-cosine weights sum to 1
+constexpr int kRim = 4;              // pixels: how far a source pixel must be from the source's edge to give the mean and tiles
 constexpr int kMeanRadius = 12;      // the local mean: a 25x25 window
 constexpr float kSamePlane = 0.95f;  // normals of one surface
 
@@ -87,15 +88,47 @@ std::vector<glm::vec3> fillByTexture(const TextureFillInput& in, TextureFillRepo
     if (sources == 0) continue; // nothing of this surface was photographed: left as it was
     const auto maskTable = summedArea(sourceMask, W, H);
     const auto valueTable = summedArea(sourceValue, W, H);
+    // Whether a source pixel is kRim pixels clear of the source's edge (its window inside the
+    // image wholly source): the rim holds the recovery's edge errors (footprints that mix
+    // surfaces), several times the interior's variance, which a fill should copy neither into its
+    // mean nor into its texture.
+    const auto clear = [&](int x, int y, int w, int h) {
+      const int rx0 = std::max(0, x - kRim), ry0 = std::max(0, y - kRim);
+      const int rx1 = std::min(W, x + w + kRim), ry1 = std::min(H, y + h + kRim);
+      return boxSum(maskTable, W, H, rx0, ry0, rx1, ry1) == float((rx1 - rx0) * (ry1 - ry0));
+    };
+    std::vector<float> clearMask(pixels, 0.0f);
+    std::vector<glm::dvec3> clearValue(pixels, glm::dvec3(0.0));
+    std::size_t clearSources = 0;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const std::size_t p = std::size_t(y) * W + x;
+        if (sourceMask[p] == 0.0f || !clear(x, y, 1, 1)) continue;
+        clearMask[p] = 1.0f;
+        clearValue[p] = sourceValue[p];
+        ++clearSources;
+      }
+    // A surface photographed only along its rim (a sliver of mixed normals at an edge) has
+    // nothing but edge errors to copy: left as it was (the caller's guess, remodel's object mean).
+    if (clearSources == 0) {
+      local.rimOnly += surface.hole.size();
+      continue;
+    }
+    const auto clearMaskTable = summedArea(clearMask, W, H);
+    const auto clearValueTable = summedArea(clearValue, W, H);
     glm::dvec3 globalMean = boxSum(valueTable, W, H, 0, 0, W, H) / double(sources);
-    // M over the source: the 9x9 mean of the surface's source pixels.
+    // M over the source: the 25x25 mean of the surface's source pixels clear of its rim (of all
+    // its source pixels where the window holds none).
     std::vector<glm::vec3> mean(pixels, glm::vec3(globalMean));
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
         const std::size_t p = std::size_t(y) * W + x;
         if (sourceMask[p] == 0.0f) continue;
         const int x0 = x - kMeanRadius, y0 = y - kMeanRadius, x1 = x + kMeanRadius + 1, y1 = y + kMeanRadius + 1;
-        mean[p] = glm::vec3(boxSum(valueTable, W, H, x0, y0, x1, y1) / double(boxSum(maskTable, W, H, x0, y0, x1, y1)));
+        const float inside = boxSum(clearMaskTable, W, H, x0, y0, x1, y1);
+        mean[p] = inside > 0.0f
+                      ? glm::vec3(boxSum(clearValueTable, W, H, x0, y0, x1, y1) / double(inside))
+                      : glm::vec3(boxSum(valueTable, W, H, x0, y0, x1, y1) / double(boxSum(maskTable, W, H, x0, y0, x1, y1)));
       }
     // M inside the hole: Laplace's equation with the source's M on the border (Dirichlet) and
     // nothing across other surfaces (Neumann), by successive over-relaxation.
@@ -124,11 +157,17 @@ std::vector<glm::vec3> fillByTexture(const TextureFillInput& in, TextureFillRepo
       }
       if (change < 1e-6f) break;
     }
-    // D: tiles of the source's deviation from its mean, from windows the photographs saw fully.
+    // D: tiles of the source's deviation from its mean, from windows the photographs saw fully,
+    // clear of the rim where the surface has such windows.
     std::vector<std::pair<int, int>> tiles;
-    for (int y = 0; y + kTile <= H; ++y)
-      for (int x = 0; x + kTile <= W; ++x)
-        if (boxSum(maskTable, W, H, x, y, x + kTile, y + kTile) == float(kTile * kTile)) tiles.emplace_back(x, y);
+    for (const bool clearOfRim : {true, false}) {
+      for (int y = 0; y + kTile <= H; ++y)
+        for (int x = 0; x + kTile <= W; ++x)
+          if (clearOfRim ? clear(x, y, kTile, kTile)
+                         : boxSum(maskTable, W, H, x, y, x + kTile, y + kTile) == float(kTile * kTile))
+            tiles.emplace_back(x, y);
+      if (!tiles.empty()) break;
+    }
     if (tiles.empty()) {
       for (std::size_t p : surface.hole) out[p] = glm::max(mean[p], glm::vec3(0.0f));
       local.meanOnly += surface.hole.size();

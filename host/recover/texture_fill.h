@@ -40,10 +40,13 @@ struct TextureFillReport {
   std::size_t holePixels = 0;
   std::size_t tiles = 0;           // tiles laid over the holes
   std::size_t meanOnly = 0;        // hole pixels whose surface had no full source tile (mean only)
+  std::size_t rimOnly = 0;         // hole pixels whose surface was photographed only along its rim (left as they were)
 };
 
 // `input.reflectance` with every hole pixel synthesized from its surface's source pixels (or,
-// with no source pixel of its surface at all, left as it was).
+// with no source pixel of its surface at all, or only ones within kRim of the source's edge,
+// left as it was). The source's rim (kRim = 4 pixels) gives neither the mean nor the texture
+// where the surface has pixels clear of it.
 std::vector<glm::vec3> fillByTexture(const TextureFillInput& input, TextureFillReport* report = nullptr);
 
 } // namespace obscura::recover

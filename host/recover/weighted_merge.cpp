@@ -196,14 +196,14 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
       out.relativeVariance[p] = static_cast<float>(1.0 / wholeSum[p]);
       out.independentVariance[p] = static_cast<float>(independentSum[p] / (weightSum[p] * weightSum[p]));
     }
-  if (options.smoothingRadius > 0) {
-    out.texturedObjects = texturedObjects(out.reflectance, out.independentVariance, pixels);
-    std::vector<float> tolerance = out.relativeVariance;
-    for (std::size_t p = 0; p < n; ++p)
-      if (pixels.object[p] >= 0 && out.texturedObjects[std::size_t(pixels.object[p])]) tolerance[p] = out.independentVariance[p];
-    out.reflectance = smoothByNoise(out.reflectance, out.relativeVariance, pixels, options.smoothingRadius,
-                                    options.agreement, &tolerance);
-  }
+  out.unsmoothed = out.reflectance;
+  out.texturedObjects = texturedObjects(out.reflectance, out.independentVariance, pixels);
+  out.tolerance = out.relativeVariance;
+  for (std::size_t p = 0; p < n; ++p)
+    if (pixels.object[p] >= 0 && out.texturedObjects[std::size_t(pixels.object[p])]) out.tolerance[p] = out.independentVariance[p];
+  if (options.smoothingRadius > 0)
+    out.reflectance = smoothByNoise(out.unsmoothed, out.relativeVariance, pixels, options.smoothingRadius,
+                                    options.agreement, &out.tolerance);
   return out;
 }
 
@@ -263,24 +263,29 @@ std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, 
   std::vector<glm::vec3> out = reflectance;
   const float a2 = agreement * agreement;
   const std::vector<float>& within = tolerance ? *tolerance : variance;
-  forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
-    if (variance[p] <= 0.0f) return;
-    const glm::vec3 rp = reflectance[p];
-    const glm::vec3 sp = within[p] * rp * rp; // per channel sigma^2
-    glm::dvec3 sum(0.0);
-    double weight = 0.0;
-    forSurfaceWindow(pixels, x, y, radius, [&](std::size_t q) {
-      if (variance[q] <= 0.0f) return;
-      const glm::vec3 rq = reflectance[q];
-      const glm::vec3 d = rq - rp, s = sp + within[q] * rq * rq;
-      for (int c = 0; c < 3; ++c)
-        if (d[c] * d[c] > a2 * s[c]) return;
-      // Relative variances weigh: absolute ones would favour the darker of two noisy pixels.
-      const double w = 1.0 / variance[q];
-      sum += w * glm::dvec3(rq);
-      weight += w;
-    });
-    out[p] = glm::vec3(sum / weight);
+  parallelFor(std::size_t(pixels.height), [&](std::size_t row) {
+    const int y = int(row);
+    for (int x = 0; x < pixels.width; ++x) {
+      const std::size_t p = std::size_t(y) * pixels.width + x;
+      if (pixels.object[p] < 0 || variance[p] <= 0.0f) continue;
+      const glm::vec3 rp = reflectance[p];
+      const glm::vec3 sp = within[p] * rp * rp; // per channel sigma^2
+      glm::dvec3 sum(0.0);
+      double weight = 0.0;
+      for (int wy = std::max(0, y - radius); wy <= std::min(pixels.height - 1, y + radius); ++wy)
+        for (int wx = std::max(0, x - radius); wx <= std::min(pixels.width - 1, x + radius); ++wx) {
+          const std::size_t q = std::size_t(wy) * pixels.width + wx;
+          if (!sameSurface(pixels, p, q) || variance[q] <= 0.0f) continue;
+          const glm::vec3 rq = reflectance[q];
+          const glm::vec3 d = rq - rp, s = sp + within[q] * rq * rq;
+          if (d.x * d.x > a2 * s.x || d.y * d.y > a2 * s.y || d.z * d.z > a2 * s.z) continue;
+          // Relative variances weigh: absolute ones would favour the darker of two noisy pixels.
+          const double w = 1.0 / variance[q];
+          sum += w * glm::dvec3(rq);
+          weight += w;
+        }
+      out[p] = glm::vec3(sum / weight);
+    }
   });
   return out;
 }

@@ -55,7 +55,8 @@ namespace obscura::recover {
 struct WeightedMergeOptions {
   float indirectUncertainty = 0.25f; // e_B: relative error of the modelled indirect light
   int shadowRadius = 2;              // the window an indirect-only estimate must be in shadow over
-  int smoothingRadius = 3;           // smoothByNoise's window radius (0: no smoothing)
+  int smoothingRadius = 3;           // smoothByNoise's window radius (0: no smoothing; the recovery's is
+                                     // RecoveryOptions' and wider)
   float agreement = 2.5f;            // smoothByNoise: standard deviations within which pixels pool
 };
 
@@ -83,6 +84,9 @@ struct WeightedMerge {
   // what differs from pixel to pixel, where B's error is shared by neighbours. 0 where nothing informs.
   std::vector<float> independentVariance;
   std::vector<bool> texturedObjects;        // per object: smoothed within independentVariance (texturedObjects below)
+  std::vector<glm::vec3> unsmoothed;        // the merged R before the smoothing
+  std::vector<float> tolerance;             // the smoothing's tolerance per pixel: relativeVariance, or on a
+                                            // textured object independentVariance
   std::vector<float> directConfidence;      // sum of the paper's K_i over the lit estimates
   std::vector<float> indirectShots;         // how many indirect-only estimates the pixel has
   std::vector<std::vector<float>> weights;  // [shot][pixel] w_i (direct or indirect-only)
@@ -127,7 +131,7 @@ std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, con
                                   const PixelGeometry& pixels);
 
 // The sigma filter above on `reflectance` with relative variances `variance` (the weights, and
-// the tolerance unless `tolerance` gives the tolerance's own).
+// the tolerance unless `tolerance` gives the tolerance's own). Rows in parallel.
 std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,
                                      const PixelGeometry& pixels, int radius, float agreement,
                                      const std::vector<float>* tolerance = nullptr);

@@ -137,12 +137,15 @@ Stats stats(const std::vector<glm::vec3>& values, const std::vector<std::size_t>
 // synthesized from what the photographs saw of them. The floor's fill is compared with the
 // visible floor's interior (pixels whose 9x9 window is measured floor: the fill's texture source;
 // the floor's rim holds the recovery's edge errors, variance 4-8 times the interior's, which a
-// fill should not copy). Measured: interior mean (0.7255, 0.7077, 0.6805), variance
-// (1.4, 1.7, 1.3)e-4; fill (0.7328, 0.7170, 0.6865), (1.05, 1.11, 0.86)e-4. Tolerances: the
-// mean within 0.015 (the recovery's lit RMSE, 0.017, is what the visible floor itself is known
-// to; the fill's mean has a standard error of ~0.004 from its ~9 independent 16x16 tiles); the
-// variance within a factor 2 (a fill of the mean alone has 1/10 of it, no fill at all has the
-// mean 0); across the fill's seam neighbouring pixels differ no more than 1.5 times as much as
+// fill should not copy). Measured: interior mean (0.7194, 0.7068, 0.6785), variance
+// (5.9, 2.5, 0.5)e-6; fill (0.7232, 0.7075, 0.6783), (1.2, 4.7, 1.8)e-6 (the recovery smooths a
+// plain floor over a 65 x 65 window: before, the interior's variance was (1.4, 1.7, 1.3)e-4).
+// Tolerances: the mean within 0.015 (the recovery's lit RMSE, 0.017 at 4 spp, is what the
+// visible floor itself is known to; the fill's mean has a standard error of ~0.004 from its ~9
+// independent 16x16 tiles); the variance within a factor 2 (a fill of the mean alone has 1/10 of
+// it, no fill at all has the mean 0) where the interior has a texture, and where it is flat
+// (below kFlat^2) the fill flat too: a fill that copied the rim's mean into its edge pixels had
+// 3-5e-5; across the fill's seam neighbouring pixels differ no more than 1.5 times as much as
 // inside the visible floor. Every pixel more than the silhouette band away from the box keeps
 // its recovered reflectance exactly.
 TEST_F(RemodelCornell, RemovedShortBoxUncoversAFloorWithTheVisibleFloorsStatistics) {
@@ -179,10 +182,17 @@ TEST_F(RemodelCornell, RemovedShortBoxUncoversAFloorWithTheVisibleFloorsStatisti
               v.mean.x, v.mean.y, v.mean.z, v.variance.x, v.variance.y, v.variance.z);
   std::printf("floor: filled %zu px, mean (%.4f, %.4f, %.4f), variance (%.2e, %.2e, %.2e)\n", f.pixels, f.mean.x,
               f.mean.y, f.mean.z, f.variance.x, f.variance.y, f.variance.z);
+  // A spread below 0.3 % is a flat surface: under half the recovery's lit RMSE (0.0066), nothing
+  // to match.
+  constexpr double kFlat = 0.003;
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(f.mean[c], v.mean[c], 0.015) << "channel " << c;
-    EXPECT_GT(f.variance[c], 0.5 * v.variance[c]) << "channel " << c;
-    EXPECT_LT(f.variance[c], 2.0 * v.variance[c]) << "channel " << c;
+    if (v.variance[c] > kFlat * kFlat) {
+      EXPECT_GT(f.variance[c], 0.5 * v.variance[c]) << "channel " << c;
+      EXPECT_LT(f.variance[c], 2.0 * v.variance[c]) << "channel " << c;
+    } else {
+      EXPECT_LT(f.variance[c], kFlat * kFlat) << "channel " << c;
+    }
   }
   // The seam: neighbouring floor pixels, one synthesized and one visible, against two visible.
   double seam = 0.0, inside = 0.0;
