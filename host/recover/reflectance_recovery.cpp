@@ -424,13 +424,14 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   // visibilities, less the estimates the outlier test rejects on them; lit by no lamp at all, the
   // object's mean (measured better there than the surface's nearby pixels, themselves lit only
   // indirectly: the classroom's shadow RMSE 0.093 against 0.112).
-  // The kept merge smoothed over the whole radius: on a plain surface what a wide window averages
-  // out is the indirect light's error, blotches ~10 px across that a 7 x 7 window's pixels share
-  // (classroom 0.0499 -> 0.0377 at radius 32, Cornell box 0.0145 -> 0.0093; BENCHMARKS).
+  // The kept merge smoothed over the whole radius, across an object's faces: on a plain surface
+  // what a wide window averages out is the indirect light's error, blotches ~10 px across that a
+  // 7 x 7 window's pixels share, and on a curved one (the chairs' tubes) the errors of its faces
+  // (classroom 0.0499 -> 0.0333 at radius 32, Cornell box 0.0145 -> 0.0084; BENCHMARKS).
   if (options.merge == MergeModel::Weighted && options.weighted.smoothingRadius > kIterationSmoothingRadius)
     merged.reflectance = smoothByNoise(merged.unsmoothed, merged.relativeVariance, lighting.geometry,
                                        options.weighted.smoothingRadius, options.weighted.agreement,
-                                       &merged.tolerance);
+                                       &merged.tolerance, true);
   std::vector<ConfidenceImage> fillWeights = lighting.visibility;
   if (options.filters.outlier)
     outlierTest(out.estimates, fillWeights, options.filters.outlierConfidence, options.filters.outlierDistance);

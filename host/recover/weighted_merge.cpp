@@ -259,7 +259,7 @@ std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, con
 
 std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,
                                      const PixelGeometry& pixels, int radius, float agreement,
-                                     const std::vector<float>* tolerance) {
+                                     const std::vector<float>* tolerance, bool acrossNormals) {
   std::vector<glm::vec3> out = reflectance;
   const float a2 = agreement * agreement;
   const std::vector<float>& within = tolerance ? *tolerance : variance;
@@ -275,7 +275,8 @@ std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, 
       for (int wy = std::max(0, y - radius); wy <= std::min(pixels.height - 1, y + radius); ++wy)
         for (int wx = std::max(0, x - radius); wx <= std::min(pixels.width - 1, x + radius); ++wx) {
           const std::size_t q = std::size_t(wy) * pixels.width + wx;
-          if (!sameSurface(pixels, p, q) || variance[q] <= 0.0f) continue;
+          const bool alike = acrossNormals ? pixels.object[q] == pixels.object[p] : sameSurface(pixels, p, q);
+          if (!alike || variance[q] <= 0.0f) continue;
           const glm::vec3 rq = reflectance[q];
           const glm::vec3 d = rq - rp, s = sp + within[q] * rq * rq;
           if (d.x * d.x > a2 * s.x || d.y * d.y > a2 * s.y || d.z * d.z > a2 * s.z) continue;

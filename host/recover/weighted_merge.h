@@ -131,9 +131,12 @@ std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, con
                                   const PixelGeometry& pixels);
 
 // The sigma filter above on `reflectance` with relative variances `variance` (the weights, and
-// the tolerance unless `tolerance` gives the tolerance's own). Rows in parallel.
+// the tolerance unless `tolerance` gives the tolerance's own). With `acrossNormals` the window's
+// pixels of the centre's object pool whatever their normal (a reflectance belongs to the object,
+// and its faces' indirect light errs apart: the recovery's wide pass; the tolerance still keeps
+// apart what differs by more than the noise). Rows in parallel.
 std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,
                                      const PixelGeometry& pixels, int radius, float agreement,
-                                     const std::vector<float>* tolerance = nullptr);
+                                     const std::vector<float>* tolerance = nullptr, bool acrossNormals = false);
 
 } // namespace obscura::recover

@@ -371,5 +371,31 @@ TEST(WeightedMerge, TheSmoothingKeepsAnIndirectlyLitTextureAndFlattensAPlainWall
   EXPECT_LT(spread(plainOut, 0), spread(plainIn, 0) / 4.0);
 }
 
+TEST(WeightedMerge, TheWidePassPoolsAnObjectsFacesWhoseIndirectLightErrsApart) {
+  // One object of reflectance 0.6 seen as two faces (a bent sheet: normals 90 degrees apart),
+  // each face's estimate off by its own indirect light's error (+5 % and -5 %), 1 % noise, the
+  // merge's variance wide with B's error (10 %).
+  const int w = 20, h = 20;
+  PixelGeometry g = wall(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      g.normal[std::size_t(y) * w + x] = glm::normalize(glm::vec3(x < w / 2 ? 1.0f : -1.0f, 0.0f, 1.0f));
+  std::mt19937 rng(9);
+  std::normal_distribution<float> noise(0.0f, 0.01f);
+  std::vector<glm::vec3> r(std::size_t(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) r[std::size_t(y) * w + x] = glm::vec3(0.6f * (x < w / 2 ? 1.05f : 0.95f) * (1.0f + noise(rng)));
+  const std::vector<float> variance(r.size(), 0.1f * 0.1f);
+  const std::vector<glm::vec3> faces = smoothByNoise(r, variance, g, 32, 2.5f);
+  const std::vector<glm::vec3> object = smoothByNoise(r, variance, g, 32, 2.5f, nullptr, true);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t p = std::size_t(y) * w + x;
+      // Each face alone keeps its error; the faces together average it out.
+      EXPECT_NEAR(faces[p].x, 0.6f * (x < w / 2 ? 1.05f : 0.95f), 0.003f) << x << "," << y;
+      EXPECT_NEAR(object[p].x, 0.6f, 0.003f) << x << "," << y;
+    }
+}
+
 } // namespace
 } // namespace obscura::recover
