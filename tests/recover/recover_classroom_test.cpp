@@ -6,20 +6,16 @@
 // Measured at the defaults (spp 8, 16 gather rays from 4 points of each pixel, 3 hidden bounces cut
 // per object, confidences filtered along surfaces, the weighted merge with each photograph's noise
 // measured without its texture and each shot weighed by its indirect light's longer paths, the
-// pixels the filters left filled from their surface, unseen objects at their material's mean, the
-// object means' swings damped; seeds 1, 2, 3) on the photographs rendered at 16 bounces
-// (docs/BENCHMARKS.md "The photographs' bounces", "Pixels the filters left"):
-//   lit 0.0174 / 0.0169 / 0.0166   lit in some photo 0.0573 / 0.0567 / 0.0568   all 0.0625 / 0.0622 / 0.0620
-//   shadow (no lamp lights the pixel) 0.0929 / 0.0936 / 0.0922
-//   the walls' mean ratio to the truth 1.001; the first design: all 0.2196 (outliers up to R = 45).
-// Before the surface fill (raw estimates by visibility there): lit in some photo 0.0613 / 0.0613 /
-// 0.0605, all 0.0658 / 0.0659 / 0.0650; before that the same merge with the noise measured
-// on each photograph alone: lit 0.0191 / 0.0186 / 0.0180, all 0.0661 / 0.0665 / 0.0655.
-// (On the first photographs, which stopped at 6 bounces: all 0.0675 / 0.0679 / 0.0668, shadow
-// 0.0962-0.0992, the walls 0.994.)
+// kept merge smoothed over a 65 x 65 window across each plain object's faces and a textured
+// object's within its photographs' noise, the footprints' mix; seeds 1, 2, 3) on the
+// photographs rendered at 16 bounces (docs/BENCHMARKS.md "Recovery: smoothing by what a surface is"):
+//   lit 0.0127 / 0.0127 / 0.0121   lit in some photo 0.0303 / 0.0307 / 0.0298   all 0.0333 / 0.0357 / 0.0345
+//   shadow (no lamp lights the pixel) 0.0502 / 0.0612 / 0.0590
+// Before the wide smoothing (a 7 x 7 window on one face), seed 1: lit 0.0172, lit in some photo
+// 0.0444, all 0.0499, shadow 0.0799; before the footprints' mix 0.0573 / 0.0625 (all).
 // The bounds below are the largest of the three plus 10 %, several times the seed-to-seed spread;
-// they are not issue 36's goals (all 0.04, lit in some photo 0.02), which this room does not meet
-// yet. On the 6-bounce photographs, with the gather's rays from each pixel's mean point, all was 0.0968 and lit 0.0361
+// issue 36's goals are all 0.04 (met) and lit in some photo 0.02 (not yet). On the 6-bounce
+// photographs, with the gather's rays from each pixel's mean point, all was 0.0968 and lit 0.0361
 // (a chair's tubular frame: the point inside the tube); cut with the pixels' mean B the shadow
 // pixels came out at 0.1396; with the seen objects' mean colour for every unseen object, at
 // 0.117. These fail here. Filtered in image windows, 6,829 pixels (chairs'
@@ -50,10 +46,10 @@ TEST_F(RecoverClassroom, ALargerRoomIsRecoveredToItsMeasuredAccuracyWithEveryRef
   const Recovery r =
       recoverReflectance(context(), room.scene, room.bvh, room.scene.cameras.at(0), photos, RecoveryOptions{});
   const RecoveryAccuracy a = recoveryAccuracy(r.reflectance, truth, lightRegions(r.visibility, r.object));
-  EXPECT_LE(a.lit.rmse, 0.0192);
-  EXPECT_LE(a.direct.rmse, 0.0630);
-  EXPECT_LE(a.all.rmse, 0.0688);
-  EXPECT_LE(a.shadow.rmse, 0.103);
+  EXPECT_LE(a.lit.rmse, 0.0140);
+  EXPECT_LE(a.direct.rmse, 0.0338);
+  EXPECT_LE(a.all.rmse, 0.0393);
+  EXPECT_LE(a.shadow.rmse, 0.0673);
   // The iteration settles instead of swinging between high and low object means.
   EXPECT_LT(r.iterations.back().rmsChange, 0.01);
   // A quarter of the pixels no lamp lights; the merge recovers some of them from their indirect
