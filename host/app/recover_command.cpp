@@ -261,7 +261,7 @@ void addRecoverCommand(CLI::App& app) {
                   "weighted: relative error assumed of the modelled indirect light")
       ->check(CLI::Range(0.001f, 10.0f));
   cmd->add_option("--smoothing-radius", o->recovery.weighted.smoothingRadius,
-                  "weighted: window radius of the smoothing along surfaces (0: none)")
+                  "weighted: window radius of the kept merge's smoothing over each object (the iterations' at most 3; 0: none)")
       ->check(CLI::Range(0, 32));
   cmd->add_flag("--no-min-filter", o->noMin, "skip the 5x5 min filter");
   cmd->add_flag("--no-lower-smoothing", o->noLowerSmoothing, "skip the 5x5 lowering smoothing");

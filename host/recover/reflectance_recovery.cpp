@@ -87,9 +87,9 @@ std::vector<std::vector<glm::vec3>> estimatesWith(const PhotoSet& photos, const 
   return r;
 }
 
-// The iterations' merges smooth over at most this radius (the recovery's own, wider, comes after
-// the last: smoothAll): they give the object means the next gather uses, which a wider window
-// barely moves, and their change from one to the next is measured alike.
+// The iterations' merges smooth over at most this radius (the recovery's own, wider, smooths the
+// kept merge after the last): they give the object means the next gather uses, which a wider
+// window barely moves, and their change from one to the next is measured alike.
 constexpr int kIterationSmoothingRadius = 3;
 
 // The estimates merged as `options.merge` says; the paper's mean in WeightedMerge's terms
@@ -419,11 +419,6 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
     }
   }
 
-  // Pixels no filtered confidence reaches, where some lamp still lights them (the filters removed
-  // them): the merged pixels of their own surface nearby (surfaceFill), else the photos' raw
-  // visibilities, less the estimates the outlier test rejects on them; lit by no lamp at all, the
-  // object's mean (measured better there than the surface's nearby pixels, themselves lit only
-  // indirectly: the classroom's shadow RMSE 0.093 against 0.112).
   // The kept merge smoothed over the whole radius, across an object's faces: on a plain surface
   // what a wide window averages out is the indirect light's error, blotches ~10 px across that a
   // 7 x 7 window's pixels share, and on a curved one (the chairs' tubes) the errors of its faces
@@ -432,6 +427,12 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
     merged.reflectance = smoothByNoise(merged.unsmoothed, merged.relativeVariance, lighting.geometry,
                                        options.weighted.smoothingRadius, options.weighted.agreement,
                                        &merged.tolerance, true);
+
+  // Pixels no filtered confidence reaches, where some lamp still lights them (the filters removed
+  // them): the merged pixels of their own surface nearby (surfaceFill), else the photos' raw
+  // visibilities, less the estimates the outlier test rejects on them; lit by no lamp at all, the
+  // object's mean (measured better there than the surface's nearby pixels, themselves lit only
+  // indirectly: the classroom's shadow RMSE 0.093 against 0.112).
   std::vector<ConfidenceImage> fillWeights = lighting.visibility;
   if (options.filters.outlier)
     outlierTest(out.estimates, fillWeights, options.filters.outlierConfidence, options.filters.outlierDistance);
