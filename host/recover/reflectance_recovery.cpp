@@ -423,10 +423,12 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   // what a wide window averages out is the indirect light's error, blotches ~10 px across that a
   // 7 x 7 window's pixels share, and on a curved one (the chairs' tubes) the errors of its faces
   // (classroom 0.0499 -> 0.0333 at radius 32, Cornell box 0.0145 -> 0.0084; BENCHMARKS).
-  if (options.merge == MergeModel::Weighted && options.weighted.smoothingRadius > kIterationSmoothingRadius)
+  if (options.merge == MergeModel::Weighted && options.weighted.smoothingRadius > kIterationSmoothingRadius) {
     merged.reflectance = smoothByNoise(merged.unsmoothed, merged.relativeVariance, lighting.geometry,
                                        options.weighted.smoothingRadius, options.weighted.agreement,
                                        &merged.tolerance, true);
+    for (glm::vec3& r : merged.reflectance) r = glm::min(r, glm::vec3(1.0f)); // as weightedMerge: after the smoothing
+  }
 
   // Pixels no filtered confidence reaches, where some lamp still lights them (the filters removed
   // them): the merged pixels of their own surface nearby (surfaceFill), else the photos' raw

@@ -171,7 +171,7 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
       // No diffuse surface reflects more than it receives: an estimate above 1 by more than
       // three of its own standard deviations says the lighting model is wrong at this pixel,
       // not the surface. (Within them it stays: cutting a noisy estimate's upper tail alone
-      // would bias what is kept low; the merged R is clamped to 1 instead.)
+      // would bias what is kept low; the merged R is clamped to 1 instead, after its smoothing.)
       const glm::vec3 r = estimates[i][p];
       if (std::max({r.x, r.y, r.z}) > 1.0f + 3.0f * std::sqrt(v)) return;
       float k = confidences[i].k[p];
@@ -192,7 +192,7 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
   }
   for (std::size_t p = 0; p < n; ++p)
     if (weightSum[p] > 0.0) {
-      out.reflectance[p] = glm::min(glm::vec3(sum[p] / weightSum[p]), glm::vec3(1.0f));
+      out.reflectance[p] = glm::vec3(sum[p] / weightSum[p]);
       out.relativeVariance[p] = static_cast<float>(1.0 / wholeSum[p]);
       out.independentVariance[p] = static_cast<float>(independentSum[p] / (weightSum[p] * weightSum[p]));
     }
@@ -204,6 +204,9 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
   if (options.smoothingRadius > 0)
     out.reflectance = smoothByNoise(out.unsmoothed, out.relativeVariance, pixels, options.smoothingRadius,
                                     options.agreement, &out.tolerance);
+  // Clamped after the smoothing: a white surface's estimates scatter both sides of 1, and
+  // clamping each before they average would bias it low.
+  for (glm::vec3& r : out.reflectance) r = glm::min(r, glm::vec3(1.0f));
   return out;
 }
 
