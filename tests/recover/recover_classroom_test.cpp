@@ -7,10 +7,13 @@
 // per object, confidences filtered along surfaces, the weighted merge with each photograph's noise
 // measured without its texture and each shot weighed by its indirect light's longer paths, the
 // kept merge smoothed over a 65 x 65 window across each plain object's faces and a textured
-// object's within its photographs' noise, the footprints' mix; seeds 1, 2, 3) on the
-// photographs rendered at 16 bounces (docs/BENCHMARKS.md "Recovery: smoothing by what a surface is"):
-//   lit 0.0127 / 0.0127 / 0.0121   lit in some photo 0.0303 / 0.0307 / 0.0298   all 0.0333 / 0.0357 / 0.0345
-//   shadow (no lamp lights the pixel) 0.0502 / 0.0612 / 0.0590
+// object's within its photographs' noise, clamped at 1 after that, the footprints' mix; seeds 1,
+// 2, 3) on the photographs rendered at 16 bounces (docs/BENCHMARKS.md "Recovery: smoothing by what
+// a surface is"):
+//   lit 0.0117 / 0.0115 / 0.0109   lit in some photo 0.0301 / 0.0305 / 0.0295   all 0.0332 / 0.0355 / 0.0344
+//   shadow (no lamp lights the pixel) 0.0506 / 0.0615 / 0.0593
+// (Clamped before the smoothing, lit 0.0127 / 0.0127 / 0.0121, all 0.0333 / 0.0357 / 0.0345: the
+// bounds below are from those, the larger.)
 // Before the wide smoothing (a 7 x 7 window on one face), seed 1: lit 0.0172, lit in some photo
 // 0.0444, all 0.0499, shadow 0.0799; before the footprints' mix 0.0573 / 0.0625 (all).
 // The bounds below are the largest of the three plus 10 %, several times the seed-to-seed spread;
