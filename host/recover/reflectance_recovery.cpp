@@ -94,14 +94,12 @@ constexpr int kIterationSmoothingRadius = 3;
 
 // The estimates merged as `options.merge` says; the paper's mean in WeightedMerge's terms
 // (relative variance 1 / sum K_i, no indirect-only estimate, no smoothing).
-WeightedMerge mergeShots(const PhotoSet& photos, const Lighting& lighting,
+WeightedMerge mergeShots(const std::vector<std::vector<glm::vec3>>& radiance, const Lighting& lighting,
                          const std::vector<std::vector<glm::vec3>>& indirect,
                          const std::vector<std::vector<glm::vec3>>& estimates,
                          const std::vector<ConfidenceImage>& confidences, const RecoveryOptions& options,
                          const std::vector<std::vector<float>>* modelled = nullptr) {
   if (options.merge == MergeModel::Weighted) {
-    std::vector<std::vector<glm::vec3>> radiance;
-    for (const auto& shot : photos.shots) radiance.push_back(shot.radiance);
     WeightedMergeOptions weighted = options.weighted;
     weighted.smoothingRadius = std::min(weighted.smoothingRadius, kIterationSmoothingRadius);
     return weightedMerge(radiance, lighting.direct, indirect, estimates, confidences, lighting.visibility,
@@ -346,11 +344,11 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.estimates = estimatesWith(photos, lighting, ambient);
   out.indirect = ambient;
   out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters, surfaces);
-  WeightedMerge merged = mergeShots(photos, lighting, ambient, out.estimates, out.confidences, options);
+  std::vector<std::vector<glm::vec3>> radiance; // the photographs, as the merge and the ratios take them
+  for (const auto& shot : photos.shots) radiance.push_back(shot.radiance);
+  WeightedMerge merged = mergeShots(radiance, lighting, ambient, out.estimates, out.confidences, options);
   // What the photographs say of the objects none of whose pixels merged (the weighted merge's;
   // the paper's gives them their material's mean as it did).
-  std::vector<std::vector<glm::vec3>> radiance;
-  for (const auto& shot : photos.shots) radiance.push_back(shot.radiance);
   const auto photographed = [&](const std::vector<std::vector<glm::vec3>>& indirect) {
     std::vector<std::optional<glm::vec3>> ratios(objects);
     if (options.merge == MergeModel::Weighted)
@@ -398,7 +396,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       }
       out.estimates = estimatesWith(photos, lighting, out.indirect);
       out.confidences = filterConfidences(out.estimates, lighting.visibility, options.filters, surfaces);
-      WeightedMerge next = mergeShots(photos, lighting, out.indirect, out.estimates, out.confidences, options,
+      WeightedMerge next = mergeShots(radiance, lighting, out.indirect, out.estimates, out.confidences, options,
                                       modelled.empty() ? nullptr : &modelled);
       double sum = 0.0;
       std::size_t n = 0;
@@ -423,12 +421,9 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   // what a wide window averages out is the indirect light's error, blotches ~10 px across that a
   // 7 x 7 window's pixels share, and on a curved one (the chairs' tubes) the errors of its faces
   // (classroom 0.0499 -> 0.0333 at radius 32, Cornell box 0.0145 -> 0.0084; BENCHMARKS).
-  if (options.merge == MergeModel::Weighted && options.weighted.smoothingRadius > kIterationSmoothingRadius) {
-    merged.reflectance = smoothByNoise(merged.unsmoothed, merged.relativeVariance, lighting.geometry,
-                                       options.weighted.smoothingRadius, options.weighted.agreement,
-                                       &merged.tolerance, true);
-    for (glm::vec3& r : merged.reflectance) r = glm::min(r, glm::vec3(1.0f)); // as weightedMerge: after the smoothing
-  }
+  if (options.merge == MergeModel::Weighted && options.weighted.smoothingRadius > kIterationSmoothingRadius)
+    merged.reflectance = smoothMerge(merged, lighting.geometry, options.weighted.smoothingRadius,
+                                     options.weighted.agreement, true);
 
   // Pixels no filtered confidence reaches, where some lamp still lights them (the filters removed
   // them): the merged pixels of their own surface nearby (surfaceFill), else the photos' raw

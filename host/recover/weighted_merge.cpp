@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 #include "core/luminance.h"
 #include "core/parallel_for.h"
@@ -46,21 +47,24 @@ bool inShadow(const ConfidenceImage& v, int x, int y, int radius) {
 // Whether at least two thirds of p's clipped 3x3 window (itself included) see its surface: inside
 // a surface or on its straight edge (6 of 9), not a sliver one pixel wide (a face seen edge-on),
 // whose mean point and normal mix two faces and whose gathered light is then another place's.
-bool onSurfacePatch(const PixelGeometry& g, int x, int y) {
+// Of p's clipped 3x3 window (itself included): how many pixels see p's surface, and how many there are.
+std::pair<int, int> surfaceSupport(const PixelGeometry& g, int x, int y) {
   int support = 0;
   forSurfaceWindow(g, x, y, 1, [&](std::size_t) { ++support; });
   const int window = (std::min(g.width - 1, x + 1) - std::max(0, x - 1) + 1) *
                      (std::min(g.height - 1, y + 1) - std::max(0, y - 1) + 1);
+  return {support, window};
+}
+
+bool onSurfacePatch(const PixelGeometry& g, int x, int y) {
+  const auto [support, window] = surfaceSupport(g, x, y);
   return 3 * support >= 2 * window;
 }
 
 // Whether p's whole clipped 3x3 window sees p's surface: not at an edge, where a pixel's
 // footprint may mix two surfaces.
 bool insideSurface(const PixelGeometry& g, int x, int y) {
-  int support = 0;
-  forSurfaceWindow(g, x, y, 1, [&](std::size_t) { ++support; });
-  const int window = (std::min(g.width - 1, x + 1) - std::max(0, x - 1) + 1) *
-                     (std::min(g.height - 1, y + 1) - std::max(0, y - 1) + 1);
+  const auto [support, window] = surfaceSupport(g, x, y);
   return support == window;
 }
 
@@ -198,15 +202,23 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
     }
   out.unsmoothed = out.reflectance;
   out.texturedObjects = texturedObjects(out.reflectance, out.independentVariance, pixels);
-  out.tolerance = out.relativeVariance;
-  for (std::size_t p = 0; p < n; ++p)
-    if (pixels.object[p] >= 0 && out.texturedObjects[std::size_t(pixels.object[p])]) out.tolerance[p] = out.independentVariance[p];
-  if (options.smoothingRadius > 0)
-    out.reflectance = smoothByNoise(out.unsmoothed, out.relativeVariance, pixels, options.smoothingRadius,
-                                    options.agreement, &out.tolerance);
+  out.reflectance = smoothMerge(out, pixels, options.smoothingRadius, options.agreement);
+  return out;
+}
+
+std::vector<glm::vec3> smoothMerge(const WeightedMerge& merged, const PixelGeometry& pixels, int radius,
+                                   float agreement, bool acrossNormals) {
+  std::vector<glm::vec3> out = merged.unsmoothed;
+  if (radius > 0) {
+    std::vector<float> tolerance = merged.relativeVariance;
+    for (std::size_t p = 0; p < tolerance.size(); ++p)
+      if (pixels.object[p] >= 0 && merged.texturedObjects[std::size_t(pixels.object[p])])
+        tolerance[p] = merged.independentVariance[p];
+    out = smoothByNoise(out, merged.relativeVariance, pixels, radius, agreement, &tolerance, acrossNormals);
+  }
   // Clamped after the smoothing: a white surface's estimates scatter both sides of 1, and
   // clamping each before they average would bias it low.
-  for (glm::vec3& r : out.reflectance) r = glm::min(r, glm::vec3(1.0f));
+  for (glm::vec3& r : out) r = glm::min(r, glm::vec3(1.0f));
   return out;
 }
 

@@ -84,9 +84,7 @@ struct WeightedMerge {
   // what differs from pixel to pixel, where B's error is shared by neighbours. 0 where nothing informs.
   std::vector<float> independentVariance;
   std::vector<bool> texturedObjects;        // per object: smoothed within independentVariance (texturedObjects below)
-  std::vector<glm::vec3> unsmoothed;        // the merged R before the smoothing
-  std::vector<float> tolerance;             // the smoothing's tolerance per pixel: relativeVariance, or on a
-                                            // textured object independentVariance
+  std::vector<glm::vec3> unsmoothed;        // the merged R before the smoothing (and before its clamp at 1)
   std::vector<float> directConfidence;      // sum of the paper's K_i over the lit estimates
   std::vector<float> indirectShots;         // how many indirect-only estimates the pixel has
   std::vector<std::vector<float>> weights;  // [shot][pixel] w_i (direct or indirect-only)
@@ -129,6 +127,12 @@ inline constexpr double kTextureRatio = 2.0;
 inline constexpr std::size_t kTexturePairs = 20;
 std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, const std::vector<float>& independentVariance,
                                   const PixelGeometry& pixels);
+
+// A merge's `unsmoothed` R smoothed (smoothByNoise over `radius`, 0: none) with the tolerance the
+// header describes, relativeVariance or, on a textured object, independentVariance, then clamped
+// at 1: weightedMerge's own smoothing, and the recovery's wide pass over the kept merge.
+std::vector<glm::vec3> smoothMerge(const WeightedMerge& merged, const PixelGeometry& pixels, int radius,
+                                   float agreement, bool acrossNormals = false);
 
 // The sigma filter above on `reflectance` with relative variances `variance` (the weights, and
 // the tolerance unless `tolerance` gives the tolerance's own). With `acrossNormals` the window's
