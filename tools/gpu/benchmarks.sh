@@ -3,7 +3,8 @@
 # frame speed) on whatever Vulkan device the bundle finds first by rank (a discrete GPU before a
 # CPU), in one run that fits a 15-minute device lease. BUNDLE_DIR comes from make_bundle.sh.
 # OUT_DIR gets log.txt (everything printed) and a few images and JSON files, at most 8 files.
-# "quick" shrinks every size (and lets modern-hall stand in for Sponza) so that the script itself
+# "quick" shrinks every size (and lets modern-hall stand in for Sponza, less the Sponza steps that
+# would repeat a modern-hall one) so that the script itself
 # can be tried on lavapipe first, as tests/scripts/gpu_benchmarks_smoke.sh does.
 #
 #   bench-rays, both scenes, with the device's own traversal and tree (render/scene_data/bvh_layout.h)
@@ -41,10 +42,16 @@ limit=${STEP_LIMIT:-150}
 hall_scene=$scenes/modern-hall/modern-hall.gltf sponza_scene=$scenes/sponza/sponza.gltf
 if [ "$quick" = quick ]; then
   # Every step as the GPU runs it, but small: modern-hall stands in for Sponza (whose load and
-  # BVH build alone take 3 s a step on 2 cores).
+  # BVH build alone take 3 s a step on 2 cores), and the Sponza steps that would repeat a
+  # modern-hall one are left out (`full`).
   rays=65536 verify=16384 check=16384 passes=80x60 hall=(80 60) sponza=(96 54) view=(64 36) limit=300
   sponza_scene=$hall_scene
 fi
+
+full() { # step ...: a step of the whole run only: in quick mode (modern-hall for Sponza) it would
+  # repeat a bench-hall step exactly
+  [ "$quick" = quick ] || "$@"
+}
 
 step() { # name command...: runs it under a time limit, everything into log.txt
   local name=$1 start rc
@@ -67,12 +74,12 @@ step() { # name command...: runs it under a time limit, everything into log.txt
   step bench-hall-binary "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify "$check" \
     --traversal binary
   step bench-hall-no-splits "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --spatial-splits 0
-  step bench-sponza "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$verify"
-  step bench-sponza-wide "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$check" \
+  full step bench-sponza "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$verify"
+  full step bench-sponza-wide "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$check" \
     --traversal wide
-  step bench-sponza-binary "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$check" \
+  full step bench-sponza-binary "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$check" \
     --traversal binary
-  step bench-sponza-no-splits "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --spatial-splits 0
+  full step bench-sponza-no-splits "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --spatial-splits 0
   step bench-sponza-storage "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --bvh-items storage
   step bench-sponza-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --cull-on-pop
   # Several rays per invocation: the binary refilling loop (slower than one ray each on an H200).
