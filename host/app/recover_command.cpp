@@ -254,6 +254,10 @@ void addRecoverCommand(CLI::App& app) {
                   "gather: path vertices through surfaces the camera does not see before the mean indirect light "
                   "stands in (0: at once)")
       ->check(CLI::Range(0u, recover::kMaxHiddenBounces));
+  cmd->add_option("--unseen-reflectance", o->recovery.unseenReflectance,
+                  "the grey of objects no photograph shows and no seen object shares a material with (0: the seen "
+                  "pixels' mean luminance)")
+      ->check(CLI::Range(0.0f, 1.0f));
   addNamedOption(*cmd, "--merge", o->recovery.merge, recover::kMergeModelNames,
                  "how the photos' estimates merge: weighted (by their expected error, pixels no lamp lights recovered "
                  "from their indirect light, smoothed along surfaces by their noise) or paper (IVR eq. 3)");

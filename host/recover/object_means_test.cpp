@@ -33,6 +33,13 @@ TEST(ObjectMeans, AnUnseenObjectTakesItsMaterialsSeenMeanElseTheGreyOfEverySeenP
   const float grey = 0.2126f * 0.6f + 0.7152f * 0.4f + 0.0722f * 0.2f;
   EXPECT_NEAR(coloured[1].x, grey, 1e-6f);
   EXPECT_NEAR(coloured[1].z, grey, 1e-6f);
+  // A grey the user knows (--unseen-reflectance) replaces only that guess: not a seen object's
+  // mean, nor an unseen object's material mean.
+  const std::vector<glm::vec3> told = objectMeans(reflectance, confidence, object, 4, &material, nullptr, 0.8f);
+  EXPECT_FLOAT_EQ(told[0].x, 0.35f);
+  EXPECT_FLOAT_EQ(told[2].x, 0.35f);
+  EXPECT_FLOAT_EQ(told[3].x, 0.8f);
+  EXPECT_FLOAT_EQ(told[3].z, 0.8f);
 }
 
 TEST(ObjectMeans, AnObjectSeenButNeverMergedTakesWhatItsPhotographsSayNotTheUnknownGrey) {

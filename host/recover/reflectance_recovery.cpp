@@ -169,7 +169,8 @@ std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, cons
 std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
                                    const std::vector<std::int32_t>& object, std::size_t objects,
                                    const std::vector<std::uint32_t>* objectMaterial,
-                                   const std::vector<std::optional<glm::vec3>>* photographed) {
+                                   const std::vector<std::optional<glm::vec3>>* photographed,
+                                   std::optional<float> unseenGrey) {
   std::vector<glm::dvec3> sum(objects, glm::dvec3(0.0));
   std::vector<double> weight(objects, 0.0);
   glm::dvec3 all(0.0);
@@ -187,7 +188,9 @@ std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, co
   // unknown surface: the staircase's wood (0.57 / 0.42 / 0.26) on its unseen white paints, steel
   // and the switched-off emitter panel, which lit the wall around the arch warm and recovered it
   // blue (R / T 0.91 / 1.00 / 1.15; BENCHMARKS).
-  const glm::vec3 fallback = allWeight > 0.0 ? glm::vec3(luminance(glm::vec3(all / allWeight))) : glm::vec3(0.5f);
+  const glm::vec3 fallback = unseenGrey         ? glm::vec3(*unseenGrey)
+                             : allWeight > 0.0 ? glm::vec3(luminance(glm::vec3(all / allWeight)))
+                                               : glm::vec3(0.5f);
   // An object no photograph shows takes the mean of the seen objects of its material.
   std::map<std::uint32_t, std::pair<glm::dvec3, double>> byMaterial;
   if (objectMaterial)
@@ -324,6 +327,8 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   // Objects no photograph shows take their material's recovered mean (objectMeans): the model's
   // materials say which surfaces are alike, though not their colours.
   const std::vector<std::uint32_t> objectMaterial = objectMaterials(room);
+  const std::optional<float> unseenGrey =
+      options.unseenReflectance > 0.0f ? std::optional<float>(options.unseenReflectance) : std::nullopt;
   Recovery out;
   out.width = photos.width;
   out.height = photos.height;
@@ -358,7 +363,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   std::vector<std::optional<glm::vec3>> ratios = photographed(ambient);
   out.iterations.push_back({0, secondsSince(stepStart), 0.0,
                             objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects,
-                                        &objectMaterial, &ratios)});
+                                        &objectMaterial, &ratios, unseenGrey)});
   if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
 
   // The device's rays through the renderer's traversal: the gather's and the pixels' footprints.
@@ -410,7 +415,8 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       const double change = n > 0 ? std::sqrt(sum / double(n)) : 0.0;
       ratios = photographed(out.indirect);
       std::vector<glm::vec3> nextMeans = objectMeans(merged.reflectance, inverseVariance(merged),
-                                                     lighting.geometry.object, objects, &objectMaterial, &ratios);
+                                                     lighting.geometry.object, objects, &objectMaterial, &ratios,
+                                                     unseenGrey);
       if (out.iterations.size() >= 2) dampSwings(out.iterations[out.iterations.size() - 2].objectReflectance, means, nextMeans);
       out.iterations.push_back({it, secondsSince(stepStart), change, std::move(nextMeans)});
       if (log) log(fmt::format("recover: iteration {}: RMS change of R {:.5f}, {:.1f} s", it, change, secondsSince(stepStart)));

@@ -66,6 +66,8 @@ struct RecoveryOptions {
                                      // the smoothing pools a 7x7 window's)
   int gatherSmoothing = 3;           // Gather: window radius of the surface-aware smoothing of B
   std::uint32_t hiddenBounces = kDefaultHiddenBounces; // Gather: path vertices through surfaces the camera does not see
+  float unseenReflectance = 0.0f;    // objects no photograph shows, of no seen object's material: this grey
+                                     // (0: the seen pixels' mean luminance)
   float constantReflectance = 0.5f;  // Constant: k
   render::AmbientModel ambient = render::AmbientModel::Reached; // of kRecoveryAmbientNames
   FilterOptions filters;
@@ -156,7 +158,8 @@ std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, cons
 std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
                                    const std::vector<std::int32_t>& object, std::size_t objects,
                                    const std::vector<std::uint32_t>* objectMaterial = nullptr,
-                                   const std::vector<std::optional<glm::vec3>>* photographed = nullptr);
+                                   const std::vector<std::optional<glm::vec3>>* photographed = nullptr,
+                                   std::optional<float> unseenGrey = std::nullopt);
 
 // Per object, sum_i sum_p C_i(p) / sum_i sum_p (D_i + B_i)(p) per channel over its pixels p and
 // the shots i (at most 1): the ratio estimate of its reflectance, the light weighting each
