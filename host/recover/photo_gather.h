@@ -59,6 +59,10 @@ struct PixelGeometry {
 // reflectance of ~0.7 the cut vertex carries 0.7^3 = 1/3 of the cut's weight at the first.
 inline constexpr std::uint32_t kMaxHiddenBounces = 8;
 inline constexpr std::uint32_t kDefaultHiddenBounces = 3;
+// A first hidden vertex's lamps that each give it at least this share of its unoccluded light get
+// a shadow ray of their own; one ray samples the rest (PhotoGather's constructor; 0: every lamp
+// its own ray).
+inline constexpr float kExactShare = 0.25f;
 
 class PhotoGather {
 public:
@@ -66,7 +70,7 @@ public:
   // kRaysPerBatch gather rays at a time).
   PhotoGather(const scene::Scene& room, render::RayBatch& rays, const scene::Camera& camera, const PixelGeometry& pixels,
               const std::vector<Shot>& shots, std::uint32_t raysPerPixel, std::uint32_t seed, int smoothRadius,
-              std::uint32_t hiddenBounces = kDefaultHiddenBounces);
+              std::uint32_t hiddenBounces = kDefaultHiddenBounces, float exactShare = kExactShare);
   // The same with the rays on `context`'s device, through the renderer's traversal of the room's
   // buffers (uploaded for this and dropped after).
   static PhotoGather onDevice(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
@@ -139,8 +143,8 @@ private:
   // Per pixel p, its seen hits are seen_[seenStart_[p] .. seenStart_[p + 1]) (pixel indices), its
   // hidden hits hiddenObject_/hiddenDirect_ [hiddenStart_[p] .. hiddenEnd_[p]) (hiddenDirect_:
   // shots_ values per vertex, the lamp's unit-reflectance direct light F V I / pi there, without
-  // the lamp's colour; at a deeper vertex one lamp's, weighted, the others 0: see the
-  // constructor). Deeper path vertices follow each chunk's pixels, outside every range.
+  // the lamp's colour; at a first vertex its main lamps' (kExactShare) and one of the rest's,
+  // weighted, at a deeper vertex one lamp's, weighted, the others 0: see the constructor). Deeper path vertices follow each chunk's pixels, outside every range.
   std::vector<std::uint32_t> seenStart_, seen_;
   std::vector<std::uint32_t> hiddenStart_, hiddenEnd_, hiddenObject_;
   std::vector<float> hiddenDirect_;
