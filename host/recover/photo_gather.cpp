@@ -131,7 +131,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
   // mean is kept). A deeper one, whose light comes back through one or more reflections more
   // (weight R^depth), traces that one alone. A ray to every lamp a first vertex faces, most of
   // them far or grazing, made the staircase's gather 4.9 s against 3.8 s, for the same RMSE to
-  // +-0.0002 on every room; one ray to every lamp at the deeper vertices cost it 4.9 s more (BENCHMARKS).
+  // +-0.0002 on every room; at the deeper vertices it had cost 4.9 s more (BENCHMARKS).
   std::vector<float> unblocked(shots.size());
   const auto queueDirect = [&](const Classified& c, std::vector<float>& direct, bool firstVertex, std::uint32_t vertex) {
     float total = 0.0f;

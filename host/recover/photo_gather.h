@@ -144,7 +144,8 @@ private:
   // hidden hits hiddenObject_/hiddenDirect_ [hiddenStart_[p] .. hiddenEnd_[p]) (hiddenDirect_:
   // shots_ values per vertex, the lamp's unit-reflectance direct light F V I / pi there, without
   // the lamp's colour; at a first vertex its main lamps' (kExactShare) and one of the rest's,
-  // weighted, at a deeper vertex one lamp's, weighted, the others 0: see the constructor). Deeper path vertices follow each chunk's pixels, outside every range.
+  // weighted, at a deeper vertex one lamp's, weighted, the others 0: see the constructor).
+  // Deeper path vertices follow each chunk's pixels, outside every range.
   std::vector<std::uint32_t> seenStart_, seen_;
   std::vector<std::uint32_t> hiddenStart_, hiddenEnd_, hiddenObject_;
   std::vector<float> hiddenDirect_;
