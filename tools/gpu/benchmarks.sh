@@ -4,8 +4,8 @@
 # CPU), in one run that fits a 15-minute device lease. BUNDLE_DIR comes from make_bundle.sh.
 # OUT_DIR gets log.txt (everything printed) and a few images and JSON files, at most 8 files.
 # "quick" shrinks every size (and lets modern-hall stand in for Sponza, less the Sponza steps that
-# would repeat a modern-hall one) so that the script itself
-# can be tried on lavapipe first, as tests/scripts/gpu_benchmarks_smoke.sh does.
+# would repeat a modern-hall one) so that the script itself can be tried on lavapipe first, as
+# tests/scripts/gpu_benchmarks_smoke.sh does.
 #
 #   bench-rays, both scenes, with the device's own traversal and tree (render/scene_data/bvh_layout.h)
 #     and with each other traversal (--traversal): closest-hit and shadow rays per second (4M random
