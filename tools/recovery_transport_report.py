@@ -29,11 +29,13 @@ import numpy as np
 from exr_image import read_image
 
 
-def channels(path, names):
+def channels(path, names, shape=None):
     pixels, have = read_image(path)
     missing = [n for n in names if n not in have]
     if missing:
         sys.exit(f"{path}: no channel {', '.join(missing)} (recover --debug writes shot-NNN.exr)")
+    if shape is not None and pixels.shape[:2] != shape:
+        sys.exit(f"{path}: {pixels.shape[1]}x{pixels.shape[0]} pixels, the photo set's are {shape[1]}x{shape[0]}")
     return np.stack([pixels[..., have.index(n)] for n in names], -1)
 
 
@@ -61,7 +63,8 @@ def main():
     if len(photos["shots"]) != len(direct["shots"]):
         sys.exit(f"{a.direct}: {len(direct['shots'])} shots, {a.photos} has {len(photos['shots'])}")
     truth = channels(os.path.join(base, photos["albedo"]["image"]), ["R", "G", "B"])
-    objects = channels(os.path.join(a.recovery, "reflectance.exr"), ["object.id"])[..., 0].astype(int)
+    size = truth.shape[:2]
+    objects = channels(os.path.join(a.recovery, "reflectance.exr"), ["object.id"], size)[..., 0].astype(int)
     # Pixels whose true reflectance is dark in a channel would turn its noise into large ratios.
     surface = (truth.min(-1) > 0.03) & (objects >= 0)
     rgb = ["R", "G", "B"]
@@ -69,11 +72,11 @@ def main():
     for k, (shot, dshot) in enumerate(zip(photos["shots"], direct["shots"])):
         if not np.allclose(shot["position"], dshot["position"], atol=1e-5):
             sys.exit(f"{a.direct}: shot {k}'s lamp is at {dshot['position']}, not at {shot['position']}")
-        photo = channels(os.path.join(base, shot["image"]), rgb)
-        photo_direct = channels(os.path.join(direct_base, dshot["image"]), rgb)
+        photo = channels(os.path.join(base, shot["image"]), rgb, size)
+        photo_direct = channels(os.path.join(direct_base, dshot["image"]), rgb, size)
         debug = os.path.join(a.recovery, f"shot-{k:03}.exr")
-        d = channels(debug, [f"direct.{c}" for c in rgb])
-        b = channels(debug, [f"indirect.{c}" for c in rgb])
+        d = channels(debug, [f"direct.{c}" for c in rgb], size)
+        b = channels(debug, [f"indirect.{c}" for c in rgb], size)
         dc = photo_direct / np.maximum(truth, 1e-6)
         bc = (photo - photo_direct) / np.maximum(truth, 1e-6)
         share = (d / np.maximum(d + b, 1e-9)).mean(-1)
