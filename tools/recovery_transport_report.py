@@ -26,17 +26,7 @@ import sys
 
 import numpy as np
 
-from exr_image import read_image
-
-
-def channels(path, names, shape=None):
-    pixels, have = read_image(path)
-    missing = [n for n in names if n not in have]
-    if missing:
-        sys.exit(f"{path}: no channel {', '.join(missing)} (recover --debug writes shot-NNN.exr)")
-    if shape is not None and pixels.shape[:2] != shape:
-        sys.exit(f"{path}: {pixels.shape[1]}x{pixels.shape[0]} pixels, the photo set's are {shape[1]}x{shape[0]}")
-    return np.stack([pixels[..., have.index(n)] for n in names], -1)
+from exr_image import read_channels
 
 
 def load(path):
@@ -62,9 +52,9 @@ def main():
     base, direct_base = os.path.dirname(a.photos), os.path.dirname(a.direct)
     if len(photos["shots"]) != len(direct["shots"]):
         sys.exit(f"{a.direct}: {len(direct['shots'])} shots, {a.photos} has {len(photos['shots'])}")
-    truth = channels(os.path.join(base, photos["albedo"]["image"]), ["R", "G", "B"])
+    truth = read_channels(os.path.join(base, photos["albedo"]["image"]), ["R", "G", "B"])
     size = truth.shape[:2]
-    objects = channels(os.path.join(a.recovery, "reflectance.exr"), ["object.id"], size)[..., 0].astype(int)
+    objects = read_channels(os.path.join(a.recovery, "reflectance.exr"), ["object.id"], size)[..., 0].astype(int)
     # Pixels whose true reflectance is dark in a channel would turn its noise into large ratios.
     surface = (truth.min(-1) > 0.03) & (objects >= 0)
     rgb = ["R", "G", "B"]
@@ -72,11 +62,11 @@ def main():
     for k, (shot, dshot) in enumerate(zip(photos["shots"], direct["shots"])):
         if not np.allclose(shot["position"], dshot["position"], atol=1e-5):
             sys.exit(f"{a.direct}: shot {k}'s lamp is at {dshot['position']}, not at {shot['position']}")
-        photo = channels(os.path.join(base, shot["image"]), rgb, size)
-        photo_direct = channels(os.path.join(direct_base, dshot["image"]), rgb, size)
+        photo = read_channels(os.path.join(base, shot["image"]), rgb, size)
+        photo_direct = read_channels(os.path.join(direct_base, dshot["image"]), rgb, size)
         debug = os.path.join(a.recovery, f"shot-{k:03}.exr")
-        d = channels(debug, [f"direct.{c}" for c in rgb], size)
-        b = channels(debug, [f"indirect.{c}" for c in rgb], size)
+        d = read_channels(debug, [f"direct.{c}" for c in rgb], size)
+        b = read_channels(debug, [f"indirect.{c}" for c in rgb], size)
         dc = photo_direct / np.maximum(truth, 1e-6)
         bc = (photo - photo_direct) / np.maximum(truth, 1e-6)
         share = (d / np.maximum(d + b, 1e-9)).mean(-1)
