@@ -49,26 +49,27 @@ int pointsOn(const recover::PixelFootprints& f, std::size_t p, std::int32_t obje
 }
 
 TEST(PixelFootprint, APixelAnEdgeCrossesIsSharedByItsTwoSurfacesInProportion) {
-  // Column 4 spans x in [0, 0.25]; an edge at x = 0.125 leaves two of its four point columns on
-  // each side, one at x = 0.19 three on the left. Rows above y = 0.5 (row 1 spans [0.5, 0.75]) see
-  // nothing; the edge at y = 0.5625 leaves one of row 1's four point rows on the walls.
+  // Column 4 spans x in [0, 0.25]; an edge at x = 0.125 leaves half of its point columns on each
+  // side, one at x = 0.19 three quarters on the left. Rows above y = 0.5 (row 1 spans [0.5, 0.75])
+  // see nothing; the edge at y = 0.5625 leaves a quarter of row 1's point rows on the walls.
+  constexpr int all = recover::PixelFootprints::kPoints;
   const recover::PixelFootprints half = footprintsOf(twoWalls(0.125f, 0.5625f));
   for (int y = 2; y < kSize; ++y) {
-    EXPECT_EQ(pointsOn(half, at(4, y), 0), 8) << "row " << y;
-    EXPECT_EQ(pointsOn(half, at(4, y), 1), 8) << "row " << y;
+    EXPECT_EQ(pointsOn(half, at(4, y), 0), all / 2) << "row " << y;
+    EXPECT_EQ(pointsOn(half, at(4, y), 1), all / 2) << "row " << y;
     EXPECT_FALSE(half.whole(at(4, y)));
     EXPECT_TRUE(half.whole(at(3, y)));
     EXPECT_TRUE(half.whole(at(5, y)));
-    EXPECT_EQ(pointsOn(half, at(3, y), 0), 16);
-    EXPECT_EQ(pointsOn(half, at(5, y), 1), 16);
+    EXPECT_EQ(pointsOn(half, at(3, y), 0), all);
+    EXPECT_EQ(pointsOn(half, at(5, y), 1), all);
   }
-  EXPECT_EQ(pointsOn(half, at(0, 1), 0), 4);
-  EXPECT_EQ(pointsOn(half, at(0, 1), -1), 12);
-  EXPECT_EQ(pointsOn(half, at(0, 0), -1), 16);
+  EXPECT_EQ(pointsOn(half, at(0, 1), 0), all / 4);
+  EXPECT_EQ(pointsOn(half, at(0, 1), -1), all * 3 / 4);
+  EXPECT_EQ(pointsOn(half, at(0, 0), -1), all);
   EXPECT_TRUE(half.whole(at(0, 0))); // on nothing, wholly
   const recover::PixelFootprints threeQuarters = footprintsOf(twoWalls(0.19f, 1.0f));
-  EXPECT_EQ(pointsOn(threeQuarters, at(4, 5), 0), 12);
-  EXPECT_EQ(pointsOn(threeQuarters, at(4, 5), 1), 4);
+  EXPECT_EQ(pointsOn(threeQuarters, at(4, 5), 0), all * 3 / 4);
+  EXPECT_EQ(pointsOn(threeQuarters, at(4, 5), 1), all / 4);
 }
 
 TEST(PixelFootprint, APixelOnTwoSurfacesTakesTheMixOfTheirReflectancesNotItsOwnEstimate) {
