@@ -302,6 +302,20 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
       if (std::isinf(blocked[i])) (*pending[i].direct)[pending[i].at] = pending[i].unblocked;
   }
   seenStart_.push_back(static_cast<std::uint32_t>(seen_.size()));
+  // Shot by shot from here on: a gather reads one shot's values of every vertex (indirect() lights
+  // one lamp at a time), and so reads a sixth of the memory it would read with them interleaved.
+  const std::size_t vertices = hiddenObject_.size();
+  std::vector<float> byShot(hiddenDirect_.size());
+  for (std::size_t v = 0; v < vertices; ++v)
+    for (std::size_t i = 0; i < shots_; ++i) byShot[i * vertices + v] = hiddenDirect_[v * shots_ + i];
+  hiddenDirect_ = std::move(byShot);
+}
+
+std::vector<std::size_t> PhotoGather::litShots(const std::vector<glm::vec3>& lampColour) const {
+  std::vector<std::size_t> lit;
+  for (std::size_t i = 0; i < shots_; ++i)
+    if (lampColour.at(i) != glm::vec3(0.0f)) lit.push_back(i);
+  return lit;
 }
 
 PhotoGather PhotoGather::onDevice(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
@@ -340,6 +354,8 @@ std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radianc
                                                        settled ? &incoming : nullptr, settled ? &paths : nullptr);
   std::vector<glm::vec3> out(pixels_, glm::vec3(0.0f)), deep;
   if (modelled) deep.assign(pixels_, glm::vec3(0.0f));
+  const std::vector<std::size_t> lit = litShots(lampColour);
+  const std::size_t vertices = hiddenObject_.size();
   const float perRay = 1.0f / float(raysPerPixel_);
   for (std::size_t p = 0; p < pixels_; ++p) {
     glm::vec3 sum(0.0f), deeper(0.0f);
@@ -349,7 +365,7 @@ std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radianc
       if (!modelled) continue;
       // What the hidden hit passes on beyond its own direct light (a shadow ray per lamp).
       glm::vec3 direct(0.0f);
-      for (std::size_t i = 0; i < shots_; ++i) direct += hiddenDirect_[std::size_t(k) * shots_ + i] * lampColour[i];
+      for (const std::size_t i : lit) direct += hiddenDirect_[i * vertices + k] * lampColour[i];
       deeper += hidden[k] - direct * objectReflectance[hiddenObject_[k]];
     }
     out[p] = sum * perRay;
@@ -390,6 +406,7 @@ std::vector<glm::vec3> PhotoGather::hiddenRadiance(const std::vector<glm::vec3>&
   // photograph where the camera sees it, 0 where the ray left, c_o(v) where the path was cut.
   const std::size_t vertices = hiddenObject_.size();
   std::vector<glm::vec3> out(vertices);
+  const std::vector<std::size_t> lit = litShots(lampColour);
   if (incoming) {
     incoming->assign(cut.size(), glm::dvec3(0.0));
     paths->assign(cut.size(), 0.0);
@@ -405,7 +422,7 @@ std::vector<glm::vec3> PhotoGather::hiddenRadiance(const std::vector<glm::vec3>&
       (*paths)[o] += 1.0;
     }
     glm::vec3 light = in;
-    for (std::size_t i = 0; i < shots_; ++i) light += hiddenDirect_[v * shots_ + i] * lampColour[i];
+    for (const std::size_t i : lit) light += hiddenDirect_[i * vertices + v] * lampColour[i];
     out[v] = light * objectReflectance[o];
   }
   return out;

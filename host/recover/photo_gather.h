@@ -134,6 +134,8 @@ private:
   std::vector<glm::vec3> hiddenRadiance(const std::vector<glm::vec3>& radiance, const std::vector<glm::vec3>& lampColour,
                                         const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
                                         std::vector<glm::dvec3>* incoming, std::vector<double>* paths) const;
+  // The shots whose lamp `lampColour` lights (the others' direct light adds nothing).
+  std::vector<std::size_t> litShots(const std::vector<glm::vec3>& lampColour) const;
 
   const PixelGeometry* geometry_;
   int smoothRadius_ = 0;
@@ -142,7 +144,8 @@ private:
   std::uint64_t rays_ = 0;
   // Per pixel p, its seen hits are seen_[seenStart_[p] .. seenStart_[p + 1]) (pixel indices), its
   // hidden hits hiddenObject_/hiddenDirect_ [hiddenStart_[p] .. hiddenEnd_[p]) (hiddenDirect_:
-  // shots_ values per vertex, the lamp's unit-reflectance direct light F V I / pi there, without
+  // [shot * vertices + vertex] once built, per vertex while the constructor fills it; the
+  // lamp's unit-reflectance direct light F V I / pi there, without
   // the lamp's colour; at a first vertex its main lamps' (kExactShare) and one of the rest's,
   // weighted, at a deeper vertex one lamp's, weighted, the others 0: see the constructor).
   // Deeper path vertices follow each chunk's pixels, outside every range.

@@ -19,28 +19,76 @@ bool PixelFootprints::whole(std::size_t p) const {
   return std::all_of(points, points + kPoints, [&](std::int32_t o) { return o == points[0]; });
 }
 
-PixelFootprints traceFootprints(const scene::Scene& room, render::RayBatch& rays, const scene::Camera& camera,
-                                int width, int height) {
-  const render::GridCamera view = pixelCamera(camera, width, height);
-  const std::vector<std::uint32_t> objectOf = triangleObjects(room);
-  PixelFootprints out;
-  out.width = width;
-  out.height = height;
-  const std::size_t pixels = std::size_t(width) * std::size_t(height);
-  out.object.assign(pixels * PixelFootprints::kPoints, -1);
+namespace {
+
+// The objects `view` sees at the centres of a grid x grid grid of cells over each of `pixels`:
+// [i * grid^2 + point] for pixels[i], -1 where it sees nothing.
+std::vector<std::int32_t> traceGrid(const scene::Scene& room, render::RayBatch& rays, const render::GridCamera& view,
+                                    const std::vector<std::uint32_t>& objectOf, int width, int height,
+                                    const std::vector<std::size_t>& pixels, int grid) {
+  const std::size_t points = std::size_t(grid) * std::size_t(grid);
   std::vector<bvh::Ray> cameraRays;
-  cameraRays.reserve(pixels * PixelFootprints::kPoints);
-  for (std::size_t p = 0; p < pixels; ++p) {
+  cameraRays.reserve(pixels.size() * points);
+  for (const std::size_t p : pixels) {
     const float x = float(p % std::size_t(width)), y = float(p / std::size_t(width));
-    for (int k = 0; k < PixelFootprints::kPoints; ++k) {
-      const float jx = (float(k % PixelFootprints::kGrid) + 0.5f) / float(PixelFootprints::kGrid);
-      const float jy = (float(k / PixelFootprints::kGrid) + 0.5f) / float(PixelFootprints::kGrid);
+    for (std::size_t k = 0; k < points; ++k) {
+      const float jx = (float(k % std::size_t(grid)) + 0.5f) / float(grid);
+      const float jy = (float(k / std::size_t(grid)) + 0.5f) / float(grid);
       cameraRays.push_back(render::gridRay(view, (x + jx) / float(width), (y + jy) / float(height), 1));
     }
   }
   const std::vector<bvh::Hit> hits = rays.closest(cameraRays);
+  std::vector<std::int32_t> object(hits.size(), -1);
   for (std::size_t r = 0; r < hits.size(); ++r)
-    if (render::gridHit(room, cameraRays[r], hits[r])) out.object[r] = std::int32_t(objectOf.at(hits[r].primitive));
+    if (render::gridHit(room, cameraRays[r], hits[r])) object[r] = std::int32_t(objectOf.at(hits[r].primitive));
+  return object;
+}
+
+} // namespace
+
+PixelFootprints traceFootprints(const scene::Scene& room, render::RayBatch& rays, const scene::Camera& camera,
+                                int width, int height, std::size_t* refined) {
+  const render::GridCamera view = pixelCamera(camera, width, height);
+  const std::vector<std::uint32_t> objectOf = triangleObjects(room);
+  const std::size_t pixels = std::size_t(width) * std::size_t(height);
+  std::vector<std::size_t> every(pixels);
+  for (std::size_t p = 0; p < pixels; ++p) every[p] = p;
+  constexpr std::size_t coarsePoints = std::size_t(PixelFootprints::kCoarseGrid) * PixelFootprints::kCoarseGrid;
+  const std::vector<std::int32_t> coarse =
+      traceGrid(room, rays, view, objectOf, width, height, every, PixelFootprints::kCoarseGrid);
+  // -2 where a pixel's coarse points see more than one object, else the one they see.
+  std::vector<std::int32_t> single(pixels);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const std::int32_t* points = coarse.data() + p * coarsePoints;
+    single[p] = std::all_of(points, points + coarsePoints, [&](std::int32_t o) { return o == points[0]; }) ? points[0] : -2;
+  }
+  // The pixels an edge crosses or may cross: those whose coarse points see more than one object,
+  // and of two side by side whose coarse points see one object each, a different one, both (the
+  // edge between them lies in one). A pixel beside a mixed one is not traced again for it: an
+  // edge that misses all its coarse points clips at most a strip of an eighth of it, which its own
+  // estimate measures better than a mix would (the staircase's RMSE 0.0407 over all pixels with
+  // its 8 neighbours traced again for it, 0.0403 without, for half the fine rays).
+  std::vector<std::size_t> nearEdge;
+  const auto differs = [&](std::size_t p, std::size_t q) { return single[q] != -2 && single[q] != single[p]; };
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
+      if (single[p] == -2 || (x > 0 && differs(p, p - 1)) || (x + 1 < width && differs(p, p + 1)) ||
+          (y > 0 && differs(p, p - std::size_t(width))) || (y + 1 < height && differs(p, p + std::size_t(width))))
+        nearEdge.push_back(p);
+    }
+  const std::vector<std::int32_t> fine =
+      traceGrid(room, rays, view, objectOf, width, height, nearEdge, PixelFootprints::kGrid);
+  PixelFootprints out;
+  out.width = width;
+  out.height = height;
+  out.object.resize(pixels * PixelFootprints::kPoints);
+  for (std::size_t p = 0; p < pixels; ++p)
+    std::fill_n(out.object.begin() + std::ptrdiff_t(p * PixelFootprints::kPoints), PixelFootprints::kPoints, single[p]);
+  for (std::size_t i = 0; i < nearEdge.size(); ++i)
+    std::copy_n(fine.begin() + std::ptrdiff_t(i * PixelFootprints::kPoints), PixelFootprints::kPoints,
+                out.object.begin() + std::ptrdiff_t(nearEdge[i] * PixelFootprints::kPoints));
+  if (refined) *refined = nearEdge.size();
   return out;
 }
 

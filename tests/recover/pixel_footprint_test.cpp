@@ -72,6 +72,29 @@ TEST(PixelFootprint, APixelAnEdgeCrossesIsSharedByItsTwoSurfacesInProportion) {
   EXPECT_EQ(pointsOn(threeQuarters, at(4, 5), 1), all / 4);
 }
 
+TEST(PixelFootprint, AnEdgeTheCoarseGridMissesIsFoundFromTheNeighbourAcrossIt) {
+  // An edge at x = 0.03 in column 4 ([0, 0.25]) passes left of all its coarse points (the first at
+  // 0.25 / 8 = 0.031), so on the coarse grid column 4 is wholly "right" and column 3 wholly
+  // "left": two whole pixels of different objects, one of which holds the edge. Both take the
+  // fine grid, whose first point column (at 0.0156) is on the left: an eighth of the footprint.
+  static_assert(recover::PixelFootprints::kCoarseGrid == 4 && recover::PixelFootprints::kGrid == 8);
+  constexpr int all = recover::PixelFootprints::kPoints;
+  const bvh::Bvh tree = bvh::build(render::triangleSoup(twoWalls(0.03f, 1.0f)));
+  render::CpuRayBatch rays(tree);
+  std::size_t refined = 0;
+  const recover::PixelFootprints f =
+      recover::traceFootprints(twoWalls(0.03f, 1.0f), rays, overTheWalls(), kSize, kSize, &refined);
+  EXPECT_EQ(refined, std::size_t(2 * kSize)); // columns 3 and 4; the others are two pixels from the edge
+  for (int y = 0; y < kSize; ++y) {
+    EXPECT_EQ(pointsOn(f, at(4, y), 0), all / 8) << "row " << y;
+    EXPECT_EQ(pointsOn(f, at(4, y), 1), all * 7 / 8) << "row " << y;
+    EXPECT_FALSE(f.whole(at(4, y)));
+    EXPECT_EQ(pointsOn(f, at(3, y), 0), all);
+    EXPECT_EQ(pointsOn(f, at(0, y), 0), all); // away from the edge: filled from the coarse grid
+    EXPECT_EQ(pointsOn(f, at(7, y), 1), all);
+  }
+}
+
 TEST(PixelFootprint, APixelOnTwoSurfacesTakesTheMixOfTheirReflectancesNotItsOwnEstimate) {
   const recover::PixelFootprints f = footprintsOf(twoWalls(0.125f, 0.5625f));
   // The estimates as photo / (D + B) gives them: right on the whole pixels (0.2 left, 0.8 right),
