@@ -42,6 +42,28 @@ TEST(ObjectMeans, AnUnseenObjectTakesItsMaterialsSeenMeanElseTheGreyOfEverySeenP
   EXPECT_FLOAT_EQ(told[3].z, 0.8f);
 }
 
+TEST(ObjectMeans, ObjectsOfOneColourInTheModelShareTheirMaterialsMeanAndTexturedOnesKeepTheirOwn) {
+  // Objects 0 and 1 are of one untextured material (7): a wall merged at 0.6 with weight 9 and a
+  // sliver beside wood that measured the wood's 0.3 with weight 1; objects 2 and 3 share a
+  // textured material (8, not one colour): 0.2 and 0.8 stay apart. Object 4, of material 7 too but
+  // not one colour (part of it another material), keeps its own 0.9.
+  const std::vector<glm::vec3> reflectance{glm::vec3(0.6f), glm::vec3(0.3f), glm::vec3(0.2f), glm::vec3(0.8f),
+                                           glm::vec3(0.9f)};
+  const std::vector<float> confidence{9.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+  const std::vector<std::int32_t> object{0, 1, 2, 3, 4};
+  const std::vector<std::uint32_t> material{7, 7, 8, 8, 7};
+  const std::vector<bool> oneColour{true, true, false, false, false};
+  const std::vector<glm::vec3> means =
+      objectMeans(reflectance, confidence, object, 5, &material, nullptr, std::nullopt, &oneColour);
+  EXPECT_FLOAT_EQ(means[0].x, 0.57f); // (9 x 0.6 + 0.3) / 10
+  EXPECT_FLOAT_EQ(means[1].x, 0.57f);
+  EXPECT_FLOAT_EQ(means[2].x, 0.2f);
+  EXPECT_FLOAT_EQ(means[3].x, 0.8f);
+  EXPECT_FLOAT_EQ(means[4].x, 0.9f);
+  // Without the flags each object keeps its own.
+  EXPECT_FLOAT_EQ(objectMeans(reflectance, confidence, object, 5, &material)[1].x, 0.3f);
+}
+
 TEST(ObjectMeans, AnObjectSeenButNeverMergedTakesWhatItsPhotographsSayNotTheUnknownGrey) {
   // Object 0 merged at 0.5; object 1 seen in two pixels, neither merged (a sliver in a penumbra),
   // nearly black; object 2 seen in one pixel nothing lights.

@@ -42,6 +42,20 @@ std::vector<std::uint32_t> objectMaterials(const scene::Scene& room) {
   return material;
 }
 
+std::vector<bool> oneColourObjects(const scene::Scene& room) {
+  std::vector<bool> one(room.objects.size(), false);
+  for (std::size_t o = 0; o < room.objects.size(); ++o) {
+    const auto& obj = room.objects[o];
+    if (obj.triangleCount == 0) continue;
+    const std::uint32_t m = room.triangleMaterial[obj.firstTriangle];
+    bool same = room.materials.at(m).baseColorTexture < 0;
+    for (std::uint32_t t = obj.firstTriangle; t < obj.firstTriangle + obj.triangleCount && same; ++t)
+      same = room.triangleMaterial[t] == m;
+    one[o] = same;
+  }
+  return one;
+}
+
 scene::Scene recoveryScene(const scene::Scene& room, const std::vector<Shot>& shots,
                            const std::vector<glm::vec3>& objectReflectance) {
   scene::Scene s = room;

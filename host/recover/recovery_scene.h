@@ -24,6 +24,9 @@ scene::Scene recoveryScene(const scene::Scene& room, const std::vector<Shot>& sh
 std::vector<std::uint32_t> triangleObjects(const scene::Scene& scene);
 // Each object's material in the room's model: the one covering most of its area.
 std::vector<std::uint32_t> objectMaterials(const scene::Scene& room);
+// Whether the room's model gives each object one colour: every triangle of one material, which
+// has no colour texture. Such objects of one material have the same reflectance.
+std::vector<bool> oneColourObjects(const scene::Scene& room);
 
 // InputError naming `photos.file` and the shot when a lamp is inside geometry: its sphere (or,
 // for radius 0, the point) touches a triangle, or it lies inside a closed object (3/4 of the rays

@@ -170,7 +170,7 @@ std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, co
                                    const std::vector<std::int32_t>& object, std::size_t objects,
                                    const std::vector<std::uint32_t>* objectMaterial,
                                    const std::vector<std::optional<glm::vec3>>* photographed,
-                                   std::optional<float> unseenGrey) {
+                                   std::optional<float> unseenGrey, const std::vector<bool>* oneColour) {
   std::vector<glm::dvec3> sum(objects, glm::dvec3(0.0));
   std::vector<double> weight(objects, 0.0);
   glm::dvec3 all(0.0);
@@ -199,8 +199,27 @@ std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, co
       m.first += sum[o];
       m.second += weight[o];
     }
+  // The objects of one colour in the model pool their pixels with the others of their material:
+  // a sliver lit only by bounces from the wood beside it (the staircase's white trim under its
+  // stringer, 149 px, 140 of them lit by no lamp) measured the wood's colour, and its fills took it
+  // (11 % of the staircase's squared error; BENCHMARKS "one colour per material").
+  std::map<std::uint32_t, std::pair<glm::dvec3, double>> pooled;
+  if (objectMaterial && oneColour)
+    for (std::size_t o = 0; o < objects; ++o)
+      if ((*oneColour)[o]) {
+        auto& m = pooled[(*objectMaterial)[o]];
+        m.first += sum[o];
+        m.second += weight[o];
+      }
   std::vector<glm::vec3> means(objects);
   for (std::size_t o = 0; o < objects; ++o) {
+    if (objectMaterial && oneColour && (*oneColour)[o]) {
+      const auto& m = pooled[(*objectMaterial)[o]];
+      if (m.second > 0.0) {
+        means[o] = glm::vec3(m.first / m.second);
+        continue;
+      }
+    }
     if (weight[o] > 0.0) {
       means[o] = glm::vec3(sum[o] / weight[o]);
       continue;
@@ -327,6 +346,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   // Objects no photograph shows take their material's recovered mean (objectMeans): the model's
   // materials say which surfaces are alike, though not their colours.
   const std::vector<std::uint32_t> objectMaterial = objectMaterials(room);
+  const std::vector<bool> oneColour = oneColourObjects(room);
   const std::optional<float> unseenGrey =
       options.unseenReflectance > 0.0f ? std::optional<float>(options.unseenReflectance) : std::nullopt;
   Recovery out;
@@ -363,7 +383,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   std::vector<std::optional<glm::vec3>> ratios = photographed(ambient);
   out.iterations.push_back({0, secondsSince(stepStart), 0.0,
                             objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects,
-                                        &objectMaterial, &ratios, unseenGrey)});
+                                        &objectMaterial, &ratios, unseenGrey, &oneColour)});
   if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
 
   // The device's rays through the renderer's traversal: the gather's and the pixels' footprints.
@@ -416,7 +436,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       ratios = photographed(out.indirect);
       std::vector<glm::vec3> nextMeans = objectMeans(merged.reflectance, inverseVariance(merged),
                                                      lighting.geometry.object, objects, &objectMaterial, &ratios,
-                                                     unseenGrey);
+                                                     unseenGrey, &oneColour);
       if (out.iterations.size() >= 2) dampSwings(out.iterations[out.iterations.size() - 2].objectReflectance, means, nextMeans);
       out.iterations.push_back({it, secondsSince(stepStart), change, std::move(nextMeans)});
       if (log) log(fmt::format("recover: iteration {}: RMS change of R {:.5f}, {:.1f} s", it, change, secondsSince(stepStart)));

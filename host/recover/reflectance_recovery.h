@@ -154,12 +154,15 @@ std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, cons
 // pixel get their `photographed` ratio where it has one (the camera sees them, but no estimate
 // of theirs merged: slivers and penumbrae), else the mean over the confident pixels of the
 // objects of their material (`objectMaterial`), or, with none, a grey of the luminance of the
-// mean over all confident pixels (an unknown colour: not the room's dominant one).
+// mean over all confident pixels (an unknown colour: not the room's dominant one). An object
+// the model gives one colour (`oneColour`, see oneColourObjects) takes, before all that, the mean
+// over the confident pixels of every such object of its material, where they have any.
 std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
                                    const std::vector<std::int32_t>& object, std::size_t objects,
                                    const std::vector<std::uint32_t>* objectMaterial = nullptr,
                                    const std::vector<std::optional<glm::vec3>>* photographed = nullptr,
-                                   std::optional<float> unseenGrey = std::nullopt);
+                                   std::optional<float> unseenGrey = std::nullopt,
+                                   const std::vector<bool>* oneColour = nullptr);
 
 // Per object, sum_i sum_p C_i(p) / sum_i sum_p (D_i + B_i)(p) per channel over its pixels p and
 // the shots i (at most 1): the ratio estimate of its reflectance, the light weighting each
