@@ -50,7 +50,7 @@ def rss_mib():
         return int(f.read().split()[1]) * resource.getpagesize() / 2**20
 
 
-def test_fifty_sessions_and_renders_give_their_memory_back(cornell):
+def test_sessions_and_renders_closed_in_a_loop_give_their_memory_back(cornell):
     def cycle():
         with obscura.Session(cornell, width=16, height=12, spp=1) as s:
             s.apply({"light": "light_rectangle_1", "scale": 0.5})
@@ -61,12 +61,14 @@ def test_fifty_sessions_and_renders_give_their_memory_back(cornell):
         cycle()
     gc.collect()
     buffers, rss = obscura.buffer_bytes_in_use(), rss_mib()
-    for _ in range(50):
+    for _ in range(20):
         cycle()
     gc.collect()
-    assert obscura.buffer_bytes_in_use() == buffers, "device memory held after 50 sessions were closed"
-    # A leak of one frame per cycle (16 x 12 pixels, ~40 KB of buffers and arrays) would be 2 MiB.
-    assert rss_mib() - rss < 8.0, f"host RSS grew {rss_mib() - rss:.1f} MiB over 50 cycles"
+    assert obscura.buffer_bytes_in_use() == buffers, "device memory held after 20 sessions were closed"
+    # The device's buffers are counted exactly above; the host's RSS only coarsely (a leak of one
+    # 16 x 12 frame per cycle, ~40 KB, would be 0.8 MiB here and 2 MiB over 50 cycles: under this
+    # bound either way).
+    assert rss_mib() - rss < 8.0, f"host RSS grew {rss_mib() - rss:.1f} MiB over 20 cycles"
 
 
 def test_the_stub_and_the_help_cover_the_api():

@@ -98,9 +98,11 @@ TEST_F(RecoverCornell, OutlierTestRemovesALampFixtureSeenInOnePhoto) {
     return std::sqrt(sum / double(patch.size()));
   };
   // The paper's merge: the outlier test is what removes the fixture.
+  // One iteration each: the fixture is in the photographs, not the indirect light the iterations
+  // refine (the patch's error with the test, seed 1: 0.0125 after one, 0.0079 after three).
   RecoveryOptions paper = options();
   paper.merge = MergeModel::Paper;
-  paper.iterations = 3; // as above
+  paper.iterations = 1;
   RecoveryOptions noOutlier = paper;
   noOutlier.filters.outlier = false;
   const double without = patchError(recover(noOutlier, photos));
@@ -110,7 +112,7 @@ TEST_F(RecoverCornell, OutlierTestRemovesALampFixtureSeenInOnePhoto) {
   // The weighted merge removes it without the outlier test too: the fixture's estimates
   // (R ~ 5 / light) are above 1, which no diffuse surface reflects.
   RecoveryOptions weightedOnly = options();
-  weightedOnly.iterations = 3;
+  weightedOnly.iterations = 1; // 0.0057 (0.0021 after three)
   weightedOnly.filters.outlier = false;
   EXPECT_LT(patchError(recover(weightedOnly, photos)), 0.05);
 }
