@@ -3,6 +3,9 @@
 // issue 10; speed itself is never asserted by a test, docs/BENCHMARKS.md records it).
 #include <string>
 
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -22,6 +25,10 @@ nlohmann::json lastJsonLine(const std::string& output) {
 }
 
 TEST_F(CliBench, PassesAndFrameFiguresArePositiveAndConsistent) {
+  // Embree's threads flush denormals; the command runs in this process and must leave its mode
+  // as it found it (left flushing, a later recovery merged other pixels).
+  constexpr unsigned kFlushModes = _MM_FLUSH_ZERO_MASK | _MM_DENORMALS_ZERO_MASK;
+  [[maybe_unused]] const unsigned modeBefore = _mm_getcsr() & kFlushModes;
   const auto r = runObscura("bench-rays " + cornellBox() +
                             " --rays 4096 --repeats 1 --verify 512 --json --passes 24x24 --frame 20x16 --frame-dmax 0.5"
                             " --frame-spp 4 --lanes 32x24 --baseline embree");
@@ -30,6 +37,7 @@ TEST_F(CliBench, PassesAndFrameFiguresArePositiveAndConsistent) {
   EXPECT_CONTAINS(r.output, "without Embree");
 #else
   ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(_mm_getcsr() & kFlushModes, modeBefore) << "bench-rays left this thread flushing denormals";
   const nlohmann::json j = lastJsonLine(r.output);
 
   // --passes: the paper's budget (8 spp, 5 shadow and 5 obscurance rays per hit) at 24x24, the
