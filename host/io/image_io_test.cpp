@@ -8,6 +8,9 @@
 #include <fstream>
 #include <unistd.h>
 #include <vector>
+#include <bit>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
 
 #include <fmt/core.h>
 
@@ -16,6 +19,7 @@
 #include "io/exr_writer.h"
 #include "io/oiio_codec.h"
 #include "io/stb_codec.h"
+#include "gpu_test.h"
 
 namespace obscura::io {
 namespace {
@@ -74,6 +78,30 @@ TEST(ImageIo, UnreadableImageNamesTheFileThroughStb) {
 // The writer of builds without OpenImageIO, read back by OpenImageIO (the default build's reader):
 // every channel by name, every value bit for bit, names out of order and one longer than 31
 // bytes (the long-names flag).
+TEST(ImageIo, HalfSubnormalsReadTheSameWhenTheCallerFlushesDenormals) {
+#ifndef OBSCURA_HAVE_OPENIMAGEIO
+  GTEST_SKIP() << "this build has no OpenImageIO to read the file";
+#endif
+  // A Cycles photograph (RGB half): its darkest pixels are half subnormals, (57, 56) of shot 1 at
+  // 2^-24, 2^-24 and 14 x 2^-24. Read with flush-to-zero and denormals-are-zero on, as a library
+  // built with -ffast-math leaves a process, they must not come back as 0; the mode is put back.
+  const std::string path = test::repoPath("tests/data/photos/classroom/photo-001.exr");
+  const Image plain = readImage(path);
+  const unsigned mode = _mm_getcsr();
+  _mm_setcsr(mode | _MM_FLUSH_ZERO_MASK | _MM_DENORMALS_ZERO_MASK);
+  const Image flushing = readImage(path);
+  const unsigned after = _mm_getcsr();
+  _mm_setcsr(mode);
+  EXPECT_EQ(after, mode | _MM_FLUSH_ZERO_MASK | _MM_DENORMALS_ZERO_MASK);
+  EXPECT_EQ(plain.at(57, 56, 0), std::ldexp(1.0f, -24));
+  EXPECT_EQ(plain.at(57, 56, 2), std::ldexp(14.0f, -24));
+  ASSERT_EQ(flushing.pixels.size(), plain.pixels.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < plain.pixels.size(); ++i)
+    differ += std::bit_cast<std::uint32_t>(flushing.pixels[i]) != std::bit_cast<std::uint32_t>(plain.pixels[i]);
+  EXPECT_EQ(differ, 0u);
+}
+
 TEST(ImageIo, UncompressedExrReadsBackBitForBitThroughOpenImageIo) {
 #ifndef OBSCURA_HAVE_OPENIMAGEIO
   GTEST_SKIP() << "this build has no OpenImageIO to read the file back";
