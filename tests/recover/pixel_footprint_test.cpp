@@ -84,7 +84,7 @@ TEST(PixelFootprint, AnEdgeTheCoarseGridMissesIsFoundFromTheNeighbourAcrossIt) {
   std::size_t refined = 0;
   const recover::PixelFootprints f =
       recover::traceFootprints(twoWalls(0.03f, 1.0f), rays, overTheWalls(), kSize, kSize, &refined);
-  EXPECT_EQ(refined, std::size_t(2 * kSize)); // columns 3 and 4; the others are two pixels from the edge
+  EXPECT_EQ(refined, std::size_t(2 * kSize)); // columns 3 and 4; each other one sees what its neighbours see
   for (int y = 0; y < kSize; ++y) {
     EXPECT_EQ(pointsOn(f, at(4, y), 0), all / 8) << "row " << y;
     EXPECT_EQ(pointsOn(f, at(4, y), 1), all * 7 / 8) << "row " << y;
