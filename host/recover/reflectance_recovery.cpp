@@ -191,29 +191,26 @@ std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, co
   const glm::vec3 fallback = unseenGrey         ? glm::vec3(*unseenGrey)
                              : allWeight > 0.0 ? glm::vec3(luminance(glm::vec3(all / allWeight)))
                                                : glm::vec3(0.5f);
-  // An object no photograph shows takes the mean of the seen objects of its material.
-  std::map<std::uint32_t, std::pair<glm::dvec3, double>> byMaterial;
+  // An object no photograph shows takes the mean of the seen objects of its material. The objects
+  // of one colour in the model pool their pixels with the others of their material: a sliver lit
+  // only by bounces from the wood beside it (the staircase's white trim under its stringer, 149 px,
+  // 140 of them lit by no lamp) measured the wood's colour, and its fills took it (11 % of the
+  // staircase's squared error; BENCHMARKS "one colour per material").
+  std::map<std::uint32_t, std::pair<glm::dvec3, double>> byMaterial, pooled;
+  const auto pools = [&](std::size_t o) { return objectMaterial && oneColour && (*oneColour)[o]; };
+  const auto add = [&](std::map<std::uint32_t, std::pair<glm::dvec3, double>>& group, std::size_t o) {
+    auto& m = group[(*objectMaterial)[o]];
+    m.first += sum[o];
+    m.second += weight[o];
+  };
   if (objectMaterial)
     for (std::size_t o = 0; o < objects; ++o) {
-      auto& m = byMaterial[(*objectMaterial)[o]];
-      m.first += sum[o];
-      m.second += weight[o];
+      add(byMaterial, o);
+      if (pools(o)) add(pooled, o);
     }
-  // The objects of one colour in the model pool their pixels with the others of their material:
-  // a sliver lit only by bounces from the wood beside it (the staircase's white trim under its
-  // stringer, 149 px, 140 of them lit by no lamp) measured the wood's colour, and its fills took it
-  // (11 % of the staircase's squared error; BENCHMARKS "one colour per material").
-  std::map<std::uint32_t, std::pair<glm::dvec3, double>> pooled;
-  if (objectMaterial && oneColour)
-    for (std::size_t o = 0; o < objects; ++o)
-      if ((*oneColour)[o]) {
-        auto& m = pooled[(*objectMaterial)[o]];
-        m.first += sum[o];
-        m.second += weight[o];
-      }
   std::vector<glm::vec3> means(objects);
   for (std::size_t o = 0; o < objects; ++o) {
-    if (objectMaterial && oneColour && (*oneColour)[o]) {
+    if (pools(o)) {
       const auto& m = pooled[(*objectMaterial)[o]];
       if (m.second > 0.0) {
         means[o] = glm::vec3(m.first / m.second);
