@@ -627,8 +627,11 @@ TEST_F(HardBvh, HundredThousandTrianglesOfGeometricSizes) {
   // Rays through the whole range of scales: aimed at points inside random triangles.
   std::mt19937 rng(2);
   std::uniform_real_distribution<float> uni(0.05f, 0.9f), sym(-1.0f, 1.0f);
-  std::vector<gpu::GpuRay> rays = raysThrough(soup, kPathologicalRays / 2, 3);
-  while (rays.size() < kPathologicalRays) {
+  // Fewer rays than the other soups': the chain's truncated ones each run the whole step budget
+  // (16 s of the suite at 10,000 rays, 6 s at 4,000).
+  constexpr std::size_t kRays = kPathologicalRays * 2 / 5;
+  std::vector<gpu::GpuRay> rays = raysThrough(soup, kRays / 2, 3);
+  while (rays.size() < kRays) {
     std::size_t t = rng() % soup.size();
     float u = uni(rng), v = uni(rng) * (1.0f - u);
     glm::vec3 p = soup.v0[t] + u * (soup.v1[t] - soup.v0[t]) + v * (soup.v2[t] - soup.v0[t]);
@@ -636,7 +639,7 @@ TEST_F(HardBvh, HundredThousandTrianglesOfGeometricSizes) {
     rays.push_back({glm::vec4(o, 0.0f), glm::vec4(p - o, kInf)});
   }
   // Rays along the chain overlap the boxes of every triangle beyond their hit (the triangles are
-  // nested around the x axis): measured 3142 of 10,000 truncated, whatever the tree. Allowed, but
+  // nested around the x axis): measured 1924 of 4,000 truncated, whatever the tree. Allowed, but
   // they must be reported, and every other ray must agree exactly.
   check(soup, rays, "geometric sizes", 10.0, true);
 }
