@@ -9,6 +9,7 @@
 //   constant    lit 0.132                                  all 0.140
 // The goals (lit <= 0.02, all <= 0.04) are asserted as such.
 #include <algorithm>
+#include <cstdio>
 
 #include <gtest/gtest.h>
 
@@ -64,7 +65,8 @@ TEST_F(RecoverCornell, PathsThroughHiddenSurfacesAndTheWeightedMergeLowerTheFirs
 
 TEST_F(RecoverCornell, MinFilterKeepsShadowedEstimatesOutOfTheMerge) {
   // Without the 5x5 min filter the smoothing filters spread confidence into pixels no lamp
-  // lights, whose estimates C / B are noisy (measured all 0.045 against 0.024).
+  // lights, whose estimates C / B are noisy (measured all 0.0422 against 0.0288; one iteration at 8
+  // gather rays, 2 s less, 0.0510 against 0.0399: too near the bound).
   // The paper's merge: the weighted one gives an estimate near a shadow edge a weight by its
   // error instead (without the min filter it measured all 0.0179 against 0.0203 with it).
   RecoveryOptions paper = options();
@@ -74,6 +76,7 @@ TEST_F(RecoverCornell, MinFilterKeepsShadowedEstimatesOutOfTheMerge) {
   noMin.filters.minFilter = false;
   const RecoveryAccuracy without = accuracy(recover(noMin, *photos_));
   const RecoveryAccuracy with = accuracy(recover(paper, *photos_));
+  std::printf("all pixels' RMSE: %.4f without the min filter, %.4f with it\n", without.all.rmse, with.all.rmse);
   EXPECT_LT(with.all.rmse, 0.8 * without.all.rmse);
 }
 
@@ -89,6 +92,17 @@ TEST_F(RecoverCornell, OutlierTestRemovesALampFixtureSeenInOnePhoto) {
       photos.shots[0].radiance[p] = glm::vec3(5.0f);
       patch.push_back(p);
     }
+  // One iteration each, 1 spp and 4 gather rays: the fixture is in the photographs, not in the
+  // indirect light the iterations and the gather refine (measured, seed 1: the paper's merge 2.24
+  // without the outlier test, 0.017 with it, the weighted merge 0.011; at options() and one
+  // iteration 0.0125 and 0.0057, for 3 s more).
+  const auto cheap = [] {
+    RecoveryOptions o = options();
+    o.iterations = 1;
+    o.spp = 1;
+    o.gatherRays = 4;
+    return o;
+  };
   auto patchError = [&](const Recovery& r) {
     double sum = 0.0;
     for (std::size_t p : patch) {
@@ -98,11 +112,8 @@ TEST_F(RecoverCornell, OutlierTestRemovesALampFixtureSeenInOnePhoto) {
     return std::sqrt(sum / double(patch.size()));
   };
   // The paper's merge: the outlier test is what removes the fixture.
-  // One iteration each: the fixture is in the photographs, not the indirect light the iterations
-  // refine (the patch's error with the test, seed 1: 0.0125 after one, 0.0079 after three).
-  RecoveryOptions paper = options();
+  RecoveryOptions paper = cheap();
   paper.merge = MergeModel::Paper;
-  paper.iterations = 1;
   RecoveryOptions noOutlier = paper;
   noOutlier.filters.outlier = false;
   const double without = patchError(recover(noOutlier, photos));
@@ -111,10 +122,12 @@ TEST_F(RecoverCornell, OutlierTestRemovesALampFixtureSeenInOnePhoto) {
   EXPECT_LT(with, 0.05);   // the fixture is gone
   // The weighted merge removes it without the outlier test too: the fixture's estimates
   // (R ~ 5 / light) are above 1, which no diffuse surface reflects.
-  RecoveryOptions weightedOnly = options();
-  weightedOnly.iterations = 1; // 0.0057 (0.0021 after three)
+  RecoveryOptions weightedOnly = cheap();
   weightedOnly.filters.outlier = false;
-  EXPECT_LT(patchError(recover(weightedOnly, photos)), 0.05);
+  const double weighted = patchError(recover(weightedOnly, photos));
+  std::printf("the patch's RMSE: the paper's merge %.4f without the outlier test, %.4f with it; the weighted merge "
+              "without it %.4f\n", without, with, weighted);
+  EXPECT_LT(weighted, 0.05);
 }
 
 } // namespace

@@ -204,8 +204,13 @@ void expectLargeFrameRenders(const gpu::Context& context, const scene::Scene& s,
 TEST_F(FrameBands, CornellBoxRendersAt3840x2160) {
   // Split again (half of its 13 s on 2 cores), it would check what modern-hall's resplit below checks:
   // the bands' arithmetic does not depend on the frame's size. (A 1080p frame, one band split in
-  // several, checked that too, for 6 s of the suite.)
-  expectLargeFrameRenders(context(), cornell_, cornellBvh_, cornellSettings(3840, 2160), 4u, Resplit::No);
+  // several, checked that too, for 6 s of the suite.) One camera ray per pixel: the probe of every
+  // pixel's corners for the lamp's edge (--emission-samples auto) was four of the frame's five
+  // primary rays, half its time, and the banded frames above probe in bands bit for bit.
+  render::ObscuranceSettings settings = cornellSettings(3840, 2160);
+  settings.emissionSamples = 1;
+  settings.emissionAtEdges = false;
+  expectLargeFrameRenders(context(), cornell_, cornellBvh_, settings, 4u, Resplit::No);
 }
 
 TEST_F(FrameBands, ModernHallRendersAtThePapers800x600WithAllItsLights) {
@@ -215,6 +220,8 @@ TEST_F(FrameBands, ModernHallRendersAtThePapers800x600WithAllItsLights) {
   settings.width = 800;
   settings.height = 600;
   settings.camera = s.cameras.at(0);
+  settings.emissionSamples = 1; // as the 4K frame's (the small banded frames probe the edges)
+  settings.emissionAtEdges = false;
   render::ObscuranceRenderer probe(context(), s, tree, [&] {
     auto small = settings;
     small.width = 8;

@@ -37,14 +37,15 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 tools=$(cd "$(dirname "$0")" && pwd)
-rays=4194304 verify=1000000 check=100000 passes=800x600 hall=(800 600) sponza=(1920 1080) view=(1280 720)
+rays=4194304 verify=1000000 check=100000 passes=800x600 hall=(800 600) sponza=(1920 1080) view=(1280 720) repeats=5
 limit=${STEP_LIMIT:-150}
 hall_scene=$scenes/modern-hall/modern-hall.gltf sponza_scene=$scenes/sponza/sponza.gltf
 if [ "$quick" = quick ]; then
   # Every step as the GPU runs it, but small: modern-hall stands in for Sponza (whose load and
   # BVH build alone take 3 s a step on 2 cores), and the Sponza steps that would repeat a
   # modern-hall one are left out (`full`).
-  rays=65536 verify=16384 check=16384 passes=80x60 hall=(80 60) sponza=(96 54) view=(64 36) limit=300
+  # One timed repeat: the figures are not read here, only that every step runs.
+  rays=65536 verify=16384 check=16384 passes=80x60 hall=(80 60) sponza=(96 54) view=(64 36) limit=300 repeats=1
   sponza_scene=$hall_scene
 fi
 
@@ -68,22 +69,22 @@ step() { # name command...: runs it under a time limit, everything into log.txt
   command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
   ldd "$obscura" | grep 'not found' && echo "LIBRARIES MISSING"
   step info "$obscura" info
-  step bench-hall "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify "$check" --passes "$passes"
-  step bench-hall-wide "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify "$check" \
+  step bench-hall "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats "$repeats" --verify "$check" --passes "$passes"
+  step bench-hall-wide "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats "$repeats" --verify "$check" \
     --passes "$passes" --traversal wide
-  step bench-hall-binary "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --verify "$check" \
+  step bench-hall-binary "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats "$repeats" --verify "$check" \
     --traversal binary
-  step bench-hall-no-splits "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats 5 --spatial-splits 0
-  full step bench-sponza "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$verify"
-  full step bench-sponza-wide "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$check" \
+  step bench-hall-no-splits "$obscura" bench-rays "$hall_scene" --rays "$rays" --repeats "$repeats" --spatial-splits 0
+  full step bench-sponza "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats "$repeats" --verify "$verify"
+  full step bench-sponza-wide "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats "$repeats" --verify "$check" \
     --traversal wide
-  full step bench-sponza-binary "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --verify "$check" \
+  full step bench-sponza-binary "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats "$repeats" --verify "$check" \
     --traversal binary
-  full step bench-sponza-no-splits "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --spatial-splits 0
-  step bench-sponza-storage "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --bvh-items storage
-  step bench-sponza-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --cull-on-pop
+  full step bench-sponza-no-splits "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats "$repeats" --spatial-splits 0
+  step bench-sponza-storage "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats "$repeats" --bvh-items storage
+  step bench-sponza-cull "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats "$repeats" --cull-on-pop
   # Several rays per invocation: the binary refilling loop (slower than one ray each on an H200).
-  step bench-sponza-64x4 "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats 5 --traversal binary \
+  step bench-sponza-64x4 "$obscura" bench-rays "$sponza_scene" --rays "$rays" --repeats "$repeats" --traversal binary \
     --trace-shape 64x4 --verify "$check"
   step render-hall "$obscura" render "$hall_scene" --width "${hall[0]}" \
     --height "${hall[1]}" --spp 8 --shadow-rays 5 --obs-rays 5 -o "$out/modern-hall.png" --metrics "$out/modern-hall.metrics.json"
