@@ -134,4 +134,31 @@ std::size_t mixFootprints(const PixelFootprints& footprints, const std::vector<s
   return mixed;
 }
 
+std::size_t unmixFootprints(const PixelFootprints& footprints, const std::vector<std::int32_t>& object,
+                            const std::vector<glm::vec3>& objectMeans, std::vector<glm::vec3>& reflectance,
+                            std::vector<float>& weight) {
+  std::size_t unmixed = 0;
+  for (std::size_t p = 0; p < reflectance.size(); ++p) {
+    const std::int32_t o = object[p];
+    if (o < 0 || weight[p] <= 0.0f || footprints.whole(p)) continue;
+    const std::int32_t* points = footprints.object.data() + p * PixelFootprints::kPoints;
+    int own = 0;
+    glm::vec3 others(0.0f); // sum_{j != o} a_j rho_j; points on nothing add no reflectance
+    for (int k = 0; k < PixelFootprints::kPoints; ++k) {
+      if (points[k] == o) ++own;
+      else if (points[k] >= 0) others += objectMeans.at(std::size_t(points[k]));
+    }
+    const float share = float(own) / float(PixelFootprints::kPoints);
+    others /= float(PixelFootprints::kPoints);
+    if (share < kUnmixShare) {
+      weight[p] = 0.0f;
+      continue;
+    }
+    reflectance[p] = glm::clamp((reflectance[p] - others) / share, glm::vec3(0.0f), glm::vec3(1.0f));
+    weight[p] *= share * share;
+    ++unmixed;
+  }
+  return unmixed;
+}
+
 } // namespace obscura::recover

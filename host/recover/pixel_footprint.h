@@ -67,4 +67,17 @@ inline constexpr int kFootprintMixSupport = 3;
 std::size_t mixFootprints(const PixelFootprints& footprints, const std::vector<std::int32_t>& object,
                           const std::vector<glm::vec3>& objectMeans, std::vector<glm::vec3>& reflectance);
 
+// The inverse of that mix, for the objects' means: every merged pixel whose footprint covers more
+// than its centre's object o (and whose `weight` is above 0) set to o's share alone,
+// rho_o = (rho - sum_{j != o} a_j objectMeans[j]) / a_o, clamped to [0, 1], its weight times a_o^2
+// (the estimate's error grows as 1 / a_o), or 0 where a_o < kUnmixShare. A surface the camera sees
+// only edge-on has no other pixels: the hall's switched-off panel across from the balustrade (base
+// colour 0, a 1-pixel column) measured the wall behind it, 0.27, and the gather's paths through it
+// lit the balustrade 7-26 % too brightly in every shot (BENCHMARKS, "the footprints unmixed").
+// Returns how many pixels were unmixed.
+inline constexpr float kUnmixShare = 0.25f;
+std::size_t unmixFootprints(const PixelFootprints& footprints, const std::vector<std::int32_t>& object,
+                            const std::vector<glm::vec3>& objectMeans, std::vector<glm::vec3>& reflectance,
+                            std::vector<float>& weight);
+
 } // namespace obscura::recover

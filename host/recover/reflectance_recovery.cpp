@@ -360,6 +360,21 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   // merge in image windows. `lighting`'s geometry is the same object when lighting is traced again.
   const Surfaces pixelSurfaces{&lighting.geometry.object, &lighting.geometry.normal};
   const Surfaces* surfaces = options.merge == MergeModel::Weighted ? &pixelSurfaces : nullptr;
+  // The device's rays through the renderer's traversal: the pixels' footprints and the gather's.
+  const render::SceneBuffers buffers(context, room, bvh);
+  render::GpuRayBatch rays(context, buffers, render::TraceShape::forDevice(context, buffers.traversal()));
+  // Which surfaces each pixel's footprint covers (the weighted merge's; pixel_footprint.h): the
+  // iterations' object means unmix the pixels that cover several, and the kept merge's take the mix
+  // of their surfaces at the end.
+  std::optional<PixelFootprints> footprints;
+  if (options.merge == MergeModel::Weighted) {
+    const auto footprintStart = Clock::now();
+    std::size_t nearEdge = 0;
+    footprints = traceFootprints(room, rays, camera, photos.width, photos.height, &nearEdge);
+    if (log)
+      log(fmt::format("recover: footprints ({} pixels near an edge traced at {} x {}): {:.1f} s", nearEdge,
+                      PixelFootprints::kGrid, PixelFootprints::kGrid, secondsSince(footprintStart)));
+  }
   std::vector<std::vector<glm::vec3>> ambient;
   for (const auto& shot : photos.shots)
     ambient.push_back(constantAmbient(shot.radiance, lighting.geometry.object, options.constantReflectance));
@@ -383,9 +398,6 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
                                         &objectMaterial, &ratios, unseenGrey, &oneColour)});
   if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
 
-  // The device's rays through the renderer's traversal: the gather's and the pixels' footprints.
-  const render::SceneBuffers buffers(context, room, bvh);
-  render::GpuRayBatch rays(context, buffers, render::TraceShape::forDevice(context, buffers.traversal()));
   std::unique_ptr<PhotoGather> gather;
   if (options.indirect == IndirectModel::Gather) {
     stepStart = Clock::now();
@@ -431,7 +443,12 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       merged = std::move(next);
       const double change = n > 0 ? std::sqrt(sum / double(n)) : 0.0;
       ratios = photographed(out.indirect);
-      std::vector<glm::vec3> nextMeans = objectMeans(merged.reflectance, inverseVariance(merged),
+      // Each object's pixels as its own reflectance: those whose footprint covers other objects
+      // too unmixed with these means (the first means, from the constant ambient, mix as they come).
+      std::vector<glm::vec3> own = merged.reflectance;
+      std::vector<float> weights = inverseVariance(merged);
+      if (footprints) unmixFootprints(*footprints, lighting.geometry.object, means, own, weights);
+      std::vector<glm::vec3> nextMeans = objectMeans(own, weights,
                                                      lighting.geometry.object, objects, &objectMaterial, &ratios,
                                                      unseenGrey, &oneColour);
       if (out.iterations.size() >= 2) dampSwings(out.iterations[out.iterations.size() - 2].objectReflectance, means, nextMeans);
@@ -500,16 +517,10 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.surfaceReflectance = out.reflectance;
   // Pixels whose footprint covers several surfaces: the mix of those surfaces' reflectances
   // (pixel_footprint.h). The paper's merge keeps its own estimate there.
-  if (options.merge == MergeModel::Weighted) {
-    stepStart = Clock::now();
-    std::size_t nearEdge = 0;
-    const PixelFootprints footprints = traceFootprints(room, rays, camera, photos.width, photos.height, &nearEdge);
-    out.mixedFromFootprint = mixFootprints(footprints, out.object, means, out.reflectance);
-    if (log)
-      log(fmt::format("recover: {} pixels whose footprint covers several surfaces, mixed from theirs ({} near an "
-                      "edge traced at {} x {}): {:.1f} s",
-                      out.mixedFromFootprint, nearEdge, PixelFootprints::kGrid, PixelFootprints::kGrid,
-                      secondsSince(stepStart)));
+  if (footprints) {
+    out.mixedFromFootprint = mixFootprints(*footprints, out.object, means, out.reflectance);
+    if (log) log(fmt::format("recover: {} pixels whose footprint covers several surfaces, mixed from theirs",
+                             out.mixedFromFootprint));
   }
   out.seconds = secondsSince(start);
   return out;

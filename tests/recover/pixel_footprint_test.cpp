@@ -141,5 +141,52 @@ TEST(PixelFootprint, APixelOnTwoSurfacesTakesTheMixOfTheirReflectancesNotItsOwnE
   EXPECT_NEAR(noneWhole[at(4, 4)].x, 0.5f * 0.2f + 0.5f * 0.7f, 1e-6f);
 }
 
+// The inverse, for the objects' means: a pixel half on the left wall (0.2) and half on the right
+// (0.8) merged at their mix, 0.5, gives back its centre's own 0.2 at a quarter of its weight; a
+// pixel with a quarter on its wall and the rest on nothing (no light, no reflectance) gives back
+// 4 x its 0.05; whole pixels and those without an estimate are left alone; a centre object with
+// less than kUnmixShare of the footprint (row 1's column 4: an eighth) loses its weight.
+TEST(PixelFootprint, AMixedPixelUnmixedWithItsNeighboursMeansGivesItsOwnSurfacesReflectance) {
+  const recover::PixelFootprints f = footprintsOf(twoWalls(0.125f, 0.5625f));
+  std::vector<std::int32_t> object(std::size_t(kSize) * kSize);
+  std::vector<glm::vec3> reflectance(object.size());
+  std::vector<float> weight(object.size(), 2.0f);
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      const std::size_t p = at(x, y);
+      object[p] = y == 0 ? -1 : x <= 4 ? 0 : 1;
+      reflectance[p] = y <= 1 ? glm::vec3(0.05f) : f.whole(p) ? glm::vec3(x <= 4 ? 0.2f : 0.8f) : glm::vec3(0.5f);
+    }
+  weight[at(4, 7)] = 0.0f; // no estimate: left alone
+  const std::vector<glm::vec3> means = {glm::vec3(0.2f), glm::vec3(0.8f)};
+  const std::size_t unmixed = recover::unmixFootprints(f, object, means, reflectance, weight);
+  EXPECT_EQ(unmixed, std::size_t(5 + kSize - 1)); // column 4 in rows 2-6, and row 1 but its column 4
+  EXPECT_EQ(weight[at(4, 1)], 0.0f);
+  for (int y = 2; y < 7; ++y) {
+    EXPECT_NEAR(reflectance[at(4, y)].x, 0.2f, 1e-6f) << "row " << y; // (0.5 - 0.5 x 0.8) / 0.5
+    EXPECT_FLOAT_EQ(weight[at(4, y)], 0.5f);                           // 2 x 0.5^2
+    EXPECT_EQ(reflectance[at(3, y)], glm::vec3(0.2f));                 // whole: as it was
+    EXPECT_FLOAT_EQ(weight[at(3, y)], 2.0f);
+  }
+  EXPECT_EQ(reflectance[at(4, 7)], glm::vec3(0.5f));
+  EXPECT_NEAR(reflectance[at(1, 1)].x, 0.2f, 1e-6f); // 0.05 / 0.25: nothing adds no reflectance
+  EXPECT_FLOAT_EQ(weight[at(1, 1)], 2.0f / 16.0f);
+  EXPECT_EQ(reflectance[at(1, 0)], glm::vec3(0.05f)); // its centre sees nothing
+
+  // A sliver: column 4 as the right wall's (an eighth of its footprint, the rest the left wall's):
+  // no weight; unmixed, its estimate would be the noise of the other seven eighths times eight.
+  const recover::PixelFootprints thin = footprintsOf(twoWalls(0.21875f, 1.0f));
+  std::vector<std::int32_t> sliver(object.size(), 0);
+  std::vector<float> sliverWeight(object.size(), 1.0f);
+  std::vector<glm::vec3> sliverR(object.size(), glm::vec3(0.3f));
+  for (int y = 0; y < kSize; ++y) sliver[at(4, y)] = 1;
+  EXPECT_EQ(recover::unmixFootprints(thin, sliver, means, sliverR, sliverWeight), 0u);
+  for (int y = 0; y < kSize; ++y) {
+    EXPECT_EQ(pointsOn(thin, at(4, y), 1), recover::PixelFootprints::kPoints / 8) << "row " << y;
+    EXPECT_EQ(sliverWeight[at(4, y)], 0.0f) << "row " << y;
+    EXPECT_EQ(sliverWeight[at(3, y)], 1.0f) << "row " << y;
+  }
+}
+
 } // namespace
 } // namespace obscura::test
