@@ -255,8 +255,8 @@ void addRecoverCommand(CLI::App& app) {
                   "stands in (0: at once)")
       ->check(CLI::Range(0u, recover::kMaxHiddenBounces));
   cmd->add_option("--unseen-reflectance", o->recovery.unseenReflectance,
-                  "the grey of objects no photograph shows and no seen object shares a material with (0: the seen "
-                  "pixels' mean luminance)")
+                  "the grey of objects no photograph shows and no seen object shares a material with (0: the colour "
+                  "the model gives them, or for a textured material the seen pixels' mean luminance)")
       ->check(CLI::Range(0.0f, 1.0f));
   addNamedOption(*cmd, "--merge", o->recovery.merge, recover::kMergeModelNames,
                  "how the photos' estimates merge: weighted (by their expected error, pixels no lamp lights recovered "

@@ -40,6 +40,20 @@ TEST(ObjectMeans, AnUnseenObjectTakesItsMaterialsSeenMeanElseTheGreyOfEverySeenP
   EXPECT_FLOAT_EQ(told[2].x, 0.35f);
   EXPECT_FLOAT_EQ(told[3].x, 0.8f);
   EXPECT_FLOAT_EQ(told[3].z, 0.8f);
+  // The colour the model gives an object of a material no photograph shows replaces the grey
+  // (object 3); not a seen object's mean, nor an unseen object's material mean (object 2); and the
+  // user's grey comes first.
+  const glm::vec3 white(0.8f, 0.8f, 0.75f);
+  const std::vector<std::optional<glm::vec3>> model{glm::vec3(0.1f), glm::vec3(0.1f), glm::vec3(0.1f), white};
+  const std::vector<glm::vec3> modelled =
+      objectMeans(reflectance, confidence, object, 4, &material, nullptr, std::nullopt, nullptr, &model);
+  EXPECT_FLOAT_EQ(modelled[0].x, 0.35f);
+  EXPECT_FLOAT_EQ(modelled[2].x, 0.35f);
+  EXPECT_FLOAT_EQ(modelled[3].z, 0.75f);
+  const std::vector<std::optional<glm::vec3>> textured{std::nullopt, std::nullopt, std::nullopt, std::nullopt};
+  EXPECT_FLOAT_EQ(objectMeans(reflectance, confidence, object, 4, &material, nullptr, std::nullopt, nullptr, &textured)[3].x,
+                  5.0f / 8.0f);
+  EXPECT_FLOAT_EQ(objectMeans(reflectance, confidence, object, 4, &material, nullptr, 0.8f, nullptr, &model)[3].z, 0.8f);
 }
 
 TEST(ObjectMeans, ObjectsOfOneColourInTheModelShareTheirMaterialsMeanAndTexturedOnesKeepTheirOwn) {

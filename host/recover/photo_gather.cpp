@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 #include <stdexcept>
+#include <unordered_map>
 
 #include <glm/gtc/constants.hpp>
 
@@ -83,6 +84,20 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
   const float scale = render::sceneScale(room.bounds);
   const float offset = 1e-4f * scale;       // ray origins off the surface
   const float samePlane = 2e-3f * scale;    // a seen pixel's point within this of the hit's plane
+  // The cut's regions: an object's part in one cubic cell of a grid over the room.
+  const glm::vec3 extent = room.bounds.extent();
+  const float cell = std::max({extent.x, extent.y, extent.z, 1e-6f}) / kCutCells;
+  const glm::ivec3 regionCells = glm::max(glm::ivec3(glm::ceil(extent / cell)), glm::ivec3(1));
+  std::unordered_map<std::uint64_t, std::uint32_t> regionAt;
+  const auto regionOf = [&](std::uint32_t object, const glm::vec3& point) {
+    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((point - room.bounds.lo) / cell)), glm::ivec3(0), regionCells - 1);
+    const std::uint64_t key =
+        ((std::uint64_t(object) * std::uint64_t(regionCells.z) + std::uint64_t(c.z)) * std::uint64_t(regionCells.y) +
+         std::uint64_t(c.y)) * std::uint64_t(regionCells.x) + std::uint64_t(c.x);
+    const auto [at, added] = regionAt.try_emplace(key, static_cast<std::uint32_t>(regionObject_.size()));
+    if (added) regionObject_.push_back(object);
+    return at->second;
+  };
   seenStart_.reserve(pixels_ + 1);
   hiddenStart_.reserve(pixels_);
   hiddenEnd_.reserve(pixels_);
@@ -258,6 +273,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
         }
         active.push_back({static_cast<std::uint32_t>(hiddenObject_.size()), c.lit, c.normal});
         hiddenObject_.push_back(c.object);
+        hiddenRegion_.push_back(regionOf(c.object, c.lit));
         next_.push_back(kTruncated);
         queueDirect(c, hiddenDirect_, true, static_cast<std::uint32_t>(hiddenObject_.size() - 1));
         ++firstHidden_;
@@ -289,6 +305,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
         const auto u = static_cast<std::uint32_t>(hiddenObject_.size());
         next_[v] = u;
         hiddenObject_.push_back(c.object);
+        hiddenRegion_.push_back(regionOf(c.object, c.lit));
         next_.push_back(kTruncated);
         queueDirect(c, hiddenDirect_, false, u);
         deeper.push_back({u, c.lit, c.normal});
@@ -348,10 +365,9 @@ std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radianc
                                            const std::vector<glm::vec3>& lampColour,
                                            const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
                                            Cut* settled, std::vector<float>* modelled) const {
-  std::vector<glm::dvec3> incoming;
-  std::vector<double> paths;
-  const std::vector<glm::vec3> hidden = hiddenRadiance(radiance, lampColour, objectReflectance, cut,
-                                                       settled ? &incoming : nullptr, settled ? &paths : nullptr);
+  CutSums sums;
+  const std::vector<glm::vec3> hidden =
+      hiddenRadiance(radiance, lampColour, objectReflectance, cut, settled ? &sums : nullptr);
   std::vector<glm::vec3> out(pixels_, glm::vec3(0.0f)), deep;
   if (modelled) deep.assign(pixels_, glm::vec3(0.0f));
   const std::vector<std::size_t> lit = litShots(lampColour);
@@ -392,8 +408,14 @@ std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radianc
         ++surfaces;
       }
     const glm::dvec3 b = surfaces > 0 ? sumB / double(surfaces) : glm::dvec3(0.0);
-    settled->resize(cut.size());
-    for (std::size_t o = 0; o < cut.size(); ++o) (*settled)[o] = glm::vec3((incoming[o] + kCutPrior * b) / (paths[o] + kCutPrior));
+    settled->object.resize(cut.object.size());
+    for (std::size_t o = 0; o < cut.object.size(); ++o)
+      settled->object[o] = glm::vec3((sums.incoming[o] + kCutPrior * b) / (sums.paths[o] + kCutPrior));
+    settled->region.resize(regionObject_.size());
+    for (std::size_t r = 0; r < regionObject_.size(); ++r) {
+      const glm::dvec3 object(settled->object[regionObject_[r]]);
+      settled->region[r] = glm::vec3((sums.regionIncoming[r] + kCutPrior * object) / (sums.regionPaths[r] + kCutPrior));
+    }
   }
   return out;
 }
@@ -401,25 +423,30 @@ std::vector<glm::vec3> PhotoGather::gather(const std::vector<glm::vec3>& radianc
 std::vector<glm::vec3> PhotoGather::hiddenRadiance(const std::vector<glm::vec3>& radiance,
                                                    const std::vector<glm::vec3>& lampColour,
                                                    const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
-                                                   std::vector<glm::dvec3>* incoming, std::vector<double>* paths) const {
+                                                   CutSums* sums) const {
   // L(v) = R_o(v) (sum_i direct_i(v) lamp_i + L_in(v)), L_in(v) the next vertex's L, the
   // photograph where the camera sees it, 0 where the ray left, c_o(v) where the path was cut.
   const std::size_t vertices = hiddenObject_.size();
   std::vector<glm::vec3> out(vertices);
   const std::vector<std::size_t> lit = litShots(lampColour);
-  if (incoming) {
-    incoming->assign(cut.size(), glm::dvec3(0.0));
-    paths->assign(cut.size(), 0.0);
+  if (sums) {
+    sums->incoming.assign(cut.object.size(), glm::dvec3(0.0));
+    sums->paths.assign(cut.object.size(), 0.0);
+    sums->regionIncoming.assign(regionObject_.size(), glm::dvec3(0.0));
+    sums->regionPaths.assign(regionObject_.size(), 0.0);
   }
+  const bool regional = cut.region.size() == regionObject_.size();
   for (std::size_t v = vertices; v-- > 0;) {
-    const std::uint32_t n = next_[v], o = hiddenObject_[v];
+    const std::uint32_t n = next_[v], o = hiddenObject_[v], r = hiddenRegion_[v];
     const glm::vec3 in = n == kEscaped ? glm::vec3(0.0f)
-                         : n == kTruncated ? cut[o]
+                         : n == kTruncated ? (regional ? cut.region[r] : cut.object[o])
                          : (n & kSeenFlag) != 0 ? radiance[n & ~kSeenFlag]
                                                 : out[n];
-    if (incoming && n != kTruncated) {
-      (*incoming)[o] += glm::dvec3(in);
-      (*paths)[o] += 1.0;
+    if (sums && n != kTruncated) {
+      sums->incoming[o] += glm::dvec3(in);
+      sums->paths[o] += 1.0;
+      sums->regionIncoming[r] += glm::dvec3(in);
+      sums->regionPaths[r] += 1.0;
     }
     glm::vec3 light = in;
     for (const std::size_t i : lit) light += hiddenDirect_[i * vertices + v] * lampColour[i];

@@ -17,7 +17,12 @@
 // The cut: the light a path would have brought on from its last vertex, which belongs to an object
 // o, is taken as c_o, the mean incoming indirect light of the hidden vertices on o whose paths went
 // on (a radiance cache of one value per object, settled over the caller's iterations: each gather
-// returns the c_o its own paths found, to cut the next one with). The first design cut with b_i,
+// returns the c_o its own paths found, to cut the next one with). One value per object is too
+// coarse where one object spans light and dark: the modern hall's walls and ceiling are one
+// object, and a path cut in the dark corner above its staircase (photographs 1/30 of the walls')
+// brought the whole hall's mean, B 2-3x what the photographs imply there. So the cache is also
+// kept per region, an object's part in one cell of a grid over the room (kCutCells along its
+// longest side), each region's value shrunk towards its object's where it has few paths. The first design cut with b_i,
 // the mean indirect light of the pixels, and with hiddenBounces = 0 gave every hidden Q b_i: that
 // lit hidden surfaces in shadow (under desks, behind objects) and whole dark regions (classroom's
 // hallway, seen through its windows, where the photographs are 1/20 of the walls) as brightly as
@@ -81,11 +86,17 @@ public:
   // and the rays and hits of one batch in tens of MiB of host memory.
   static constexpr std::size_t kRaysPerBatch = std::size_t(1) << 20;
 
-  // The cut c_o per object (see above): the incoming indirect light (per unit reflectance,
-  // radiance units) a path cut at a vertex on object o brings.
-  using Cut = std::vector<glm::vec3>;
+  // The cut (see above): the incoming indirect light (per unit reflectance, radiance units) a path
+  // cut at a vertex brings: c_o per object, and per region (the object's part in one grid cell,
+  // this gather's regions) where a gather settled one; a cut without regions is its objects'.
+  struct Cut {
+    std::vector<glm::vec3> object;
+    std::vector<glm::vec3> region;
+  };
   // A cut of one value b for every one of `objects` objects (the first design's, to start from).
-  static Cut uniformCut(std::size_t objects, glm::vec3 b) { return Cut(objects, b); }
+  static Cut uniformCut(std::size_t objects, glm::vec3 b) { return {std::vector<glm::vec3>(objects, b), {}}; }
+  // Cells of the regions' grid along the room's longest side (cubic cells).
+  static constexpr float kCutCells = 16.0f;
 
   // B_i per pixel for every shot (per unit reflectance, radiance units), with the photographs'
   // radiance where the camera sees the hit, and objectReflectance and cut[i] elsewhere; with
@@ -101,7 +112,8 @@ public:
   // the path's next vertex, or `cut` at its last). With `settled`, also the cut these paths found:
   // per object, the mean incoming light of its vertices whose paths went on, shrunk towards the
   // pixels' mean B where they are few (kCutPrior vertices' worth; an object no path went on from,
-  // or every object with hiddenBounces = 0, gets that mean: the first design's cut).
+  // or every object with hiddenBounces = 0, gets that mean: the first design's cut); per region
+  // the same of its own vertices, shrunk towards its object's value.
   // indirect() is this with photo i's radiance and only lamp i.
   // With `modelled`, also the share of each pixel's B (its luminance, smoothed as B is) that rests
   // on the model's longer reach: what the hidden hits pass on beyond their own direct light (the
@@ -121,6 +133,8 @@ public:
   double seenFraction() const { return double(seen_.size()) / double(rays_); }
   double hiddenFraction() const { return double(firstHidden_) / double(rays_); }
   std::uint64_t rays() const { return rays_; }
+  // The object of each region of the cut (Cut::region's order).
+  const std::vector<std::uint32_t>& regionObjects() const { return regionObject_; }
 
 private:
   // next_[v]: where the path goes on from hidden vertex v.
@@ -130,10 +144,15 @@ private:
   // Otherwise the next hidden vertex's index.
   // Every hidden vertex's radiance towards where its ray came from, folded from the paths' ends
   // (a vertex's next one always has a larger index); with `incoming`, also per object the sum of
-  // the incoming light of its vertices whose paths went on, and in `paths` how many there were.
+  // the incoming light of its vertices whose paths went on, and in `paths` how many there were;
+  // the same per region in `regionIncoming` and `regionPaths`.
+  struct CutSums {
+    std::vector<glm::dvec3> incoming, regionIncoming;
+    std::vector<double> paths, regionPaths;
+  };
   std::vector<glm::vec3> hiddenRadiance(const std::vector<glm::vec3>& radiance, const std::vector<glm::vec3>& lampColour,
                                         const std::vector<glm::vec3>& objectReflectance, const Cut& cut,
-                                        std::vector<glm::dvec3>* incoming, std::vector<double>* paths) const;
+                                        CutSums* sums) const;
   // The shots whose lamp `lampColour` lights (the others' direct light adds nothing).
   std::vector<std::size_t> litShots(const std::vector<glm::vec3>& lampColour) const;
 
@@ -151,6 +170,8 @@ private:
   // Deeper path vertices follow each chunk's pixels, outside every range.
   std::vector<std::uint32_t> seenStart_, seen_;
   std::vector<std::uint32_t> hiddenStart_, hiddenEnd_, hiddenObject_;
+  // Each hidden vertex's region (the cut's), and each region's object.
+  std::vector<std::uint32_t> hiddenRegion_, regionObject_;
   std::vector<float> hiddenDirect_;
   // The hidden vertices' paths (the first vertices are the pixels' ranges above; deeper ones
   // follow each chunk's), and how many first vertices there are.

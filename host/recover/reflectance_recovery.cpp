@@ -170,7 +170,8 @@ std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, co
                                    const std::vector<std::int32_t>& object, std::size_t objects,
                                    const std::vector<std::uint32_t>* objectMaterial,
                                    const std::vector<std::optional<glm::vec3>>* photographed,
-                                   std::optional<float> unseenGrey, const std::vector<bool>* oneColour) {
+                                   std::optional<float> unseenGrey, const std::vector<bool>* oneColour,
+                                   const std::vector<std::optional<glm::vec3>>* modelColour) {
   std::vector<glm::dvec3> sum(objects, glm::dvec3(0.0));
   std::vector<double> weight(objects, 0.0);
   glm::dvec3 all(0.0);
@@ -225,7 +226,7 @@ std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, co
       means[o] = *(*photographed)[o];
       continue;
     }
-    means[o] = fallback;
+    means[o] = !unseenGrey && modelColour && (*modelColour)[o] ? *(*modelColour)[o] : fallback;
     if (objectMaterial) {
       const auto& m = byMaterial[(*objectMaterial)[o]];
       if (m.second > 0.0) means[o] = glm::vec3(m.first / m.second);
@@ -344,6 +345,11 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   // materials say which surfaces are alike, though not their colours.
   const std::vector<std::uint32_t> objectMaterial = objectMaterials(room);
   const std::vector<bool> oneColour = oneColourObjects(room);
+  // An object of a material no photograph shows: the colour the model gives it, where it gives
+  // one, or a grey. The grey alone made the paths through the staircase's unseen white surfaces
+  // too dark (its never-lit wall's B 0.82-0.92 of the photographs' with paths to 8 vertices), and
+  // the per-object cut's brightening of dark places had hidden it (BENCHMARKS).
+  const std::vector<std::optional<glm::vec3>> modelColour = modelColours(room);
   const std::optional<float> unseenGrey =
       options.unseenReflectance > 0.0f ? std::optional<float>(options.unseenReflectance) : std::nullopt;
   Recovery out;
@@ -395,7 +401,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   std::vector<std::optional<glm::vec3>> ratios = photographed(ambient);
   out.iterations.push_back({0, secondsSince(stepStart), 0.0,
                             objectMeans(merged.reflectance, inverseVariance(merged), lighting.geometry.object, objects,
-                                        &objectMaterial, &ratios, unseenGrey, &oneColour)});
+                                        &objectMaterial, &ratios, unseenGrey, &oneColour, &modelColour)});
   if (log) log(fmt::format("recover: constant ambient (k = {}): {:.1f} s", options.constantReflectance, secondsSince(stepStart)));
 
   std::unique_ptr<PhotoGather> gather;
@@ -450,7 +456,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
       if (footprints) unmixFootprints(*footprints, lighting.geometry.object, means, own, weights);
       std::vector<glm::vec3> nextMeans = objectMeans(own, weights,
                                                      lighting.geometry.object, objects, &objectMaterial, &ratios,
-                                                     unseenGrey, &oneColour);
+                                                     unseenGrey, &oneColour, &modelColour);
       if (out.iterations.size() >= 2) dampSwings(out.iterations[out.iterations.size() - 2].objectReflectance, means, nextMeans);
       out.iterations.push_back({it, secondsSince(stepStart), change, std::move(nextMeans)});
       if (log) log(fmt::format("recover: iteration {}: RMS change of R {:.5f}, {:.1f} s", it, change, secondsSince(stepStart)));

@@ -156,13 +156,17 @@ std::vector<glm::vec3> constantAmbient(const std::vector<glm::vec3>& photo, cons
 // objects of their material (`objectMaterial`), or, with none, a grey of the luminance of the
 // mean over all confident pixels (an unknown colour: not the room's dominant one). An object
 // the model gives one colour (`oneColour`, see oneColourObjects) takes, before all that, the mean
-// over the confident pixels of every such object of its material, where they have any.
+// over the confident pixels of every such object of its material, where they have any. With
+// `modelColour` (modelColours), an object of a material no photograph shows takes the colour the
+// model gives it, where it gives one, instead of the grey; a grey the user gives (`unseenGrey`)
+// comes before both.
 std::vector<glm::vec3> objectMeans(const std::vector<glm::vec3>& reflectance, const std::vector<float>& confidence,
                                    const std::vector<std::int32_t>& object, std::size_t objects,
                                    const std::vector<std::uint32_t>* objectMaterial = nullptr,
                                    const std::vector<std::optional<glm::vec3>>* photographed = nullptr,
                                    std::optional<float> unseenGrey = std::nullopt,
-                                   const std::vector<bool>* oneColour = nullptr);
+                                   const std::vector<bool>* oneColour = nullptr,
+                                   const std::vector<std::optional<glm::vec3>>* modelColour = nullptr);
 
 // Per object, sum_i sum_p C_i(p) / sum_i sum_p (D_i + B_i)(p) per channel over its pixels p and
 // the shots i (at most 1): the ratio estimate of its reflectance, the light weighting each
