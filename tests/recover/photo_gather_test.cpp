@@ -242,19 +242,33 @@ TEST(PhotoGather, TheModelledShareIsWhatHiddenHitsPassOnBeyondTheirOwnDirectLigh
   EXPECT_GT(partly, 50); // the tube's and the floor's pixels near it see hidden floor
 }
 
+// tubeOverAFloor seen from above, 64 x 64, with the floor's pixels marked as seeing nothing: the
+// camera is told it does not see the floor, so every gather ray that meets it is hidden.
+struct TubeOverAHiddenFloor {
+  static constexpr int kSize = 64;
+  scene::Scene room = tubeOverAFloor(0.02f, 0.05f, 32);
+  bvh::Bvh tree = bvh::build(render::triangleSoup(room));
+  scene::Camera camera = lookingDownAtTheTube();
+  recover::PixelGeometry pixels = hiddenFloor(pixelGeometry(room, tree, camera, kSize, kSize));
+  static recover::PixelGeometry hiddenFloor(recover::PixelGeometry pixels) {
+    for (auto& o : pixels.object)
+      if (o == 0) o = -1;
+    return pixels;
+  }
+};
+
 TEST(PhotoGather, ALampSampledAtAHiddenVertexKeepsItsMeanLight) {
   // The tube seen over a floor the camera is told it does not see: the tube's gather rays meet a
   // hidden floor, whose paths are cut at once with nothing (the floor's light is its lamps' alone).
   // Four lamps, near and far, bright and dim: at most vertices one or two of them give a quarter of
   // the light and have rays of their own, and one ray samples the others, weighted back. Each
   // shot's B summed over the tube must be what a ray to every lamp gives.
-  const scene::Scene room = tubeOverAFloor(0.02f, 0.05f, 32);
-  const bvh::Bvh tree = bvh::build(render::triangleSoup(room));
-  constexpr int kSize = 64;
-  const scene::Camera camera = lookingDownAtTheTube();
-  recover::PixelGeometry pixels = pixelGeometry(room, tree, camera, kSize, kSize);
-  for (auto& o : pixels.object)
-    if (o == 0) o = -1; // the floor: hidden
+  const TubeOverAHiddenFloor view;
+  const scene::Scene& room = view.room;
+  const bvh::Bvh& tree = view.tree;
+  constexpr int kSize = TubeOverAHiddenFloor::kSize;
+  const scene::Camera& camera = view.camera;
+  const recover::PixelGeometry& pixels = view.pixels;
   std::vector<recover::Shot> shots;
   for (const auto& [position, intensity] : {std::pair{glm::vec3(0.1f, 0.3f, 0.0f), 0.2f}, {glm::vec3(-0.8f, 0.5f, 0.6f), 2.0f},
                                             {glm::vec3(0.9f, 1.5f, -0.4f), 4.0f}, {glm::vec3(0.0f, 0.2f, -1.2f), 1.0f}}) {
@@ -302,20 +316,15 @@ TEST(PhotoGather, APathCutOnADarkPartOfAnObjectBringsThatPartsLightNotTheObjects
   // (what a path cut on the floor brings next time) must keep that apart per region; the object's
   // one value is the mean of both, which brought a dark corner's paths the bright parts' light
   // (the modern hall's walls; BENCHMARKS).
-  const scene::Scene room = tubeOverAFloor(0.02f, 0.05f, 32);
-  const bvh::Bvh tree = bvh::build(render::triangleSoup(room));
-  constexpr int kSize = 64;
-  const scene::Camera camera = lookingDownAtTheTube();
-  recover::PixelGeometry pixels = pixelGeometry(room, tree, camera, kSize, kSize);
-  for (auto& o : pixels.object)
-    if (o == 0) o = -1; // the floor: hidden
+  const TubeOverAHiddenFloor view;
+  constexpr int kSize = TubeOverAHiddenFloor::kSize;
   recover::Shot shot{.position = glm::vec3(0.0f, 0.5f, 0.3f), .intensity = 0.0f};
   shot.radiance.assign(kSize * kSize, glm::vec3(0.0f));
   for (int p = 0; p < kSize * kSize; ++p)
-    if (pixels.object[p] == 1) shot.radiance[p] = glm::vec3(p % kSize < kSize / 2 ? 1.0f : 0.01f);
+    if (view.pixels.object[p] == 1) shot.radiance[p] = glm::vec3(p % kSize < kSize / 2 ? 1.0f : 0.01f);
   const std::vector<recover::Shot> shots{shot};
-  render::CpuRayBatch rays(tree);
-  const recover::PhotoGather gather(room, rays, camera, pixels, shots, 256, 1, 0, 1);
+  render::CpuRayBatch rays(view.tree);
+  const recover::PhotoGather gather(view.room, rays, view.camera, view.pixels, shots, 256, 1, 0, 1);
   std::vector<recover::PhotoGather::Cut> settled;
   gather.indirect(shots, {glm::vec3(0.5f), glm::vec3(0.5f)},
                   {recover::PhotoGather::uniformCut(2, glm::vec3(0.0f))}, &settled);
