@@ -22,8 +22,9 @@
 // object, and a path cut in the dark corner above its staircase (photographs 1/30 of the walls')
 // brought the whole hall's mean, B 2-3x what the photographs imply there. So the cache is also
 // kept per region, an object's part in one cell of a grid over the room (kCutCells along its
-// longest side), each region's value shrunk towards its object's where it has few paths. The first design cut with b_i,
-// the mean indirect light of the pixels, and with hiddenBounces = 0 gave every hidden Q b_i: that
+// longest side), each region's value shrunk towards its object's where it has few paths.
+// The first design cut with b_i, the mean indirect light of the pixels, and with
+// hiddenBounces = 0 gave every hidden Q b_i: that
 // lit hidden surfaces in shadow (under desks, behind objects) and whole dark regions (classroom's
 // hallway, seen through its windows, where the photographs are 1/20 of the walls) as brightly as
 // the room's average, and biased B up where most rays are hidden (69-88 % in a large room).
@@ -143,9 +144,9 @@ private:
   static constexpr std::uint32_t kSeenFlag = 1u << 31;  // | the pixel that shows the next hit
   // Otherwise the next hidden vertex's index.
   // Every hidden vertex's radiance towards where its ray came from, folded from the paths' ends
-  // (a vertex's next one always has a larger index); with `incoming`, also per object the sum of
-  // the incoming light of its vertices whose paths went on, and in `paths` how many there were;
-  // the same per region in `regionIncoming` and `regionPaths`.
+  // (a vertex's next one always has a larger index); with `sums`, also per object the sum of
+  // the incoming light of its vertices whose paths went on (`incoming`) and how many there were
+  // (`paths`), and the same per region.
   struct CutSums {
     std::vector<glm::dvec3> incoming, regionIncoming;
     std::vector<double> paths, regionPaths;
