@@ -56,11 +56,11 @@ std::vector<bool> oneColourObjects(const scene::Scene& room) {
   return one;
 }
 
-std::vector<std::optional<glm::vec3>> modelColours(const scene::Scene& room) {
-  const std::vector<std::uint32_t> material = objectMaterials(room);
+std::vector<std::optional<glm::vec3>> modelColours(const scene::Scene& room,
+                                                   const std::vector<std::uint32_t>& objectMaterial) {
   std::vector<std::optional<glm::vec3>> colour(room.objects.size());
   for (std::size_t o = 0; o < room.objects.size(); ++o) {
-    const scene::Material& m = room.materials.at(material[o]);
+    const scene::Material& m = room.materials.at(objectMaterial[o]);
     if (m.baseColorTexture < 0) colour[o] = glm::vec3(m.baseColor);
   }
   return colour;

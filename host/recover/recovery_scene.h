@@ -28,9 +28,10 @@ std::vector<std::uint32_t> objectMaterials(const scene::Scene& room);
 // Whether the room's model gives each object one colour: every triangle of one material, which
 // has no colour texture. Such objects of one material have the same reflectance.
 std::vector<bool> oneColourObjects(const scene::Scene& room);
-// The colour the room's model gives each object: its material's (objectMaterials) base colour,
-// none where that material has a colour texture.
-std::vector<std::optional<glm::vec3>> modelColours(const scene::Scene& room);
+// The colour the room's model gives each object: its material's (`objectMaterial`, from
+// objectMaterials) base colour, none where that material has a colour texture.
+std::vector<std::optional<glm::vec3>> modelColours(const scene::Scene& room,
+                                                   const std::vector<std::uint32_t>& objectMaterial);
 
 // InputError naming `photos.file` and the shot when a lamp is inside geometry: its sphere (or,
 // for radius 0, the point) touches a triangle, or it lies inside a closed object (3/4 of the rays

@@ -349,7 +349,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   // one, or a grey. The grey alone made the paths through the staircase's unseen white surfaces
   // too dark (its never-lit wall's B 0.82-0.92 of the photographs' with paths to 8 vertices), and
   // the per-object cut's brightening of dark places had hidden it (BENCHMARKS).
-  const std::vector<std::optional<glm::vec3>> modelColour = modelColours(room);
+  const std::vector<std::optional<glm::vec3>> modelColour = modelColours(room, objectMaterial);
   const std::optional<float> unseenGrey =
       options.unseenReflectance > 0.0f ? std::optional<float>(options.unseenReflectance) : std::nullopt;
   Recovery out;
