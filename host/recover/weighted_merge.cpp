@@ -201,7 +201,11 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
       out.independentVariance[p] = static_cast<float>(independentSum[p] / (weightSum[p] * weightSum[p]));
     }
   out.unsmoothed = out.reflectance;
-  out.texturedObjects = texturedObjects(out.reflectance, out.independentVariance, pixels);
+  const std::vector<SurfaceTexture> textures = surfaceTextures(out.reflectance, out.independentVariance, pixels);
+  for (const SurfaceTexture t : textures) {
+    out.texturedObjects.push_back(t == SurfaceTexture::Textured);
+    out.plainObjects.push_back(t == SurfaceTexture::Plain);
+  }
   out.reflectance = smoothMerge(out, pixels, options.smoothingRadius, options.agreement);
   return out;
 }
@@ -240,6 +244,14 @@ std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeo
 
 std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, const std::vector<float>& independentVariance,
                                   const PixelGeometry& pixels) {
+  std::vector<bool> textured;
+  for (const SurfaceTexture t : surfaceTextures(reflectance, independentVariance, pixels))
+    textured.push_back(t == SurfaceTexture::Textured);
+  return textured;
+}
+
+std::vector<SurfaceTexture> surfaceTextures(const std::vector<glm::vec3>& reflectance,
+                                            const std::vector<float>& independentVariance, const PixelGeometry& pixels) {
   std::int32_t objects = 0;
   for (const std::int32_t o : pixels.object) objects = std::max(objects, o + 1);
   const auto count = static_cast<std::size_t>(objects);
@@ -263,13 +275,14 @@ std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, con
     pair(x + 1, y);
     pair(x, y + 1);
   });
-  std::vector<bool> textured(count, false);
-  for (std::size_t o = 0; o < textured.size(); ++o) {
+  std::vector<SurfaceTexture> textures(count, SurfaceTexture::Unjudged);
+  for (std::size_t o = 0; o < textures.size(); ++o) {
     if (differences[o].size() < kTexturePairs) continue;
     const double expected = median(noise[o]);
-    textured[o] = expected > 0.0 && median(differences[o]) > kTextureRatio * expected;
+    textures[o] = expected > 0.0 && median(differences[o]) > kTextureRatio * expected ? SurfaceTexture::Textured
+                                                                                      : SurfaceTexture::Plain;
   }
-  return textured;
+  return textures;
 }
 
 std::vector<glm::vec3> smoothByNoise(const std::vector<glm::vec3>& reflectance, const std::vector<float>& variance,

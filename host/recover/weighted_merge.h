@@ -84,6 +84,7 @@ struct WeightedMerge {
   // what differs from pixel to pixel, where B's error is shared by neighbours. 0 where nothing informs.
   std::vector<float> independentVariance;
   std::vector<bool> texturedObjects;        // per object: smoothed within independentVariance (texturedObjects below)
+  std::vector<bool> plainObjects;           // per object: judged of one colour (enough pairs, not textured)
   std::vector<glm::vec3> unsmoothed;        // the merged R before the smoothing (and before its clamp at 1)
   std::vector<float> directConfidence;      // sum of the paper's K_i over the lit estimates
   std::vector<float> indirectShots;         // how many indirect-only estimates the pixel has
@@ -125,6 +126,10 @@ std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeo
 // than kTexturePairs pairs are not judged.
 inline constexpr double kTextureRatio = 2.0;
 inline constexpr std::size_t kTexturePairs = 20;
+enum class SurfaceTexture : std::uint8_t { Unjudged, Plain, Textured };
+std::vector<SurfaceTexture> surfaceTextures(const std::vector<glm::vec3>& reflectance,
+                                            const std::vector<float>& independentVariance, const PixelGeometry& pixels);
+// surfaceTextures' Textured.
 std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, const std::vector<float>& independentVariance,
                                   const PixelGeometry& pixels);
 

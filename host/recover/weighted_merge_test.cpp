@@ -428,5 +428,29 @@ TEST(WeightedMerge, AWhiteWallsNoisyEstimatesAverageToWhiteNotBelow) {
   EXPECT_GT(sum / count, 0.995);
 }
 
+TEST(WeightedMerge, AnObjectIsJudgedPlainTexturedOrNotAtAllByHowManyInteriorPairsItHas) {
+  // Three objects on one wall: a noisy plain grey (x < 16), a 2-pixel-wide strip (16 <= x < 18)
+  // that no 3 x 3 window lies wholly on, so no pair to judge it by, and a granite (x >= 18).
+  const int w = 38, h = 30;
+  PixelGeometry g = wall(w, h, 18);
+  for (int y = 0; y < h; ++y)
+    for (int x = 16; x < 18; ++x) g.object[std::size_t(y) * w + x] = 2;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> granite(0.4f, 0.8f);
+  std::normal_distribution<float> noise(0.0f, 0.02f);
+  const std::size_t n = std::size_t(w) * h;
+  std::vector<glm::vec3> r(n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) r[std::size_t(y) * w + x] = glm::vec3(x >= 18 ? granite(rng) : 0.6f * (1.0f + noise(rng)));
+  const std::vector<float> variance(n, 0.02f * 0.02f);
+  const std::vector<SurfaceTexture> t = surfaceTextures(r, variance, g);
+  ASSERT_EQ(t.size(), 3u);
+  EXPECT_EQ(t[0], SurfaceTexture::Plain);
+  EXPECT_EQ(t[1], SurfaceTexture::Textured);
+  EXPECT_EQ(t[2], SurfaceTexture::Unjudged);
+  // texturedObjects is the same judgement: an unjudged object is not textured.
+  EXPECT_EQ(texturedObjects(r, variance, g), (std::vector<bool>{false, true, false}));
+}
+
 } // namespace
 } // namespace obscura::recover
