@@ -2,6 +2,7 @@
 #include "recover/photo_gather.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
@@ -57,6 +58,30 @@ glm::vec3 shadingNormal(const scene::Scene& room, const bvh::Hit& hit, const glm
   return glm::dot(n, geometric) < 0.0f ? -n / length : n / length;
 }
 
+// The box of the points the camera sees, from the 2nd to the 98th percentile on each axis: a
+// room's model may stand in far larger geometry (the classroom's ground, 221 m across its 9 m
+// room), and a grid over the model's bounds made one cell of the whole room.
+scene::Bounds seenBounds(const PixelGeometry& pixels) {
+  std::array<std::vector<float>, 3> axes;
+  for (std::size_t p = 0; p < pixels.position.size(); ++p)
+    if (pixels.object[p] >= 0)
+      for (int a = 0; a < 3; ++a) axes[std::size_t(a)].push_back(pixels.position[p][a]);
+  scene::Bounds b;
+  if (axes[0].empty()) return b;
+  b.lo = b.hi = glm::vec3(0.0f);
+  for (int a = 0; a < 3; ++a) {
+    std::vector<float>& v = axes[std::size_t(a)];
+    const auto at = [&](double q) {
+      const auto k = static_cast<std::ptrdiff_t>(q * double(v.size() - 1));
+      std::nth_element(v.begin(), v.begin() + k, v.end());
+      return v[std::size_t(k)];
+    };
+    b.lo[a] = at(0.02);
+    b.hi[a] = at(0.98);
+  }
+  return b;
+}
+
 } // namespace
 
 std::int64_t projectToPixel(const scene::Camera& camera, int width, int height, const glm::vec3& point) {
@@ -84,16 +109,24 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
   const float scale = render::sceneScale(room.bounds);
   const float offset = 1e-4f * scale;       // ray origins off the surface
   const float samePlane = 2e-3f * scale;    // a seen pixel's point within this of the hit's plane
-  // The cut's regions: an object's part in one cubic cell of a grid over the room.
-  const glm::vec3 extent = room.bounds.extent();
-  const float cell = std::max({extent.x, extent.y, extent.z, 1e-6f}) / kCutCells;
-  const glm::ivec3 regionCells = glm::max(glm::ivec3(glm::ceil(extent / cell)), glm::ivec3(1));
+  // The cut's regions: an object's part facing one of the six axis directions (the two faces of
+  // a thin wall see different rooms) in one cubic cell of a grid over what the camera sees, the
+  // cells past its edges gathered into one layer around it.
+  scene::Bounds seen = seenBounds(pixels);
+  if (seen.empty()) seen = room.bounds;
+  const glm::vec3 extent = seen.extent();
+  const float cell = std::max({extent.x, extent.y, extent.z, 1e-6f * scale}) / kCutCells;
+  const glm::ivec3 regionCells = glm::max(glm::ivec3(glm::ceil(extent / cell)), glm::ivec3(1)) + 2;
   std::unordered_map<std::uint64_t, std::uint32_t> regionAt;
-  const auto regionOf = [&](std::uint32_t object, const glm::vec3& point) {
-    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((point - room.bounds.lo) / cell)), glm::ivec3(0), regionCells - 1);
+  const auto regionOf = [&](std::uint32_t object, const glm::vec3& point, const glm::vec3& normal) {
+    const glm::ivec3 c =
+        glm::clamp(glm::ivec3(glm::floor((point - seen.lo) / cell)) + 1, glm::ivec3(0), regionCells - 1);
+    const glm::vec3 a = glm::abs(normal);
+    const int axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+    const std::uint64_t facing = std::uint64_t(2 * axis + (normal[axis] < 0.0f ? 1 : 0));
     const std::uint64_t key =
-        ((std::uint64_t(object) * std::uint64_t(regionCells.z) + std::uint64_t(c.z)) * std::uint64_t(regionCells.y) +
-         std::uint64_t(c.y)) * std::uint64_t(regionCells.x) + std::uint64_t(c.x);
+        (((std::uint64_t(object) * 6u + facing) * std::uint64_t(regionCells.z) + std::uint64_t(c.z)) *
+             std::uint64_t(regionCells.y) + std::uint64_t(c.y)) * std::uint64_t(regionCells.x) + std::uint64_t(c.x);
     const auto [at, added] = regionAt.try_emplace(key, static_cast<std::uint32_t>(regionObject_.size()));
     if (added) regionObject_.push_back(object);
     return at->second;
@@ -273,7 +306,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
         }
         active.push_back({static_cast<std::uint32_t>(hiddenObject_.size()), c.lit, c.normal});
         hiddenObject_.push_back(c.object);
-        hiddenRegion_.push_back(regionOf(c.object, c.lit));
+        hiddenRegion_.push_back(regionOf(c.object, c.lit, c.normal));
         next_.push_back(kTruncated);
         queueDirect(c, hiddenDirect_, true, static_cast<std::uint32_t>(hiddenObject_.size() - 1));
         ++firstHidden_;
@@ -305,7 +338,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
         const auto u = static_cast<std::uint32_t>(hiddenObject_.size());
         next_[v] = u;
         hiddenObject_.push_back(c.object);
-        hiddenRegion_.push_back(regionOf(c.object, c.lit));
+        hiddenRegion_.push_back(regionOf(c.object, c.lit, c.normal));
         next_.push_back(kTruncated);
         queueDirect(c, hiddenDirect_, false, u);
         deeper.push_back({u, c.lit, c.normal});

@@ -21,8 +21,11 @@
 // coarse where one object spans light and dark: the modern hall's walls and ceiling are one
 // object, and a path cut in the dark corner above its staircase (photographs 1/30 of the walls')
 // brought the whole hall's mean, B 2-3x what the photographs imply there. So the cache is also
-// kept per region, an object's part in one cell of a grid over the room (kCutCells along its
-// longest side), each region's value shrunk towards its object's where it has few paths.
+// kept per region, an object's part facing one of the six axis directions in one cell of a grid
+// over what the camera sees (kCutCells along its longest side; not over the model's bounds, which
+// may hold far more: the classroom's 221 m ground made its whole room one cell, and its hallway,
+// seen through the windows, came out 10 % dark), each region's value shrunk towards its object's
+// where it has few paths.
 // The first design cut with b_i, the mean indirect light of the pixels, and with
 // hiddenBounces = 0 gave every hidden Q b_i: that
 // lit hidden surfaces in shadow (under desks, behind objects) and whole dark regions (classroom's
@@ -96,7 +99,7 @@ public:
   };
   // A cut of one value b for every one of `objects` objects (the first design's, to start from).
   static Cut uniformCut(std::size_t objects, glm::vec3 b) { return {std::vector<glm::vec3>(objects, b), {}}; }
-  // Cells of the regions' grid along the room's longest side (cubic cells).
+  // Cells of the regions' grid along the longest side of what the camera sees (cubic cells).
   static constexpr float kCutCells = 16.0f;
 
   // B_i per pixel for every shot (per unit reflectance, radiance units), with the photographs'
