@@ -488,6 +488,9 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.relativeVariance = merged.relativeVariance;
   out.filled.assign(merged.reflectance.size(), 0);
   const std::vector<glm::vec3> means = out.iterations.back().objectReflectance;
+  std::vector<bool> whole; // the pixels whose footprint lies on one surface: those fill their surface's
+  if (footprints)
+    for (std::size_t p = 0; p < out.reflectance.size(); ++p) whole.push_back(footprints->whole(p));
   for (std::size_t p = 0; p < out.reflectance.size(); ++p) {
     if (out.object[p] < 0) continue;
     if (!merged.texturedObjects.empty() && merged.texturedObjects[std::size_t(out.object[p])]) ++out.texturedPixels;
@@ -505,7 +508,9 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
     }
     const bool lamplit = weight > 0.0f;
     const std::optional<glm::vec3> surface =
-        lamplit && options.merge == MergeModel::Weighted ? surfaceFill(merged, lighting.geometry, p) : std::nullopt;
+        lamplit && options.merge == MergeModel::Weighted
+            ? surfaceFill(merged, lighting.geometry, p, footprints ? &whole : nullptr)
+            : std::nullopt;
     // On a surface judged of one colour, the object's mean rather than the raw estimates the
     // filters rejected: those are single photographs' noise (the classroom's chair frames, thin
     // tubes whose pixels the min filter empties: RMSE 0.113 over 458 px from visibility, 0.03 at

@@ -226,13 +226,14 @@ std::vector<glm::vec3> smoothMerge(const WeightedMerge& merged, const PixelGeome
   return out;
 }
 
-std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeometry& pixels, std::size_t p) {
+std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeometry& pixels, std::size_t p,
+                                     const std::vector<bool>* whole) {
   const int x = int(p % std::size_t(pixels.width)), y = int(p / std::size_t(pixels.width));
   glm::dvec3 sum(0.0);
   double weight = 0.0;
   int support = 0;
   forSurfaceWindow(pixels, x, y, kSurfaceFillRadius, [&](std::size_t q) {
-    if (merged.relativeVariance[q] <= 0.0f) return;
+    if (merged.relativeVariance[q] <= 0.0f || (whole && !(*whole)[q])) return;
     const double w = 1.0 / merged.relativeVariance[q];
     sum += w * glm::dvec3(merged.reflectance[q]);
     weight += w;

@@ -286,6 +286,23 @@ TEST(WeightedMerge, AnUnmergedPixelIsFilledFromTheMergedPixelsOfItsOwnSurfaceNea
   std::fill(lone.relativeVariance.begin(), lone.relativeVariance.end(), 0.0f);
   lone.relativeVariance[0] = lone.relativeVariance[1] = 0.01f;
   EXPECT_FALSE(surfaceFill(lone, g, std::size_t(1) * w + 1));
+  // With the footprints: wall 0's column 3, beside the hole, merged to 0.6 (its pixels' footprints
+  // cross onto the other wall, their estimates a mix), is left out; only the whole pixels of
+  // column 2 fill, so the fill is between 0.2 and 0.25 as before, not pulled towards 0.6.
+  WeightedMerge edged = m;
+  std::vector<bool> whole(m.reflectance.size(), true);
+  for (int y = 0; y < h; ++y) {
+    edged.reflectance[std::size_t(y) * w + 3] = glm::vec3(0.6f);
+    whole[std::size_t(y) * w + 3] = false;
+  }
+  for (int y = 1; y < h - 1; ++y) {
+    const std::size_t p = std::size_t(y) * w + 5;
+    const auto kept = surfaceFill(edged, g, p, &whole), mixed = surfaceFill(edged, g, p);
+    ASSERT_TRUE(kept && mixed) << y;
+    EXPECT_GT(kept->x, 0.2f) << y;
+    EXPECT_LT(kept->x, 0.25f) << y;
+    EXPECT_GT(mixed->x, 0.3f) << y; // the edge column's 0.6 weighs in without them
+  }
 }
 
 TEST(WeightedMerge, SmoothingByNoiseFlattensAWallAndKeepsATextureEdge) {
