@@ -472,8 +472,9 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
                                      options.weighted.agreement, true);
 
   // Pixels no filtered confidence reaches, where some lamp still lights them (the filters removed
-  // them): the merged pixels of their own surface nearby (surfaceFill), else the photos' raw
-  // visibilities, less the estimates the outlier test rejects on them; lit by no lamp at all, the
+  // them): the merged whole pixels of their own surface nearby (surfaceFill), else on a plain
+  // object its mean, else the photos' raw visibilities, less the estimates the outlier test
+  // rejects on them; lit by no lamp at all, the
   // object's mean (measured better there than the surface's nearby pixels, themselves lit only
   // indirectly: the classroom's shadow RMSE 0.093 against 0.112).
   std::vector<ConfidenceImage> fillWeights = lighting.visibility;

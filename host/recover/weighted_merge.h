@@ -120,14 +120,15 @@ std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeo
                                      const std::vector<bool>* whole = nullptr);
 
 // Per object (indexed by object id): whether its merged reflectance has a texture the noise does
-// not explain. Over the pairs of horizontally and vertically neighbouring pixels inside one
+// not explain (Textured), has none (Plain), or cannot be judged (Unjudged). Over the pairs of horizontally and vertically neighbouring pixels inside one
 // surface (both pixels' 3x3 windows wholly on it: no edge, no pixel that mixes surfaces), the
 // median squared difference of their luminances against the median of what their independent
 // noise gives it (independentVariance): pure noise puts that ratio near 0.455 (the median of a
 // chi-square of one degree), less where the variance is overestimated (0.2-0.5 on the three test
 // rooms' plain surfaces, measured against their answer keys). Above kTextureRatio, 4.4 times
 // that, the object is textured (the staircase's wallpapers and wood: 3.8-9). Objects with fewer
-// than kTexturePairs pairs are not judged.
+// than kTexturePairs pairs are not judged (a sliver, or an object whose merged pixels are all
+// at its edges).
 inline constexpr double kTextureRatio = 2.0;
 inline constexpr std::size_t kTexturePairs = 20;
 enum class SurfaceTexture : std::uint8_t { Unjudged, Plain, Textured };
