@@ -9,9 +9,9 @@
 # still named in the output (--output-on-failure), and every test still fails on a validation
 # message of its own (tests/gpu_test.h).
 #
-# Inputs (-D): TEST_EXECUTABLE, CTEST_FILE (written), TEST_TIMEOUT (seconds per suite), and
+# Inputs (-D): TEST_EXECUTABLE, CTEST_FILE (written), TEST_TIMEOUT (seconds per suite),
 # SUITE_ENVIRONMENT: "Suite=NAME=VALUE" entries (;-separated) that one suite's process runs with
-# besides OBSCURA_VALIDATE=1.
+# besides OBSCURA_VALIDATE=1, and SUITE_SECONDS: tests/suite_seconds.txt (each test's measured seconds).
 execute_process(COMMAND "${TEST_EXECUTABLE}" --gtest_list_tests
                 OUTPUT_VARIABLE listing RESULT_VARIABLE status ERROR_VARIABLE errors)
 if(NOT status EQUAL 0)
@@ -19,6 +19,10 @@ if(NOT status EQUAL 0)
 endif()
 string(REPLACE "\n" ";" lines "${listing}")
 set(content "# Written by cmake/discover_test_suites.cmake after obscura_tests was linked.\n")
+set(measured "")
+if(SUITE_SECONDS AND EXISTS "${SUITE_SECONDS}")
+  file(STRINGS "${SUITE_SECONDS}" measured REGEX "^[A-Za-z0-9_./]+ [0-9.]+$")
+endif()
 set(suite "")
 set(count 0)
 macro(flush_suite)
@@ -29,12 +33,20 @@ macro(flush_suite)
         string(APPEND environment ";${CMAKE_MATCH_1}")
       endif()
     endforeach()
-    # COST: CTest starts the costliest first on a clean build (no timings yet); a suite's tests
-    # are the best guess there is before one has run.
+    # COST: CTest starts the costliest first on a clean build (no timings yet): the seconds the
+    # suite took on a clean clone (SUITE_SECONDS), else its number of tests. By the number of tests
+    # alone a long suite of one test (RecoverClassroom, 12 s) started last and the suite's 414 s
+    # of tests took 249 s on 2 cores.
+    set(cost ${count})
+    foreach(entry IN LISTS measured)
+      if(entry MATCHES "^${suite} ([0-9.]+)$")
+        set(cost ${CMAKE_MATCH_1})
+      endif()
+    endforeach()
     string(APPEND content
            "add_test([=[${suite}]=] [=[${TEST_EXECUTABLE}]=] [=[--gtest_filter=${suite}.*]=])\n"
            "set_tests_properties([=[${suite}]=] PROPERTIES ENVIRONMENT \"${environment}\" "
-           "TIMEOUT ${TEST_TIMEOUT} COST ${count} LABELS gtest)\n")
+           "TIMEOUT ${TEST_TIMEOUT} COST ${cost} LABELS gtest)\n")
   endif()
 endmacro()
 foreach(line IN LISTS lines)
