@@ -19,10 +19,8 @@ if(NOT status EQUAL 0)
 endif()
 string(REPLACE "\n" ";" lines "${listing}")
 set(content "# Written by cmake/discover_test_suites.cmake after obscura_tests was linked.\n")
-set(measured "")
-if(SUITE_SECONDS AND EXISTS "${SUITE_SECONDS}")
-  file(STRINGS "${SUITE_SECONDS}" measured REGEX "^[A-Za-z0-9_./]+ [0-9.]+$")
-endif()
+include("${CMAKE_CURRENT_LIST_DIR}/measured_cost.cmake")
+obscura_read_test_seconds("${SUITE_SECONDS}" measured)
 set(suite "")
 set(count 0)
 macro(flush_suite)
@@ -37,12 +35,7 @@ macro(flush_suite)
     # suite took on a clean clone (SUITE_SECONDS), else its number of tests. By the number of tests
     # alone a long suite of one test (RecoverClassroom, 12 s) started last and the suite's 414 s
     # of tests took 249 s on 2 cores.
-    set(cost ${count})
-    foreach(entry IN LISTS measured)
-      if(entry MATCHES "^${suite} ([0-9.]+)$")
-        set(cost ${CMAKE_MATCH_1})
-      endif()
-    endforeach()
+    obscura_measured_cost("${measured}" ${suite} ${count} cost)
     string(APPEND content
            "add_test([=[${suite}]=] [=[${TEST_EXECUTABLE}]=] [=[--gtest_filter=${suite}.*]=])\n"
            "set_tests_properties([=[${suite}]=] PROPERTIES ENVIRONMENT \"${environment}\" "
