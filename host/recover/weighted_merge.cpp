@@ -243,14 +243,6 @@ std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeo
   return glm::vec3(sum / weight);
 }
 
-std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, const std::vector<float>& independentVariance,
-                                  const PixelGeometry& pixels) {
-  std::vector<bool> textured;
-  for (const SurfaceTexture t : surfaceTextures(reflectance, independentVariance, pixels))
-    textured.push_back(t == SurfaceTexture::Textured);
-  return textured;
-}
-
 std::vector<SurfaceTexture> surfaceTextures(const std::vector<glm::vec3>& reflectance,
                                             const std::vector<float>& independentVariance, const PixelGeometry& pixels) {
   std::int32_t objects = 0;

@@ -38,7 +38,7 @@
 // That tolerance holds B's whole error, which neighbours share, so on a surface lit mostly by
 // indirect light it is wide (e_B = 0.25: neighbours within ~50 % pool) and pools a texture's
 // levels: the staircase's wallpapers kept 60-83 % of their contrast. On an object whose
-// neighbouring pixels differ by more than their independent noise allows (texturedObjects) the
+// neighbouring pixels differ by more than their independent noise allows (surfaceTextures) the
 // tolerance is that noise alone: the photographs' noise, which differs from pixel to pixel.
 #pragma once
 #include <cstdint>
@@ -83,7 +83,7 @@ struct WeightedMerge {
   // Of the merged R, from the photographs' noise alone (sum_i w_i^2 sigma_i^2 / C_i^2 / (sum_i w_i)^2):
   // what differs from pixel to pixel, where B's error is shared by neighbours. 0 where nothing informs.
   std::vector<float> independentVariance;
-  std::vector<bool> texturedObjects;        // per object: smoothed within independentVariance (texturedObjects below)
+  std::vector<bool> texturedObjects;        // per object: smoothed within independentVariance (surfaceTextures below)
   std::vector<bool> plainObjects;           // per object: judged of one colour (enough pairs, not textured)
   std::vector<glm::vec3> unsmoothed;        // the merged R before the smoothing (and before its clamp at 1)
   std::vector<float> directConfidence;      // sum of the paper's K_i over the lit estimates
@@ -134,9 +134,6 @@ inline constexpr std::size_t kTexturePairs = 20;
 enum class SurfaceTexture : std::uint8_t { Unjudged, Plain, Textured };
 std::vector<SurfaceTexture> surfaceTextures(const std::vector<glm::vec3>& reflectance,
                                             const std::vector<float>& independentVariance, const PixelGeometry& pixels);
-// surfaceTextures' Textured.
-std::vector<bool> texturedObjects(const std::vector<glm::vec3>& reflectance, const std::vector<float>& independentVariance,
-                                  const PixelGeometry& pixels);
 
 // A merge's `unsmoothed` R smoothed (smoothByNoise over `radius`, 0: none) with the tolerance the
 // header describes, relativeVariance or, on a textured object, independentVariance, then clamped

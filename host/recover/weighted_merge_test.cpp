@@ -465,8 +465,6 @@ TEST(WeightedMerge, AnObjectIsJudgedPlainTexturedOrNotAtAllByHowManyInteriorPair
   EXPECT_EQ(t[0], SurfaceTexture::Plain);
   EXPECT_EQ(t[1], SurfaceTexture::Textured);
   EXPECT_EQ(t[2], SurfaceTexture::Unjudged);
-  // texturedObjects is the same judgement: an unjudged object is not textured.
-  EXPECT_EQ(texturedObjects(r, variance, g), (std::vector<bool>{false, true, false}));
 }
 
 } // namespace
