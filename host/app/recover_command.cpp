@@ -205,8 +205,7 @@ void runRecover(RecoverOptions& o) {
   }
   writeOutputs(o, r, photos, accuracy);
   const auto stateStart = std::chrono::steady_clock::now();
-  recover::saveRecoveredState((fs::path(o.output) / "state").string(), context, loaded.scene, loaded.bvh, camera,
-                              photos, r, rec);
+  recover::saveRecoveredState((fs::path(o.output) / "state").string(), loaded.scene.sourcePath, photos, r, rec);
   fmt::print(stderr, "recover: relighting state (lights shot0..shot{}) in {:.1f} s -> {}/state\n",
              photos.shots.size() - 1,
              std::chrono::duration<double>(std::chrono::steady_clock::now() - stateStart).count(), o.output);

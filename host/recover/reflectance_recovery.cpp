@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/luminance.h"
+#include "core/names.h"
 #include "recover/pixel_footprint.h"
 #include "recover/recovery_scene.h"
 #include "relight/relight_state.h"
@@ -43,7 +44,7 @@ glm::vec3 pixel3(const io::Image& image, std::size_t p, int first) {
 glm::vec3 renderable(const glm::vec3& r) { return glm::clamp(r, glm::vec3(0.02f), glm::vec3(0.95f)); }
 
 render::ObscuranceSettings recoverySettings(const PhotoSet& photos, const scene::Camera& camera,
-                                            const RecoveryOptions& options, bool forState) {
+                                            const RecoveryOptions& options) {
   render::ObscuranceSettings settings;
   settings.width = static_cast<std::uint32_t>(photos.width);
   settings.height = static_cast<std::uint32_t>(photos.height);
@@ -52,8 +53,8 @@ render::ObscuranceSettings recoverySettings(const PhotoSet& photos, const scene:
   settings.camera = camera;
   settings.obscuranceRays = options.obscuranceRays;
   // The gather brings its own B: the lighting render's obscurance term would go unused, so it is
-  // not traced (the relighting state's render keeps it; the staircase's lighting pass 0.3 s less).
-  if (options.indirect == IndirectModel::Gather && !forState) settings.obscuranceRays = 0;
+  // not traced (the staircase's lighting pass 0.3 s less).
+  if (options.indirect == IndirectModel::Gather) settings.obscuranceRays = 0;
   settings.dMax = options.dMax;
   settings.shadowSampling = render::ShadowSampling::PerLight; // each lamp alone, one exact ray to a point
   settings.ambient = options.ambient;
@@ -67,12 +68,11 @@ struct RoomRender {
   std::unique_ptr<render::ObscuranceRenderer> renderer;
 
   RoomRender(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh, const scene::Camera& camera,
-             const PhotoSet& photos, const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options,
-             bool forState = false) {
+             const PhotoSet& photos, const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options) {
     std::vector<glm::vec3> materials;
     for (const auto& r : objectReflectance) materials.push_back(renderable(r));
     scene = recoveryScene(room, photos.shots, materials);
-    renderer = std::make_unique<render::ObscuranceRenderer>(context, scene, bvh, recoverySettings(photos, camera, options, forState));
+    renderer = std::make_unique<render::ObscuranceRenderer>(context, scene, bvh, recoverySettings(photos, camera, options));
     renderer->render();
     if (renderer->stats().truncatedTraversals > 0)
       throw DeviceError("traversals ran out of steps (kMaxTraversalSteps); the lighting would be wrong");
@@ -288,14 +288,16 @@ Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, co
     const Shot& shot = photos.shots[i];
     const std::size_t s = renderer.lightIndex(fmt::format("shot{}", i));
     const glm::vec3 ambientWeight = renderer.ambient().weight.at(s) * emissions[s];
-    std::vector<glm::vec3> direct(pixels, glm::vec3(0.0f)), indirect(pixels, glm::vec3(0.0f));
+    std::vector<glm::vec3> direct(pixels, glm::vec3(0.0f)), directPerEmission(pixels, glm::vec3(0.0f)),
+        indirect(pixels, glm::vec3(0.0f));
     ConfidenceImage visibility{photos.width, photos.height, std::vector<float>(pixels, 0.0f)};
     for (std::size_t p = 0; p < pixels; ++p) {
       const glm::vec3 rho = pixel3(aov, p, albedo);
       if (out.geometry.object[p] < 0 || glm::any(glm::lessThan(rho, glm::vec3(1e-4f)))) continue;
       // D_s and A hold the albedo of the surface (its current estimate): divided out, they are
       // the light per unit reflectance.
-      direct[p] = transport.direct[s][p] * emissions[s] / rho;
+      directPerEmission[p] = transport.direct[s][p] / rho;
+      direct[p] = directPerEmission[p] * emissions[s];
       indirect[p] = ambientWeight * glm::vec3(transport.ambient[p]) / rho;
       // V = rendered direct / the unoccluded point-light formula I cos(theta) / (pi d^2) at the
       // pixel's mean point and normal.
@@ -309,6 +311,8 @@ Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, co
       visibility.k[p] = cosine > 1e-3f && unoccluded > 0.0f ? std::clamp(rendered / unoccluded, 0.0f, 1.0f) : 0.0f;
     }
     out.direct.push_back(std::move(direct));
+    out.directPerEmission.push_back(std::move(directPerEmission));
+    out.emission.push_back(emissions[s]);
     out.indirect.push_back(std::move(indirect));
     out.visibility.push_back(std::move(visibility));
   }
@@ -316,24 +320,58 @@ Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, co
   return out;
 }
 
-void saveRecoveredState(const std::string& dir, const gpu::Context& context, const scene::Scene& room,
-                        const bvh::Bvh& bvh, const scene::Camera& camera, const PhotoSet& photos,
+void saveRecoveredState(const std::string& dir, const std::string& scenePath, const PhotoSet& photos,
                         const Recovery& recovery, const RecoveryOptions& options) {
-  const RoomRender roomRender(context, room, bvh, camera, photos, recovery.iterations.back().objectReflectance, options,
-                              /*forState=*/true);
-  const render::ObscuranceRenderer& renderer = *roomRender.renderer;
-  render::Transport transport = renderer.transport();
-  const io::Image aov = renderer.image();
-  const int albedo = channel(aov, "albedo.R");
-  for (std::size_t p = 0; p < transport.pixels(); ++p) {
-    const glm::vec3 rho = pixel3(aov, p, albedo);
-    glm::vec3 scale(0.0f);
+  const std::size_t pixels = recovery.reflectance.size();
+  render::Transport transport;
+  transport.width = recovery.width;
+  transport.height = recovery.height;
+  transport.ambient.assign(pixels, glm::vec4(0.0f)); // no modelled term: every lamp's indirect is its own
+  std::vector<relight::LightRecord> lights;
+  for (std::size_t i = 0; i < photos.shots.size(); ++i) {
+    const glm::vec3 emission = recovery.shotEmission[i];
+    lights.push_back({fmt::format("shot{}", i), "point", emission, glm::vec3(0.0f)});
+    transport.lights.push_back(lights.back().name);
+    // The indirect light per unit emission. A channel the lamp leaves black, which its photograph
+    // cannot measure, takes the mean of its lit ones (a grey bounce), so that recolouring the lamp
+    // in `relight` still lights that channel's indirect.
+    glm::vec3 perEmission(0.0f);
+    int lit = 0;
     for (int c = 0; c < 3; ++c)
-      if (rho[c] >= 1e-4f) scale[c] = recovery.reflectance[p][c] / rho[c];
-    for (auto& direct : transport.direct) direct[p] *= scale;
-    transport.ambient[p] = glm::vec4(glm::vec3(transport.ambient[p]) * scale, transport.ambient[p].w);
+      if (emission[c] > 0.0f) {
+        perEmission[c] = 1.0f / emission[c];
+        ++lit;
+      }
+    std::vector<glm::vec3> direct(pixels), indirect(pixels);
+    for (std::size_t p = 0; p < pixels; ++p) {
+      const glm::vec3 R = recovery.reflectance[p];
+      glm::vec3 own = recovery.indirect[i][p] * perEmission;
+      const float grey = lit > 0 ? (own.x + own.y + own.z) / float(lit) : 0.0f;
+      for (int c = 0; c < 3; ++c)
+        if (emission[c] <= 0.0f) own[c] = grey;
+      direct[p] = recovery.directPerEmission[i][p] * R;
+      indirect[p] = own * R;
+    }
+    transport.direct.push_back(std::move(direct));
+    transport.seen.emplace_back(pixels, glm::vec3(0.0f)); // the lamps were not in view
+    transport.ownIndirect.push_back(std::move(indirect));
   }
-  relight::saveState(dir, renderer, transport, room.sourcePath);
+  glm::dvec3 sum(0.0);
+  std::size_t seen = 0;
+  for (std::size_t p = 0; p < pixels; ++p)
+    if (recovery.object[p] >= 0) {
+      sum += glm::dvec3(recovery.reflectance[p]);
+      ++seen;
+    }
+  const glm::vec3 average = seen > 0 ? glm::vec3(sum / double(seen)) : glm::vec3(0.0f);
+  const nlohmann::json settings = {{"made_by", "obscura recover"},
+                                   {"photographs", photos.file},
+                                   {"seed", options.seed},
+                                   {"direct", "per lamp, one exact shadow ray to each point per sample"},
+                                   {"indirect", nameString(kIndirectModelNames, options.indirect)},
+                                   {"gather_rays", options.gatherRays},
+                                   {"hidden_bounces", options.hiddenBounces}};
+  relight::saveState(dir, relight::stateJson(scenePath, options.spp, settings, average, lights, transport), transport);
 }
 
 Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& room, const bvh::Bvh& bvh,
@@ -482,6 +520,8 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
     outlierTest(out.estimates, fillWeights, options.filters.outlierConfidence, options.filters.outlierDistance);
   out.visibility = lighting.visibility;
   out.direct = lighting.direct;
+  out.directPerEmission = lighting.directPerEmission;
+  out.shotEmission = lighting.emission;
   out.object = lighting.geometry.object;
   out.reflectance = merged.reflectance;
   out.confidence = merged.directConfidence;

@@ -79,6 +79,10 @@ struct RecoveryOptions {
 // One render's lighting per photo, per unit reflectance, and what the pixels see.
 struct Lighting {
   std::vector<std::vector<glm::vec3>> direct;   // [shot][pixel] F V E_i
+  // [shot][pixel] D_s / albedo: the direct light per unit reflectance and unit lamp emission, which
+  // the relighting state scales by R (F V E_i without E_i, kept whole where a lamp has a black channel).
+  std::vector<std::vector<glm::vec3>> directPerEmission;
+  std::vector<glm::vec3> emission;              // [shot] E_i, the renderer's emission of the shot's lamp
   std::vector<std::vector<glm::vec3>> indirect; // [shot][pixel] B_i (the obscurance term)
   std::vector<ConfidenceImage> visibility;      // [shot] V_i in [0, 1]
   PixelGeometry geometry;                       // what each pixel sees
@@ -108,6 +112,8 @@ struct Recovery {
   std::vector<std::vector<glm::vec3>> estimates; // [shot] R_i
   std::vector<ConfidenceImage> visibility;       // [shot] V_i
   std::vector<std::vector<glm::vec3>> direct;    // [shot] F V E_i of the last render
+  std::vector<std::vector<glm::vec3>> directPerEmission; // [shot] the same per unit emission (Lighting's)
+  std::vector<glm::vec3> shotEmission;           // [shot] E_i (Lighting's emission)
   std::vector<std::vector<glm::vec3>> indirect;  // [shot] B_i the last estimate used
   std::vector<ConfidenceImage> confidences;      // [shot] filtered K_i
   std::vector<std::int32_t> object;
@@ -135,11 +141,13 @@ Lighting traceLighting(const gpu::Context& context, const scene::Scene& room, co
                        const std::vector<glm::vec3>& objectReflectance, const RecoveryOptions& options);
 
 // Writes `dir` as a relighting state (relight/relight_state.h) of the photographed room whose
-// albedo is `recovery`'s reflectance: rendered with each object at its mean recovered reflectance
-// (which sets I_a), then D_s and A scaled per pixel by R / albedo. Its lights are the shots'
-// lamps, "shot<i>", so `obscura relight DIR --light shot2=0.5` relights the photographed room.
-void saveRecoveredState(const std::string& dir, const gpu::Context& context, const scene::Scene& room,
-                        const bvh::Bvh& bvh, const scene::Camera& camera, const PhotoSet& photos,
+// albedo is `recovery`'s reflectance R, with no ray: per shot's lamp, D_s is the lighting render's
+// direct light per unit reflectance and emission (recovery.directPerEmission) times R, and its own
+// indirect light I_s the B_i the recovery ended with, per unit emission, times R; no lamp has an
+// obscurance share (w_s = 0). Relit with one lamp, the state is the recovery's model of that
+// photograph, R (F V E_i + B_i). Its lights are the shots' lamps, "shot<i>", so
+// `obscura relight DIR --light shot2=0.5` relights the photographed room.
+void saveRecoveredState(const std::string& dir, const std::string& scenePath, const PhotoSet& photos,
                         const Recovery& recovery, const RecoveryOptions& options);
 
 // IVR eq. 2 per pixel: C / (direct + indirect), 0 where nothing lights the pixel.

@@ -29,10 +29,11 @@ RelightState stateFromJson(const nlohmann::json& json, const std::string& file) 
   RelightState state;
   state.document = json;
   try {
-    if (!json.contains("version") || json.at("version").get<int>() != kStateVersion)
-      throw InputError(fmt::format("{}: state version {} (this obscura reads version {}); render it again",
+    if (!json.contains("version") || !json.at("version").is_number_integer() ||
+        json.at("version").get<int>() < kOldestStateVersion || json.at("version").get<int>() > kStateVersion)
+      throw InputError(fmt::format("{}: state version {} (this obscura reads versions {} to {}); render it again",
                                    file, json.contains("version") ? json.at("version").dump() : "missing",
-                                   kStateVersion));
+                                   kOldestStateVersion, kStateVersion));
     state.scene = json.at("scene").get<std::string>();
     state.samples = json.at("samples").get<std::uint32_t>();
     state.settings = json.at("settings");
@@ -76,29 +77,42 @@ void saveState(const std::string& dir, const render::ObscuranceRenderer& rendere
   saveState(dir, renderer, renderer.transport(), scenePath);
 }
 
+nlohmann::json stateJson(const std::string& scenePath, std::uint32_t samples, const nlohmann::json& settings,
+                         const glm::vec3& averageReflectance, const std::vector<LightRecord>& lights,
+                         const render::Transport& transport) {
+  nlohmann::json json = {{"version", kStateVersion},
+                         {"scene", scenePath},
+                         {"width", transport.width},
+                         {"height", transport.height},
+                         {"samples", samples},
+                         {"specular", transport.specular},
+                         {"settings", settings},
+                         {"average_reflectance", vec3Json(averageReflectance)},
+                         {"lights", nlohmann::json::array()}};
+  for (const auto& l : lights)
+    json["lights"].push_back({{"name", l.name}, {"type", l.type}, {"emission", vec3Json(l.emission)},
+                              {"ambient_weight", vec3Json(l.ambientWeight)}});
+  return json;
+}
+
 nlohmann::json stateJson(const render::ObscuranceRenderer& renderer, const std::string& scenePath) {
   const auto& lights = renderer.lights();
   const auto& s = renderer.settings();
-  nlohmann::json json = {
-      {"version", kStateVersion},
-      {"scene", scenePath},
-      {"width", s.width},
-      {"height", s.height},
-      {"samples", renderer.samples()},
-      {"specular", renderer.specular()},
-      {"settings", {{"seed", s.seed}, {"shadow_rays", s.shadowRays}, {"obscurance_rays", s.obscuranceRays},
-                    {"dmax", renderer.dMax()}, {"rho", static_cast<int>(s.rho)}, {"systematic", s.systematic},
-                    {"colour_bleeding", s.colourBleeding}, {"dark_escapes", renderer.darkEscapes()},
-                    {"max_depth", s.maxDepth},
-                    {"vertex_rays_by_throughput", s.vertexRaysByThroughput},
-                    {"emission_samples", s.emissionSamples}, {"emission_at_edges", s.emissionAtEdges}}},
-      {"average_reflectance", vec3Json(renderer.ambient().averageReflectance)},
-      {"lights", nlohmann::json::array()}};
+  const nlohmann::json settings = {{"seed", s.seed}, {"shadow_rays", s.shadowRays}, {"obscurance_rays", s.obscuranceRays},
+                                   {"dmax", renderer.dMax()}, {"rho", static_cast<int>(s.rho)}, {"systematic", s.systematic},
+                                   {"colour_bleeding", s.colourBleeding}, {"dark_escapes", renderer.darkEscapes()},
+                                   {"max_depth", s.maxDepth},
+                                   {"vertex_rays_by_throughput", s.vertexRaysByThroughput},
+                                   {"emission_samples", s.emissionSamples}, {"emission_at_edges", s.emissionAtEdges}};
+  std::vector<LightRecord> records;
   for (std::size_t i = 0; i < lights.size(); ++i)
-    json["lights"].push_back({{"name", lights.names[i]}, {"type", nameString(render::kLightTypeNames, lights.type(i))},
-                              {"emission", vec3Json(renderer.emissions()[i])},
-                              {"ambient_weight", vec3Json(renderer.ambient().weight[i])}});
-  return json;
+    records.push_back({lights.names[i], nameString(render::kLightTypeNames, lights.type(i)), renderer.emissions()[i],
+                       renderer.ambient().weight[i]});
+  render::Transport size; // the header's size and specular flag, without resolving the frame
+  size.width = static_cast<int>(s.width);
+  size.height = static_cast<int>(s.height);
+  size.specular = renderer.specular();
+  return stateJson(scenePath, renderer.samples(), settings, renderer.ambient().averageReflectance, records, size);
 }
 
 void saveState(const std::string& dir, const render::ObscuranceRenderer& renderer, const render::Transport& transport,

@@ -3,6 +3,8 @@
 //   DIR/state.json     version, scene, size, samples, settings, and per light its name, type,
 //                      render-time emission E_s and I_a weight w_s [RTO eq. 12]
 //   DIR/transport.exr  the resolved per-light transport (render/transport.h channels)
+// `obscura recover` writes one too: the photographed room's, whose lights carry their own
+// indirect light as the photographs measured it (render/transport.h I_s).
 #pragma once
 #include <string>
 #include <vector>
@@ -15,7 +17,9 @@
 
 namespace obscura::relight {
 
-inline constexpr int kStateVersion = 1;
+// 2: a light may carry its own indirect light (I.<light> channels). Version 1 states read as before.
+inline constexpr int kStateVersion = 2;
+inline constexpr int kOldestStateVersion = 1;
 
 struct LightRecord {
   std::string name;
@@ -49,6 +53,11 @@ void saveState(const std::string& dir, const render::ObscuranceRenderer& rendere
 
 // What state.json says of a renderer's frame (its samples so far among it).
 nlohmann::json stateJson(const render::ObscuranceRenderer& renderer, const std::string& scenePath);
+// The same of a transport no renderer traced whole (recover's): `settings` says how it was made;
+// its size and specular flag are the transport's.
+nlohmann::json stateJson(const std::string& scenePath, std::uint32_t samples, const nlohmann::json& settings,
+                         const glm::vec3& averageReflectance, const std::vector<LightRecord>& lights,
+                         const render::Transport& transport);
 // Writes DIR from state.json's contents and the resolved transport (a farm's merged parts).
 void saveState(const std::string& dir, const nlohmann::json& state, const render::Transport& transport);
 

@@ -49,6 +49,7 @@ Transport resolveSums(Transport t, const std::vector<std::uint32_t>& counts) {
       t.direct[l][p] *= inv;
       t.seen[l][p] *= inv;
       if (t.specular) t.specularDirect[l][p] *= inv;
+      if (t.hasOwnIndirect()) t.ownIndirect[l][p] *= inv;
     }
   }
   return t;
@@ -65,6 +66,7 @@ io::Image Transport::toImage() const {
     rgb("D." + name);
     rgb("M." + name);
     if (specular) rgb("S." + name);
+    if (hasOwnIndirect()) rgb("I." + name);
   }
   rgb("A");
   image.channels.push_back("A.W");
@@ -78,6 +80,10 @@ io::Image Transport::toImage() const {
       c += 6;
       if (specular) {
         putRgb(image, p, c, specularDirect[s][p]);
+        c += 3;
+      }
+      if (hasOwnIndirect()) {
+        putRgb(image, p, c, ownIndirect[s][p]);
         c += 3;
       }
     }
@@ -95,10 +101,12 @@ Transport Transport::fromImage(const io::Image& image, const std::vector<std::st
   t.height = image.height;
   t.lights = lights;
   t.specular = specular;
+  const bool ownIndirect = !lights.empty() && image.channelIndex("I." + lights.front() + ".R") >= 0;
   for (const auto& name : lights) {
     t.direct.push_back(readRgb(image, "D." + name, file));
     t.seen.push_back(readRgb(image, "M." + name, file));
     if (specular) t.specularDirect.push_back(readRgb(image, "S." + name, file));
+    if (ownIndirect) t.ownIndirect.push_back(readRgb(image, "I." + name, file));
   }
   const auto a = readRgb(image, "A", file);
   const int w = requireChannel(image, "A.W", file);
@@ -120,14 +128,14 @@ io::Image composeTransport(const Transport& t, const std::vector<glm::vec3>& emi
   image.pixels.assign(t.pixels() * nc, 0.0f);
   const glm::vec3 ia = indirectIntensity(emissions, ambientWeights);
   for (std::size_t p = 0; p < t.pixels(); ++p) {
-    glm::vec3 direct(0.0f), seen(0.0f), specular(0.0f);
+    glm::vec3 direct(0.0f), seen(0.0f), specular(0.0f), indirect = ia * glm::vec3(t.ambient[p]);
     for (std::size_t s = 0; s < t.lights.size(); ++s) {
       direct += emissions[s] * t.direct[s][p];
       seen += emissions[s] * t.seen[s][p];
       if (t.specular) specular += emissions[s] * t.specularDirect[s][p];
+      if (t.hasOwnIndirect()) indirect += emissions[s] * t.ownIndirect[s][p];
     }
     if (t.specular) specular += ia * t.specularAmbient[p];
-    const glm::vec3 indirect = ia * glm::vec3(t.ambient[p]);
     putRgb(image, p, 0, direct + indirect + seen + specular);
     putRgb(image, p, 3, direct);
     putRgb(image, p, 6, indirect);
@@ -155,6 +163,7 @@ io::Image lightLayers(const Transport& t, const std::vector<glm::vec3>& emission
         own += t.specularDirect[s][p];
         a += t.specularAmbient[p];
       }
+      if (t.hasOwnIndirect()) own += t.ownIndirect[s][p];
       putRgb(image, p, s * 3, emissions[s] * own + share * a);
     }
   }
