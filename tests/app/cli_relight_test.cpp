@@ -65,6 +65,16 @@ TEST_F(CliRelight, SavedStateRecomposesTheRenderAndScalesALight) {
   ASSERT_EQ(before.size(), same.size());
   for (std::size_t i = 0; i < before.size(); ++i) EXPECT_NEAR(same[i], before[i], 1e-5f * std::max(1.0f, before[i]));
 
+  // A state of version 1 (before a light could carry its own indirect layer) reads as it did.
+  fs::copy(path("state"), path("state-v1"));
+  json v1 = json::parse(std::ifstream(path("state-v1") + "/state.json"));
+  ASSERT_EQ(v1["version"], 2);
+  v1["version"] = 1;
+  std::ofstream(path("state-v1") + "/state.json") << v1.dump();
+  r = runObscura("relight " + path("state-v1") + " -o " + path("same-v1.exr"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(combined(io::readImage(path("same-v1.exr"))), same);
+
   r = runObscura("relight " + path("state") + " --light " + kCornellLight + "=2 -o " + path("double.exr"));
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const auto doubled = combined(io::readImage(path("double.exr")));
