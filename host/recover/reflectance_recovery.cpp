@@ -445,13 +445,17 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   std::unique_ptr<PhotoGather> gather;
   if (options.indirect == IndirectModel::Gather) {
     stepStart = Clock::now();
+    const std::uint64_t raysBefore = rays.rays();
+    const double deviceMsBefore = rays.gpuMs();
     gather = std::make_unique<PhotoGather>(room, rays, camera, lighting.geometry, photos.shots, options.gatherRays,
                                            options.seed, options.gatherSmoothing, options.hiddenBounces);
     out.gatherSeen = gather->seenFraction();
     out.gatherHidden = gather->hiddenFraction();
     if (log)
-      log(fmt::format("recover: gather: {} rays, {:.1f} % seen by the camera, {:.1f} % hidden, {:.1f} s", gather->rays(),
-                      100.0 * out.gatherSeen, 100.0 * out.gatherHidden, secondsSince(stepStart)));
+      log(fmt::format("recover: gather: {} rays, {:.1f} % seen by the camera, {:.1f} % hidden; {} rays traced on the "
+                      "device in {:.1f} s of its time; {:.1f} s",
+                      gather->rays(), 100.0 * out.gatherSeen, 100.0 * out.gatherHidden, rays.rays() - raysBefore,
+                      (rays.gpuMs() - deviceMsBefore) / 1000.0, secondsSince(stepStart)));
   }
   if (options.indirect != IndirectModel::Constant) {
     std::vector<PhotoGather::Cut> cuts; // per shot
