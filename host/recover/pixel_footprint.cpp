@@ -19,6 +19,12 @@ bool PixelFootprints::whole(std::size_t p) const {
   return std::all_of(points, points + kPoints, [&](std::int32_t o) { return o == points[0]; });
 }
 
+std::vector<bool> PixelFootprints::wholePixels() const {
+  std::vector<bool> out(std::size_t(width) * std::size_t(height));
+  for (std::size_t p = 0; p < out.size(); ++p) out[p] = whole(p);
+  return out;
+}
+
 namespace {
 
 // The objects `view` sees at the centres of a grid x grid grid of cells over each of `pixels`:
@@ -97,8 +103,7 @@ std::size_t mixFootprints(const PixelFootprints& footprints, const std::vector<s
                           const std::vector<glm::vec3>& objectMeans, std::vector<glm::vec3>& reflectance) {
   const int w = footprints.width, h = footprints.height;
   const std::vector<glm::vec3> estimate = reflectance; // the whole pixels' own, before any is mixed
-  std::vector<char> whole(estimate.size());
-  for (std::size_t p = 0; p < whole.size(); ++p) whole[p] = footprints.whole(p);
+  const std::vector<bool> whole = footprints.wholePixels();
   // rho_o near pixel (x, y): the mean of o's whole pixels in the window, else o's mean.
   const auto surfaceNear = [&](std::int32_t o, int x, int y) {
     glm::vec3 sum(0.0f);

@@ -43,6 +43,8 @@ struct PixelFootprints {
 
   // Whether every point of pixel p sees the same object (a footprint on one surface).
   bool whole(std::size_t p) const;
+  // whole(p) of every pixel.
+  std::vector<bool> wholePixels() const;
 };
 
 // The footprints of every pixel, traced through `rays` adaptively: kCoarseGrid^2 camera rays per

@@ -533,12 +533,11 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.relativeVariance = merged.relativeVariance;
   out.filled.assign(merged.reflectance.size(), 0);
   const std::vector<glm::vec3> means = out.iterations.back().objectReflectance;
-  std::vector<bool> whole; // the pixels whose footprint lies on one surface: those fill their surface's
-  if (footprints)
-    for (std::size_t p = 0; p < out.reflectance.size(); ++p) whole.push_back(footprints->whole(p));
+  // The pixels whose footprint lies on one surface: those fill their surface's.
+  const std::vector<bool> whole = footprints ? footprints->wholePixels() : std::vector<bool>();
   for (std::size_t p = 0; p < out.reflectance.size(); ++p) {
     if (out.object[p] < 0) continue;
-    if (!merged.texturedObjects.empty() && merged.texturedObjects[std::size_t(out.object[p])]) ++out.texturedPixels;
+    if (merged.textureOf(out.object[p]) == SurfaceTexture::Textured) ++out.texturedPixels;
     if (out.confidence[p] > 0.0f) ++out.litPixels;
     else if (out.relativeVariance[p] > 0.0f) ++out.indirectOnlyPixels;
     if (out.relativeVariance[p] > 0.0f) continue;
@@ -561,8 +560,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
     // tubes whose pixels the min filter empties: RMSE 0.113 over 458 px from visibility, 0.03 at
     // the mean). Not where too few of the object's pixels merged to judge it (BENCHMARKS: the
     // hall's black door panel, whose few merged pixels are its edges, mixed with the wall).
-    const bool plain = options.merge == MergeModel::Weighted && !merged.plainObjects.empty() &&
-                       merged.plainObjects[std::size_t(out.object[p])];
+    const bool plain = merged.textureOf(out.object[p]) == SurfaceTexture::Plain; // the weighted merge's alone
     if (surface) {
       out.reflectance[p] = *surface;
       out.filled[p] = 3;

@@ -201,11 +201,7 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
       out.independentVariance[p] = static_cast<float>(independentSum[p] / (weightSum[p] * weightSum[p]));
     }
   out.unsmoothed = out.reflectance;
-  const std::vector<SurfaceTexture> textures = surfaceTextures(out.reflectance, out.independentVariance, pixels);
-  for (const SurfaceTexture t : textures) {
-    out.texturedObjects.push_back(t == SurfaceTexture::Textured);
-    out.plainObjects.push_back(t == SurfaceTexture::Plain);
-  }
+  out.objectTextures = surfaceTextures(out.reflectance, out.independentVariance, pixels);
   out.reflectance = smoothMerge(out, pixels, options.smoothingRadius, options.agreement);
   return out;
 }
@@ -216,7 +212,7 @@ std::vector<glm::vec3> smoothMerge(const WeightedMerge& merged, const PixelGeome
   if (radius > 0) {
     std::vector<float> tolerance = merged.relativeVariance;
     for (std::size_t p = 0; p < tolerance.size(); ++p)
-      if (pixels.object[p] >= 0 && merged.texturedObjects[std::size_t(pixels.object[p])])
+      if (merged.textureOf(pixels.object[p]) == SurfaceTexture::Textured)
         tolerance[p] = merged.independentVariance[p];
     out = smoothByNoise(out, merged.relativeVariance, pixels, radius, agreement, &tolerance, acrossNormals);
   }

@@ -52,6 +52,9 @@
 
 namespace obscura::recover {
 
+// What surfaceTextures (below) judges an object: of one colour, textured, or not at all.
+enum class SurfaceTexture : std::uint8_t { Unjudged, Plain, Textured };
+
 struct WeightedMergeOptions {
   float indirectUncertainty = 0.25f; // e_B: relative error of the modelled indirect light
   int shadowRadius = 2;              // the window an indirect-only estimate must be in shadow over
@@ -83,8 +86,15 @@ struct WeightedMerge {
   // Of the merged R, from the photographs' noise alone (sum_i w_i^2 sigma_i^2 / C_i^2 / (sum_i w_i)^2):
   // what differs from pixel to pixel, where B's error is shared by neighbours. 0 where nothing informs.
   std::vector<float> independentVariance;
-  std::vector<bool> texturedObjects;        // per object: smoothed within independentVariance (surfaceTextures below)
-  std::vector<bool> plainObjects;           // per object: judged of one colour (enough pairs, not textured)
+  // Per object, surfaceTextures' verdict: a textured object is smoothed within independentVariance,
+  // a plain one's pixels the filters emptied take its mean (reflectance_recovery.cpp).
+  std::vector<SurfaceTexture> objectTextures;
+  // The verdict on a pixel's object; Unjudged where none was made (the paper's merge) or the pixel
+  // sees nothing (object -1).
+  SurfaceTexture textureOf(std::int32_t object) const {
+    return object >= 0 && std::size_t(object) < objectTextures.size() ? objectTextures[std::size_t(object)]
+                                                                       : SurfaceTexture::Unjudged;
+  }
   std::vector<glm::vec3> unsmoothed;        // the merged R before the smoothing (and before its clamp at 1)
   std::vector<float> directConfidence;      // sum of the paper's K_i over the lit estimates
   std::vector<float> indirectShots;         // how many indirect-only estimates the pixel has
@@ -131,7 +141,6 @@ std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeo
 // at its edges).
 inline constexpr double kTextureRatio = 2.0;
 inline constexpr std::size_t kTexturePairs = 20;
-enum class SurfaceTexture : std::uint8_t { Unjudged, Plain, Textured };
 std::vector<SurfaceTexture> surfaceTextures(const std::vector<glm::vec3>& reflectance,
                                             const std::vector<float>& independentVariance, const PixelGeometry& pixels);
 

@@ -357,9 +357,9 @@ TEST(WeightedMerge, TheSmoothingKeepsAnIndirectlyLitTextureAndFlattensAPlainWall
     }
   const std::vector<ConfidenceImage> none(shots, filled(w, h, 0.0f));
   const WeightedMerge m = weightedMerge(photos, direct, indirect, estimates, none, none, g, WeightedMergeOptions{});
-  ASSERT_EQ(m.texturedObjects.size(), 2u);
-  EXPECT_TRUE(m.texturedObjects[0]);
-  EXPECT_FALSE(m.texturedObjects[1]);
+  ASSERT_EQ(m.objectTextures.size(), 2u);
+  EXPECT_EQ(m.objectTextures[0], SurfaceTexture::Textured);
+  EXPECT_NE(m.objectTextures[1], SurfaceTexture::Textured);
   // The same merge smoothed as before objects were judged: every estimate's tolerance is ~50 %,
   // so the granite's levels pool.
   WeightedMergeOptions unsmoothed;
