@@ -1,4 +1,5 @@
-# discover_test_suites.cmake — run after obscura_tests is linked (cmake -P): lists its tests and
+# discover_test_suites.cmake — run after obscura_tests is linked and when tests/suite_seconds.txt
+# changes (cmake -P; CMakeLists.txt's obscura_test_suites target): lists its tests and
 # writes one CTest test per GoogleTest suite, run as `obscura_tests --gtest_filter=Suite.*`.
 #
 # Why per suite and not per test (gtest_discover_tests): on lavapipe most of a small GPU test's
