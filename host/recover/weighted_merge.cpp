@@ -202,8 +202,51 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
     }
   out.unsmoothed = out.reflectance;
   out.objectTextures = surfaceTextures(out.reflectance, out.independentVariance, pixels);
+  const std::vector<bool> coarse = coarselyTextured(estimates, confidences, pixels);
+  for (std::size_t o = 0; o < out.objectTextures.size() && o < coarse.size(); ++o)
+    if (coarse[o]) out.objectTextures[o] = SurfaceTexture::Textured;
   out.reflectance = smoothMerge(out, pixels, options.smoothingRadius, options.agreement);
   return out;
+}
+
+std::vector<bool> coarselyTextured(const std::vector<std::vector<glm::vec3>>& estimates,
+                                   const std::vector<ConfidenceImage>& confidences, const PixelGeometry& pixels) {
+  std::int32_t objects = 0;
+  for (const std::int32_t o : pixels.object) objects = std::max(objects, o + 1);
+  const auto count = static_cast<std::size_t>(objects);
+  std::vector<double> consistent(count, 0.0), scatter(count, 0.0);
+  std::vector<std::size_t> pairs(count, 0);
+  std::vector<char> inside(pixels.object.size(), 0); // not at an edge, whose mix repeats in every shot
+  forSurfacePixels(pixels, [&](int x, int y, std::size_t p) { inside[p] = insideSurface(pixels, x, y); });
+  std::vector<double> d;
+  forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
+    if (!inside[p]) return;
+    const auto pair = [&](int qx, int qy) {
+      if (qx >= pixels.width || qy >= pixels.height) return;
+      const std::size_t q = std::size_t(qy) * pixels.width + qx;
+      if (!inside[q] || !sameSurface(pixels, p, q)) return;
+      d.clear();
+      for (std::size_t i = 0; i < estimates.size(); ++i)
+        if (confidences[i].k[p] >= kLitConfidence && confidences[i].k[q] >= kLitConfidence)
+          d.push_back(double(luminance(estimates[i][q])) - double(luminance(estimates[i][p])));
+      if (d.size() < 2) return;
+      double mean = 0.0, variance = 0.0;
+      for (const double v : d) mean += v;
+      mean /= double(d.size());
+      for (const double v : d) variance += (v - mean) * (v - mean);
+      variance /= double(d.size() - 1);
+      const auto o = std::size_t(pixels.object[p]);
+      consistent[o] += mean * mean;
+      scatter[o] += variance / double(d.size());
+      ++pairs[o];
+    };
+    pair(x + kCoarseTextureStep, y);
+    pair(x, y + kCoarseTextureStep);
+  });
+  std::vector<bool> textured(count, false);
+  for (std::size_t o = 0; o < count; ++o)
+    textured[o] = pairs[o] >= kTexturePairs && scatter[o] > 0.0 && consistent[o] > kCoarseTextureRatio * scatter[o];
+  return textured;
 }
 
 std::vector<glm::vec3> smoothMerge(const WeightedMerge& merged, const PixelGeometry& pixels, int radius,

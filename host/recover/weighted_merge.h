@@ -144,6 +144,25 @@ inline constexpr std::size_t kTexturePairs = 20;
 std::vector<SurfaceTexture> surfaceTextures(const std::vector<glm::vec3>& reflectance,
                                             const std::vector<float>& independentVariance, const PixelGeometry& pixels);
 
+// Texture coarser than a pixel, which neighbouring pairs do not see (the hall's marble floor: its
+// neighbours agree within the noise, its tiles differ): pairs of an object's pixels
+// kCoarseTextureStep apart on one surface, each lit in at least two shots (K_i >= kLitConfidence),
+// whose difference in luminance d_i repeats from shot to shot. A texture of the reflectance gives
+// every shot the same d; a lamp-dependent error of the modelled light does not. Over the pairs,
+// sum of mean_i(d_i)^2 against sum of var_i(d_i) / k (k shots): 1 where the shots only scatter.
+// Pixels at an edge are left out (their mix of two surfaces repeats in every shot). Measured at the
+// last merge: 1.1-1.4 on the Cornell box's walls, floor and tall box, 2.0 on its short box (87
+// pairs), 1.3 on the hall's walls; 7.4 on its floor in photographs of 512 samples (less at 128:
+// there the noise hides the tiles, and it stays plain), 4-660 on the staircase's wallpapers and
+// wood. The first merge, on the paper's constant ambient, puts up to 5 on plain walls, whose
+// verdicts the later merges make again. Above kCoarseTextureRatio, twice kTextureRatio, an
+// object is textured.
+inline constexpr int kCoarseTextureStep = 4;
+inline constexpr double kCoarseTextureRatio = 2.0 * kTextureRatio;
+inline constexpr float kLitConfidence = 0.9f;
+std::vector<bool> coarselyTextured(const std::vector<std::vector<glm::vec3>>& estimates,
+                                   const std::vector<ConfidenceImage>& confidences, const PixelGeometry& pixels);
+
 // A merge's `unsmoothed` R smoothed (smoothByNoise over `radius`, 0: none) with the tolerance the
 // header describes, relativeVariance or, on a textured object, independentVariance, then clamped
 // at 1: weightedMerge's own smoothing, and the recovery's wide pass over the kept merge.

@@ -467,5 +467,41 @@ TEST(WeightedMerge, AnObjectIsJudgedPlainTexturedOrNotAtAllByHowManyInteriorPair
   EXPECT_EQ(t[2], SurfaceTexture::Unjudged);
 }
 
+TEST(WeightedMerge, TilesThatNeighboursDoNotSeeAreTexturedWhereEveryShotSeesThemAndALampsErrorIsNot) {
+  // Two walls, six shots. Object 0 (x < 32): tiles of 8 x 8 pixels, 0.45 or 0.55, under each
+  // shot's noise of 0.03: neighbours mostly agree, tiles 4 pixels apart differ, alike in every
+  // shot. Object 1 (x >= 32): one grey, each shot's estimate off by a slope of its own (a lamp's
+  // error of the modelled light, 0.03 over 4 pixels, its sign from the shot), also under noise.
+  const int w = 64, h = 32, shots = 6;
+  const PixelGeometry g = wall(w, h, 32);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 0.03f);
+  const std::size_t n = std::size_t(w) * h;
+  std::vector<std::vector<glm::vec3>> estimates(shots, std::vector<glm::vec3>(n));
+  std::vector<glm::vec3> merged(n, glm::vec3(0.0f));
+  for (int i = 0; i < shots; ++i) {
+    const float slope = (i % 2 == 0 ? 1.0f : -1.0f) * 0.03f / 4.0f;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t p = std::size_t(y) * w + x;
+        const float truth = x < 32 ? (((x / 8) + (y / 8)) % 2 == 0 ? 0.45f : 0.55f) : 0.5f + slope * float(x - 48);
+        estimates[i][p] = glm::vec3(truth + noise(rng));
+        merged[p] += estimates[i][p] / float(shots);
+      }
+  }
+  const std::vector<ConfidenceImage> lit(shots, filled(w, h, 1.0f));
+  const std::vector<bool> coarse = coarselyTextured(estimates, lit, g);
+  ASSERT_EQ(coarse.size(), 2u);
+  EXPECT_TRUE(coarse[0]);
+  EXPECT_FALSE(coarse[1]);
+  // The neighbours' test alone sees the tiles only at their borders: plain.
+  const std::vector<float> variance(n, 0.03f * 0.03f / float(shots) / (0.5f * 0.5f));
+  EXPECT_EQ(surfaceTextures(merged, variance, g)[0], SurfaceTexture::Plain);
+  // Lit in one shot alone, a pair has no second shot to repeat in: nothing to judge by.
+  std::vector<ConfidenceImage> one(shots, filled(w, h, 0.0f));
+  one[0] = filled(w, h, 1.0f);
+  EXPECT_EQ(coarselyTextured(estimates, one, g), std::vector<bool>(2, false));
+}
+
 } // namespace
 } // namespace obscura::recover
