@@ -21,6 +21,9 @@
 namespace obscura::recover {
 namespace {
 
+// The host's share of the gather, on every core, a block of rays at a time.
+constexpr std::size_t kHostBlock = 4096;
+
 // A 32-bit integer hash (PCG's output permutation), for per-pixel sample shifts.
 std::uint32_t hash(std::uint32_t v) {
   const std::uint32_t state = v * 747796405u + 2891336453u;
@@ -164,6 +167,17 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
     c.normal = nq;
     return c;
   };
+  // Every hit of a batch classified on every core (classify reads the scene and the camera
+  // alone); the pass over them that numbers the hidden vertices stays in order, on one.
+  const auto blocks = [](std::size_t n) { return (n + kHostBlock - 1) / kHostBlock; };
+  const auto classifyAll = [&](const std::vector<bvh::Hit>& hits, const std::vector<bvh::Ray>& from) {
+    std::vector<Classified> out(hits.size());
+    parallelFor(blocks(hits.size()), [&](std::size_t b) {
+      for (std::size_t r = b * kHostBlock; r < std::min(hits.size(), (b + 1) * kHostBlock); ++r)
+        if (hits[r].hit()) out[r] = classify(hits[r], from[r].direction);
+    });
+    return out;
+  };
   // The shadow rays from a hidden point to every shot's lamp, their results written to
   // direct[at + i] after the batch is traced.
   struct PendingDirect {
@@ -258,6 +272,16 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
       }
     }
     const std::vector<bvh::Hit> surface = rays.closest(cameraRays);
+    // Where each camera ray meets the room and the shading normal there, once per point (each
+    // point starts raysPerPixel / points gather rays), on every core.
+    std::vector<std::optional<render::GridHit>> starts(cameraRays.size());
+    std::vector<glm::vec3> shadings(cameraRays.size());
+    parallelFor(blocks(cameraRays.size()), [&](std::size_t b) {
+      for (std::size_t at = b * kHostBlock; at < std::min(cameraRays.size(), (b + 1) * kHostBlock); ++at) {
+        starts[at] = render::gridHit(room, cameraRays[at], surface[at]);
+        if (starts[at]) shadings[at] = shadingNormal(room, surface[at], starts[at]->normal);
+      }
+    });
     gatherRays.clear();
     std::size_t pixelFirst = 0; // the pixel's first camera ray
     for (std::size_t p = first; p < last; ++p) {
@@ -267,7 +291,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
       const float shift1 = unit(h), shift2 = unit(hash(h));
       for (std::uint32_t k = 0; k < raysPerPixel; ++k) {
         const std::size_t at = pixelFirst + k % points;
-        const std::optional<render::GridHit> start = render::gridHit(room, cameraRays[at], surface[at]);
+        const std::optional<render::GridHit>& start = starts[at];
         if (!start) { // this point of the pixel sees nothing: no light, as none in D there
           gatherRays.push_back({cameraRays[at].origin, cameraRays[at].direction, 0.0f, 0.0f});
           continue;
@@ -276,14 +300,14 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
         const float u2 = std::fmod(radicalInverse2(k) + shift2, 1.0f);
         // Cosine-distributed about the shading normal, as the renderer's D and the photographs'
         // diffuse surfaces reflect; one below the surface's own plane sees its inside: black.
-        const glm::vec3 shading = shadingNormal(room, surface[at], start->normal);
-        bvh::Ray gatherRay = cosineRay(start->position + offset * start->normal, shading, u1, u2);
+        bvh::Ray gatherRay = cosineRay(start->position + offset * start->normal, shadings[at], u1, u2);
         if (!(glm::dot(gatherRay.direction, start->normal) > 0.0f)) gatherRay.tmax = 0.0f;
         gatherRays.push_back(gatherRay);
       }
       pixelFirst += points;
     }
     const std::vector<bvh::Hit> hits = rays.closest(gatherRays);
+    const std::vector<Classified> classes = classifyAll(hits, gatherRays);
     shadowRays.clear();
     pending.clear();
     bounceRays.clear();
@@ -297,9 +321,8 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
       }
       rays_ += raysPerPixel;
       for (std::uint32_t k = 0; k < raysPerPixel; ++k, ++ray) {
-        const bvh::Hit& hit = hits[ray];
-        if (!hit.hit()) continue; // leaves the scene: black
-        const Classified c = classify(hit, gatherRays[ray].direction);
+        if (!hits[ray].hit()) continue; // leaves the scene: black
+        const Classified& c = classes[ray];
         if (c.seenPixel >= 0) {
           seen_.push_back(static_cast<std::uint32_t>(c.seenPixel));
           continue;
@@ -323,6 +346,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
         bounceRays.push_back(cosineRay(a.lit, a.normal, unit(hb), unit(hash(hb))));
       }
       const std::vector<bvh::Hit> bounces = rays.closest(bounceRays);
+      const std::vector<Classified> bounceClasses = classifyAll(bounces, bounceRays);
       std::vector<Active> deeper;
       for (std::size_t k = 0; k < bounces.size(); ++k) {
         const std::uint32_t v = active[k].vertex;
@@ -330,7 +354,7 @@ PhotoGather::PhotoGather(const scene::Scene& room, render::RayBatch& rays, const
           next_[v] = kEscaped;
           continue;
         }
-        const Classified c = classify(bounces[k], bounceRays[k].direction);
+        const Classified& c = bounceClasses[k];
         if (c.seenPixel >= 0) {
           next_[v] = kSeenFlag | static_cast<std::uint32_t>(c.seenPixel);
           continue;
