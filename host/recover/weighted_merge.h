@@ -153,8 +153,8 @@ std::vector<SurfaceTexture> surfaceTextures(const std::vector<glm::vec3>& reflec
 // Pixels at an edge are left out (their mix of two surfaces repeats in every shot). Measured at the
 // last merge: 1.1-1.4 on the Cornell box's walls, floor and tall box, 2.0 on its short box (87
 // pairs), 1.3 on the hall's walls; 7.4 on its floor in photographs of 512 samples (less at 128:
-// there the noise hides the tiles, and it stays plain), 4-660 on the staircase's wallpapers and
-// wood. The first merge, on the paper's constant ambient, puts up to 5 on plain walls, whose
+// there the noise hides the tiles, and it stays plain), 2.2-660 on the staircase's wallpapers
+// and wood, most of which the neighbours' test already judges textured. The first merge, on the paper's constant ambient, puts up to 5 on plain walls, whose
 // verdicts the later merges make again. Above kCoarseTextureRatio, twice kTextureRatio, an
 // object is textured.
 inline constexpr int kCoarseTextureStep = 4;
