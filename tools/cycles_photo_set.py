@@ -32,7 +32,7 @@
 # Needs Blender 3.4 (Debian 12: apt-get install blender):
 #   blender -b -P tools/cycles_photo_set.py -- SCENE.gltf -o DIR [--width 320] [--height 180]
 #       [--spp 512] [--shots 6] [--noisy-spp 64] [--power 30] [--radius 0.04] [--threads 2]
-#       [--bounces 16] [--positions-from OLD/lights.json]
+#       [--bounces 16] [--positions-from OLD/lights.json] [--shots-only]
 import argparse
 import json
 import math
@@ -65,6 +65,8 @@ def parse_args():
     p.add_argument("--positions-from", help="a set's lights.json: its lamps (and their coverages) instead of choosing")
     p.add_argument("--new-lamp-only", action="store_true", help="render new-lamp.exr only (with --positions-from: "
                    "what another bounce count or sample count changes)")
+    p.add_argument("--shots-only", action="store_true", help="the shots and albedo.exr only, no new lamp or "
+                   "repeats (a set's accuracy at another sample count, for a fraction of the time)")
     return p.parse_args(argv)
 
 
@@ -275,6 +277,8 @@ def main():
         lamp.location = candidates[c]
         render(scene, os.path.join(a.output, f"photo-{k:03d}.exr"), k, a.spp,
                os.path.join(a.output, "albedo.exr") if k == 0 else None)
+    if a.shots_only:
+        return
     lamp.location = candidates[chosen[-1]]
     render(scene, os.path.join(a.output, "new-lamp.exr"), 99, a.spp)
     os.makedirs(os.path.join(a.output, "repeat"), exist_ok=True)
