@@ -329,7 +329,7 @@ void saveRecoveredState(const std::string& dir, const std::string& scenePath, co
   transport.ambient.assign(pixels, glm::vec4(0.0f)); // no modelled term: every lamp's indirect is its own
   std::vector<relight::LightRecord> lights;
   for (std::size_t i = 0; i < photos.shots.size(); ++i) {
-    const glm::vec3 emission = recovery.shotEmission[i];
+    const glm::vec3 emission = recovery.emission[i];
     lights.push_back({fmt::format("shot{}", i), "point", emission, glm::vec3(0.0f)});
     transport.lights.push_back(lights.back().name);
     // The indirect light per unit emission. A channel the lamp leaves black, which its photograph
@@ -525,7 +525,7 @@ Recovery recoverReflectance(const gpu::Context& context, const scene::Scene& roo
   out.visibility = lighting.visibility;
   out.direct = lighting.direct;
   out.directPerEmission = lighting.directPerEmission;
-  out.shotEmission = lighting.emission;
+  out.emission = lighting.emission;
   out.object = lighting.geometry.object;
   out.reflectance = merged.reflectance;
   out.confidence = merged.directConfidence;

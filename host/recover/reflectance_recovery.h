@@ -113,7 +113,7 @@ struct Recovery {
   std::vector<ConfidenceImage> visibility;       // [shot] V_i
   std::vector<std::vector<glm::vec3>> direct;    // [shot] F V E_i of the last render
   std::vector<std::vector<glm::vec3>> directPerEmission; // [shot] the same per unit emission (Lighting's)
-  std::vector<glm::vec3> shotEmission;           // [shot] E_i (Lighting's emission)
+  std::vector<glm::vec3> emission;               // [shot] E_i (Lighting's)
   std::vector<std::vector<glm::vec3>> indirect;  // [shot] B_i the last estimate used
   std::vector<ConfidenceImage> confidences;      // [shot] filtered K_i
   std::vector<std::int32_t> object;

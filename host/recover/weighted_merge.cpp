@@ -68,6 +68,13 @@ bool insideSurface(const PixelGeometry& g, int x, int y) {
   return support == window;
 }
 
+// One more than the largest object a pixel sees: the size of a per-object table.
+std::size_t objectCount(const PixelGeometry& pixels) {
+  std::int32_t objects = 0;
+  for (const std::int32_t o : pixels.object) objects = std::max(objects, o + 1);
+  return static_cast<std::size_t>(objects);
+}
+
 double median(std::vector<double>& v) {
   const auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
@@ -211,9 +218,7 @@ WeightedMerge weightedMerge(const std::vector<std::vector<glm::vec3>>& photos,
 
 std::vector<bool> coarselyTextured(const std::vector<std::vector<glm::vec3>>& estimates,
                                    const std::vector<ConfidenceImage>& confidences, const PixelGeometry& pixels) {
-  std::int32_t objects = 0;
-  for (const std::int32_t o : pixels.object) objects = std::max(objects, o + 1);
-  const auto count = static_cast<std::size_t>(objects);
+  const std::size_t count = objectCount(pixels);
   std::vector<double> consistent(count, 0.0), scatter(count, 0.0);
   std::vector<std::size_t> pairs(count, 0);
   std::vector<char> inside(pixels.object.size(), 0); // not at an edge, whose mix repeats in every shot
@@ -284,9 +289,7 @@ std::optional<glm::vec3> surfaceFill(const WeightedMerge& merged, const PixelGeo
 
 std::vector<SurfaceTexture> surfaceTextures(const std::vector<glm::vec3>& reflectance,
                                             const std::vector<float>& independentVariance, const PixelGeometry& pixels) {
-  std::int32_t objects = 0;
-  for (const std::int32_t o : pixels.object) objects = std::max(objects, o + 1);
-  const auto count = static_cast<std::size_t>(objects);
+  const std::size_t count = objectCount(pixels);
   std::vector<std::vector<double>> differences(count), noise(count);
   std::vector<char> inside(pixels.object.size(), 0);
   forSurfacePixels(pixels, [&](int x, int y, std::size_t p) {
