@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "io/exr_reader.h"
 #include "io/exr_writer.h"
 #include "io/oiio_codec.h"
 #include "io/stb_codec.h"
@@ -127,8 +128,9 @@ void writePng(const std::string& path, const Image& image, int firstChannel, flo
 Image readImage(const std::string& path) {
   if (stbReads(path)) return readImageWithStb(path);
 #ifndef OBSCURA_HAVE_OPENIMAGEIO
-  throw InputError(fmt::format("{}: cannot read .{} images: this build has no OpenImageIO (it reads PNG, JPEG, BMP, "
-                               "TGA and HDR)", path, extensionOf(path)));
+  if (extensionOf(path) == "exr") return readExr(path);
+  throw InputError(fmt::format("{}: cannot read .{} images: this build has no OpenImageIO (it reads EXR, PNG, JPEG, "
+                               "BMP, TGA and HDR)", path, extensionOf(path)));
 #else
   Image image;
   if (std::string failure = oiioCodec(path).read(path, image); !failure.empty())

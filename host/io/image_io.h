@@ -1,7 +1,8 @@
 // image_io.h — images in and out. PNG is written, and PNG, JPEG, BMP, TGA and HDR are read,
 // through stb (io/stb_codec.h); EXR and the other formats through OpenImageIO, in a module loaded
 // on first use (io/oiio_codec.h). A build without OpenImageIO (-DOBSCURA_WITH_OPENIMAGEIO=OFF)
-// reads no EXR and writes uncompressed EXR (io/exr_writer.h).
+// reads scan-line EXR itself (io/exr_reader.h), writes it uncompressed (io/exr_writer.h), and
+// reads no other format.
 //
 // EXR holds linear radiance and every AOV as channel layers ("albedo.R", "depth.Z", …). PNG is
 // for viewing only: exposure, then the sRGB curve, 8 bits [SPEC §5]. Files are written to a

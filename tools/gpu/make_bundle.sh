@@ -3,7 +3,7 @@
 # of Obscura's build dependencies (the device tool's bare CUDA image), for tools/gpu/benchmarks.sh.
 #
 # The build leaves out OpenImageIO (its libraries and theirs come to ~400 MB; PNG still works
-# through stb, EXR is written uncompressed and not read) and Embree (the CPU baseline: 44 MB, and a GPU
+# through stb, EXR is read by host/io/exr_reader.cpp and written uncompressed) and Embree (the CPU baseline: 44 MB, and a GPU
 # is measured against the issue's absolute figures, not against the CPU). BUNDLE_DIR gets the
 # binary, the shared libraries it needs beyond glibc and libstdc++ (fmt, stb, zlib, GLFW and X11's
 # client libraries) and the benchmark scenes from ../shared/scenes. The Vulkan loader travels
