@@ -23,6 +23,8 @@
 #   relight: modern-hall 800x600, 1 spp: a light's scale and colour, add and remove a point light,
 #     move an object, add an emissive quad, each twice (edits.jsonl: GPU, wall and host CPU ms per
 #     edit; the second round without first-use costs)
+#   recover: the modern hall's six photographs (320x180, photos/modern-hall) to reflectance, its
+#     gather traced on the device, against the answer key (--truth): RMSE and seconds per stage
 # STEP_LIMIT (seconds, default 150) bounds each step, so that a hang cannot eat the lease.
 set -u
 bundle=$(cd "${1:?usage: benchmarks.sh BUNDLE_DIR OUT_DIR [quick]}" && pwd)
@@ -101,5 +103,8 @@ step() { # name command...: runs it under a time limit, everything into log.txt
     -o "$work/relight" --width "${hall[0]}" --height "${hall[1]}" --spp 1 --png
   cat "$work/relight/edits.jsonl"
   cp "$work/relight/frame-012.png" "$out/relight-last-frame.png"
+  step recover-hall "$obscura" recover "$hall_scene" --photos "$bundle/photos/modern-hall/lights.json" \
+    -o "$work/recover" --truth "$bundle/photos/modern-hall/albedo.exr"
+  cat "$work/recover/recover.json"; echo
 } > "$out/log.txt" 2>&1
 cat "$out/log.txt"
